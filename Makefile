@@ -1,0 +1,45 @@
+# The two commands of the README: `make demo` and `make test`. Both set up everything first.
+# Set-up is idempotent: the venv, pip installs, the interface packages and the Debian test peer
+# are only (re)done when their inputs change or they are missing.
+
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.ros_gz_bridge_py-setup
+LOOPBACK := ../shared/tools/loopback-env
+# Keep ROS, Gazebo Transport and Zenoh traffic on this host (see DEVELOPERS.md).
+WITH_LOOPBACK := if [ -f $(LOOPBACK) ]; then source $(LOOPBACK); else source tools/loopback-env; fi;
+
+.PHONY: setup test lint typecheck unit demo bench clean
+
+setup: $(STAMP)
+
+$(STAMP): pyproject.toml tools/setup_peer.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[ros,dev]'
+	bash tools/setup_peer.sh
+	bash tools/setup_interfaces.sh $(VENV)
+	@touch $(STAMP)
+
+lint: setup
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
+
+typecheck: setup
+	$(VENV)/bin/mypy ros_gz_bridge_py tests benchmarks tools
+
+unit: setup
+	$(WITH_LOOPBACK) $(PY) -m pytest -q tests
+
+test: lint typecheck unit
+
+demo: setup
+	$(WITH_LOOPBACK) $(PY) -m ros_gz_bridge_py.demo
+
+bench: setup
+	$(WITH_LOOPBACK) $(PY) -m benchmarks.run
+
+clean:
+	rm -rf .build .pytest_cache .mypy_cache .ruff_cache

@@ -1,0 +1,288 @@
+"""Bridge YAML files (the ``config_file`` parameter) parsed into specs with located errors.
+
+Keys, precedence and the error texts are the C++ bridge's (behaviour spec 4.1-4.3); an invalid
+entry is skipped and the others still parse. The file is composed (PyYAML ``SafeLoader``) into
+a node tree rather than loaded, so every error and warning can name the entry and its line.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar, cast
+
+import yaml
+from yaml.constructor import SafeConstructor
+
+from ros_gz_bridge_py.config_model import (
+    DEPRECATED_DIRECTIONS,
+    QOS_PROFILE_NAMES,
+    BridgeSpec,
+    Direction,
+    ParseResult,
+    ServiceBridgeSpec,
+    TopicBridgeSpec,
+    as_bool,
+    as_queue,
+    ros_type_hint,
+)
+from ros_gz_bridge_py.errors import ConfigError
+
+_NAME_KEYS = ("topic_name", "ros_topic_name", "gz_topic_name")
+_TOPIC_ONLY_KEYS = (
+    "gz_type_name",
+    "direction",
+    "publisher_queue",
+    "subscriber_queue",
+    "lazy",
+    "qos_profile",
+    "frame_id",
+)
+_SERVICE_KEYS = ("service_name", "gz_req_type_name", "gz_rep_type_name")
+#: Humble-era spellings of gz_topic_name and gz_type_name.
+_DEPRECATED_KEYS = ("ign_topic_name", "ign_type_name")
+_KNOWN_KEYS = frozenset(
+    (*_NAME_KEYS, "ros_type_name", *_TOPIC_ONLY_KEYS, *_SERVICE_KEYS, *_DEPRECATED_KEYS)
+)
+_NULL_TAG = "tag:yaml.org,2002:null"
+_T = TypeVar("_T")
+
+
+def _entry_error(text: str, source: str) -> ConfigError:
+    return ConfigError(f"Could not parse entry: {text}", source)
+
+
+class _Entry:
+    """The keys of one YAML map entry, read with C++ semantics and located errors."""
+
+    def __init__(
+        self, node: yaml.MappingNode, source_name: str, index: int, warnings: list[str]
+    ) -> None:
+        self._source_name = source_name
+        self._index = index
+        self.location = self.at(node)
+        self._warnings = warnings
+        self._constructor = SafeConstructor()
+        try:
+            self._constructor.flatten_mapping(node)  # resolve "<<: *anchor" merge keys
+        except yaml.YAMLError as err:
+            msg = f"invalid merge key: {err}"
+            raise _entry_error(msg, self.location) from err
+        self._values: dict[str, yaml.Node] = {}
+        for key_node, value_node in node.value:
+            if not isinstance(key_node, yaml.ScalarNode):
+                msg = "keys must be plain strings"
+                raise _entry_error(msg, self.at(key_node))
+            if key_node.value in self._values:
+                self.warn(f"key '{key_node.value}' is set twice; the last value is used")
+            self._values[key_node.value] = value_node
+
+    def at(self, node: yaml.Node) -> str:
+        return f"{self._source_name} entry {self._index} (line {node.start_mark.line + 1})"
+
+    def at_value(self, key: str) -> str:
+        """The location of ``key``'s value (the entry's when the key is absent)."""
+        node = self._values.get(key)
+        return self.at(node) if node is not None else self.location
+
+    def warn(self, text: str) -> None:
+        self._warnings.append(f"{self.location}: {text}")
+
+    def has(self, key: str) -> bool:
+        node = self._values.get(key)
+        return node is not None and node.tag != _NULL_TAG
+
+    def text(self, key: str) -> str:
+        """The scalar's text as written (yaml-cpp ``as<std::string>``); "" when unset or null."""
+        node = self._values.get(key)
+        if node is None or node.tag == _NULL_TAG:
+            return ""
+        if not isinstance(node, yaml.ScalarNode):
+            kind = "map" if isinstance(node, yaml.MappingNode) else "list"
+            msg = f"{key} must be a string, got a {kind}"
+            raise _entry_error(msg, self.at(node))
+        return cast(str, node.value)
+
+    def value(self, key: str) -> object:
+        """The key's value constructed as PyYAML would (int, bool, str, ...); None when unset."""
+        node = self._values.get(key)
+        if node is None:
+            return None
+        try:
+            return self._constructor.construct_object(node, deep=True)
+        except yaml.YAMLError as err:
+            msg = f"{key}: {err}"
+            raise _entry_error(msg, self.at(node)) from err
+
+    def flag(self, key: str) -> bool | None:
+        raw = self.value(key)
+        return None if raw is None else self._checked(key, lambda: as_bool(key, raw))
+
+    def queue(self, key: str) -> int | None:
+        raw = self.value(key)
+        return None if raw is None else self._checked(key, lambda: as_queue(key, raw))
+
+    def _checked(self, key: str, convert: Callable[[], _T]) -> _T:
+        try:
+            return convert()
+        except ConfigError as err:
+            raise _entry_error(err.message, self.at_value(key)) from err
+
+    def unknown_keys(self) -> list[str]:
+        return [key for key in self._values if key not in _KNOWN_KEYS]
+
+
+def _gz_key(entry: _Entry, key: str) -> str:
+    """A ``gz_*`` key, or its Humble-era ``ign_*`` spelling (with a warning) if only that is set."""
+    old = key.replace("gz_", "ign_", 1)
+    value = entry.text(key)
+    if entry.has(old):
+        entry.warn(f"{old} is deprecated, migrate to {key}")
+        value = value or entry.text(old)
+    return value
+
+
+def _direction(entry: _Entry) -> Direction:
+    if not entry.has("direction"):
+        return Direction.BIDIRECTIONAL
+    text = entry.text("direction")
+    if text in DEPRECATED_DIRECTIONS:
+        replacement = DEPRECATED_DIRECTIONS[text]
+        entry.warn(f"{text} constant is deprecated, migrate to {replacement.value}")
+        return replacement
+    try:
+        return Direction(text)
+    except ValueError:
+        msg = f"invalid direction [{text}]"
+        raise _entry_error(msg, entry.at_value("direction")) from None
+
+
+def _parse_service(entry: _Entry) -> ServiceBridgeSpec:
+    for key in _NAME_KEYS:
+        if entry.text(key):
+            msg = f"service_name and {key} are mutually exclusive"
+            raise _entry_error(msg, entry.location)
+    ros_type = entry.text("ros_type_name")
+    if not ros_type:
+        msg = "ros_type_name must be set for a service"
+        raise _entry_error(msg, entry.location)
+    req_type = entry.text("gz_req_type_name")
+    rep_type = entry.text("gz_rep_type_name")
+    if bool(req_type) != bool(rep_type):
+        msg = "set both gz_req_type_name and gz_rep_type_name, or neither"
+        raise _entry_error(msg, entry.location)
+    for key in _TOPIC_ONLY_KEYS:
+        if entry.has(key):
+            entry.warn(f"{key} does not apply to a service bridge; it is ignored")
+    return ServiceBridgeSpec(
+        entry.text("service_name"), ros_type, req_type or None, rep_type or None, entry.location
+    )
+
+
+def _parse_topic(entry: _Entry) -> TopicBridgeSpec:
+    topic_name = entry.text("topic_name")
+    ros_topic = entry.text("ros_topic_name")
+    gz_topic = _gz_key(entry, "gz_topic_name")
+    ros_type = entry.text("ros_type_name")
+    gz_type = _gz_key(entry, "gz_type_name")
+    if topic_name and ros_topic:
+        msg = "topic_name and ros_topic_name are mutually exclusive"
+        raise _entry_error(msg, entry.location)
+    if topic_name and gz_topic:
+        msg = "topic_name and gz_topic_name are mutually exclusive"
+        raise _entry_error(msg, entry.location)
+    if not ros_type or not gz_type:
+        msg = "both ros_type_name and gz_type_name must be set"
+        raise _entry_error(msg, entry.location)
+    direction = _direction(entry)
+    if not (topic_name or ros_topic or gz_topic):
+        msg = "one of topic_name, ros_topic_name or gz_topic_name must be set"
+        raise _entry_error(msg, entry.location)
+    ros_topic = topic_name or ros_topic or gz_topic
+    gz_topic = topic_name or gz_topic or ros_topic
+    qos_profile = entry.text("qos_profile") or None
+    if qos_profile is not None and qos_profile not in QOS_PROFILE_NAMES:
+        choices = ", ".join(sorted(QOS_PROFILE_NAMES))
+        msg = f"invalid qos_profile [{qos_profile}]; use one of {choices}"
+        raise _entry_error(msg, entry.at_value("qos_profile"))
+    lazy = entry.flag("lazy")
+    publisher_queue = entry.queue("publisher_queue")
+    subscriber_queue = entry.queue("subscriber_queue")
+    if hint := ros_type_hint(ros_type):
+        entry.warn(hint)
+    return TopicBridgeSpec(
+        ros_topic=ros_topic,
+        gz_topic=gz_topic,
+        ros_type=ros_type,
+        gz_type=gz_type,
+        direction=direction,
+        lazy=lazy,
+        publisher_queue=publisher_queue,
+        subscriber_queue=subscriber_queue,
+        qos_profile=qos_profile,
+        frame_id=entry.text("frame_id") or None,
+        source=entry.location,
+    )
+
+
+def _parse_entry(node: yaml.Node, source_name: str, index: int, warnings: list[str]) -> BridgeSpec:
+    if not isinstance(node, yaml.MappingNode):
+        location = f"{source_name} entry {index} (line {node.start_mark.line + 1})"
+        msg = "entry must be a YAML map"
+        raise _entry_error(msg, location)
+    entry = _Entry(node, source_name, index, warnings)
+    for key in entry.unknown_keys():
+        close = difflib.get_close_matches(key, _KNOWN_KEYS, n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        entry.warn(f"unknown key '{key}'{hint} is ignored")
+    if entry.text("service_name"):
+        return _parse_service(entry)
+    return _parse_topic(entry)
+
+
+def parse_yaml(text: str, source_name: str = "<string>") -> ParseResult:
+    """Parse the text of a bridge YAML file: a sequence of topic or service entries."""
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.MarkedYAMLError as err:
+        mark = err.problem_mark or err.context_mark
+        where = f"{source_name} (line {mark.line + 1})" if mark else source_name
+        problem = err.problem or err.context or "syntax error"
+        message = f"Could not parse config: invalid YAML: {problem}"
+        return ParseResult(errors=(ConfigError(message, where),))
+    except yaml.YAMLError as err:
+        message = f"Could not parse config: invalid YAML: {err}"
+        return ParseResult(errors=(ConfigError(message, source_name),))
+    if not isinstance(root, yaml.SequenceNode):
+        message = "Could not parse config: top level must be a YAML sequence"
+        return ParseResult(errors=(ConfigError(message, source_name),))
+    specs: list[BridgeSpec] = []
+    errors: list[ConfigError] = []
+    warnings: list[str] = []
+    for index, node in enumerate(root.value, start=1):
+        try:
+            specs.append(_parse_entry(node, source_name, index, warnings))
+        except ConfigError as err:
+            errors.append(err)
+    return ParseResult(tuple(specs), tuple(errors), tuple(warnings))
+
+
+def read_yaml_file(path: str | os.PathLike[str]) -> ParseResult:
+    """Read and parse a bridge YAML file; a missing, empty or non-UTF-8 file is one error."""
+    name = os.fspath(path)
+    try:
+        data = Path(path).read_bytes()
+    except OSError:
+        message = f"Could not parse config: failed to open file [{name}]"
+        return ParseResult(errors=(ConfigError(message, name),))
+    if not data:
+        message = f"Could not parse config: file empty [{name}]"
+        return ParseResult(errors=(ConfigError(message, name),))
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        message = f"Could not parse config: file is not UTF-8 text [{name}]"
+        return ParseResult(errors=(ConfigError(message, name),))
+    return parse_yaml(text, name)

@@ -1,0 +1,221 @@
+"""The table of ROS <-> Gazebo message pairs, built from data declared by each module.
+
+Conventions for writing converter modules: ``CONVENTIONS.md`` beside this file.
+
+Each module in this package (one per ROS package) declares a module-level ``PAIRS`` tuple of
+:class:`Pair` (topics) and optionally ``SERVICES`` of :class:`ServicePair`. The registry
+imports those modules, plus any third-party module registered under the entry-point group
+``ros_gz_bridge_py.converters`` (which must expose the same ``PAIRS``/``SERVICES``), and
+indexes them by (ROS type, Gazebo type).
+
+Gazebo type names are accepted as ``gz.msgs.X`` or ``ignition.msgs.X``. An exact registration
+wins (``ignition.msgs.IMU`` has its own, Fortress wire layout); otherwise the name is
+normalised to ``gz.msgs.X``. The default ROS type for a bare Gazebo type, and the default
+Gazebo type for a ROS type, is the first pair declared for it (declaration order is deliberate).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import importlib
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field
+from importlib.metadata import entry_points
+from types import ModuleType
+from typing import Any
+
+from ros_gz_bridge_py.errors import BridgeError, UnsupportedTypeError
+
+ENTRY_POINT_GROUP = "ros_gz_bridge_py.converters"
+
+#: Modules of this package that declare pairs, in listing order.
+BUILTIN_MODULES: tuple[str, ...] = (
+    "builtin_interfaces",
+    "std_msgs",
+    "geometry_msgs",
+    "nav_msgs",
+    "rosgraph_msgs",
+    "sensor_msgs",
+    "tf2_msgs",
+    "trajectory_msgs",
+    "actuator_msgs",
+    "gps_msgs",
+    "vision_msgs",
+    "rcl_interfaces",
+    "ros_gz_interfaces",
+)
+
+GZ_PREFIX = "gz.msgs."
+IGN_PREFIX = "ignition.msgs."
+
+
+def canonical_gz_type(name: str) -> str:
+    """Return ``gz.msgs.X`` for ``ignition.msgs.X``; any other name unchanged."""
+    if name.startswith(IGN_PREFIX):
+        return GZ_PREFIX + name[len(IGN_PREFIX) :]
+    return name
+
+
+@dataclass(frozen=True)
+class Pair:
+    """One ROS message type and one Gazebo message type with both conversions.
+
+    ``to_gz`` takes a ROS message and returns a new gz protobuf message; ``to_ros`` takes a
+    gz protobuf message and returns a new ROS message. Either raises
+    :class:`~ros_gz_bridge_py.errors.ConversionError` for data it cannot convert.
+    """
+
+    ros_type: str
+    gz_type: str
+    to_gz: Callable[[Any], Any]
+    to_ros: Callable[[Any], Any]
+    ros_class: type[Any]
+    #: Where it came from (module name), for listings and error messages.
+    origin: str = field(default="", compare=False)
+
+
+@dataclass(frozen=True)
+class ServicePair:
+    """A ROS service type bridged to one Gazebo service (request type, reply type).
+
+    ``request_to_gz`` takes the ROS request and returns the gz request message;
+    ``reply_to_ros`` takes the gz reply message and returns a new ROS response.
+    ``failure_to_ros`` returns the ROS response sent when Gazebo reports failure or times out.
+    """
+
+    ros_type: str
+    gz_req_type: str
+    gz_rep_type: str
+    request_to_gz: Callable[[Any], Any]
+    reply_to_ros: Callable[[Any], Any]
+    failure_to_ros: Callable[[], Any]
+    ros_class: type[Any]
+    origin: str = field(default="", compare=False)
+
+
+@dataclass
+class Registry:
+    """All known pairs, indexed for lookup. Registering a duplicate pair raises."""
+
+    pairs: list[Pair] = field(default_factory=list)
+    services: list[ServicePair] = field(default_factory=list)
+    #: Modules that could not be imported (e.g. an interface package not built): name -> reason.
+    unavailable: dict[str, str] = field(default_factory=dict)
+    _by_key: dict[tuple[str, str], Pair] = field(default_factory=dict, repr=False)
+    _services_by_type: dict[str, ServicePair] = field(default_factory=dict, repr=False)
+
+    def add(self, pair: Pair) -> None:
+        key = (pair.ros_type, pair.gz_type)
+        if key in self._by_key:
+            msg = f"pair {pair.ros_type} <-> {pair.gz_type} registered twice ({pair.origin})"
+            raise BridgeError(msg)
+        self._by_key[key] = pair
+        self.pairs.append(pair)
+
+    def add_service(self, pair: ServicePair) -> None:
+        if pair.ros_type in self._services_by_type:
+            msg = f"service {pair.ros_type} registered twice ({pair.origin})"
+            raise BridgeError(msg)
+        self._services_by_type[pair.ros_type] = pair
+        self.services.append(pair)
+
+    def add_module(self, module: ModuleType, origin: str) -> None:
+        for pair in getattr(module, "PAIRS", ()):
+            self.add(_with_origin(pair, origin))
+        for service in getattr(module, "SERVICES", ()):
+            self.add_service(_with_origin(service, origin))
+
+    def find(self, ros_type: str, gz_type: str) -> Pair | None:
+        """The pair for exactly these names, accepting both Gazebo prefixes."""
+        pair = self._by_key.get((ros_type, gz_type))
+        if pair is None:
+            pair = self._by_key.get((ros_type, canonical_gz_type(gz_type)))
+        return pair
+
+    def get(self, ros_type: str, gz_type: str) -> Pair:
+        """Like :meth:`find`, but raise :class:`UnsupportedTypeError` naming the fix."""
+        pair = self.find(ros_type, gz_type)
+        if pair is not None:
+            return pair
+        raise UnsupportedTypeError(self._explain_missing(ros_type, gz_type))
+
+    def get_service(self, ros_type: str) -> ServicePair:
+        service = self._services_by_type.get(ros_type)
+        if service is not None:
+            return service
+        known = ", ".join(sorted(self._services_by_type)) or "none"
+        msg = f"service type [{ros_type}] is not supported; supported: {known}"
+        raise UnsupportedTypeError(msg)
+
+    def gz_types_for(self, ros_type: str) -> list[str]:
+        return [p.gz_type for p in self.pairs if p.ros_type == ros_type]
+
+    def ros_types_for(self, gz_type: str) -> list[str]:
+        exact = [p.ros_type for p in self.pairs if p.gz_type == gz_type]
+        if exact:
+            return exact
+        canonical = canonical_gz_type(gz_type)
+        return [p.ros_type for p in self.pairs if p.gz_type == canonical]
+
+    def _explain_missing(self, ros_type: str, gz_type: str) -> str:
+        text = f"no converter for ROS type [{ros_type}] and Gazebo type [{gz_type}]"
+        if "/" in ros_type and "/msg/" not in ros_type and "/srv/" not in ros_type:
+            pkg, _, name = ros_type.partition("/")
+            return f"{text}; ROS types are written in full: did you mean [{pkg}/msg/{name}]?"
+        if not gz_type.startswith((GZ_PREFIX, IGN_PREFIX)):
+            return f"{text}; Gazebo types are written gz.msgs.X (or ignition.msgs.X)"
+        pkg = ros_type.split("/", 1)[0]
+        if pkg in self.unavailable:
+            return f"{text}; converters for {pkg} could not load: {self.unavailable[pkg]}"
+        gz_options = self.gz_types_for(ros_type)
+        if gz_options:
+            return f"{text}; [{ros_type}] pairs with: {', '.join(gz_options)}"
+        ros_options = self.ros_types_for(gz_type)
+        if ros_options:
+            return f"{text}; [{gz_type}] pairs with: {', '.join(ros_options)}"
+        return f"{text}; run `bridge_types --print-pairs` to list the supported pairs"
+
+
+def _with_origin(item: Any, origin: str) -> Any:
+    if not isinstance(item, Pair | ServicePair):
+        msg = f"{origin}: expected Pair or ServicePair, got {type(item).__name__}"
+        raise BridgeError(msg)
+    return item if item.origin else dataclasses.replace(item, origin=origin)
+
+
+def _iter_modules() -> Iterator[tuple[str, Callable[[], ModuleType]]]:
+    for name in BUILTIN_MODULES:
+        yield name, functools.partial(importlib.import_module, f"{__package__}.{name}")
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        yield ep.name, ep.load
+
+
+def build_registry(
+    modules: Iterable[tuple[str, Callable[[], ModuleType]]] | None = None,
+) -> Registry:
+    """Import every converter module and index its pairs.
+
+    A module that fails to import (its ROS interface package is not installed) is recorded in
+    :attr:`Registry.unavailable` instead of failing the whole registry.
+    """
+    registry = Registry()
+    for name, load in modules if modules is not None else _iter_modules():
+        try:
+            module = load()
+        except ImportError as err:
+            registry.unavailable[name] = str(err)
+            continue
+        registry.add_module(module, name)
+    return registry
+
+
+_DEFAULT: Registry | None = None
+
+
+def default_registry() -> Registry:
+    """The process-wide registry, built on first use."""
+    global _DEFAULT  # noqa: PLW0603 - a lazily built process-wide cache
+    if _DEFAULT is None:
+        _DEFAULT = build_registry()
+    return _DEFAULT

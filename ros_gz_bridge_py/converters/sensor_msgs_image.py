@@ -1,0 +1,138 @@
+"""sensor_msgs Image and CameraInfo converters (conversions.md §3.5); paired in sensor_msgs.py.
+
+Image data is copied once, as ``bytes``. The ROS ``step`` (row padding) and ``is_bigendian``
+are ignored, as in the reference: ``step`` is recomputed from width and encoding.
+
+Differences from ros_gz_bridge:
+- Image R→G with an unknown encoding raises ConversionError (C++ prints and publishes an
+  image with format UNKNOWN_PIXEL_FORMAT and no data).
+- Image R→G with data shorter than height*step raises ConversionError (C++ over-reads).
+- Image G→R with an unsupported format raises ConversionError (C++ prints and publishes an
+  empty image); longer gz data is truncated to step*height, shorter data is zero-padded.
+- CameraInfo G→R truncates gz arrays longer than the ROS k (9), p (12), r (9) arrays
+  (C++ writes out of bounds).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sensor_msgs.msg import CameraInfo, Image
+
+from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
+from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.msgs import message_class
+
+GzImage = message_class("gz.msgs.Image")
+GzCameraInfo = message_class("gz.msgs.CameraInfo")
+
+#: ROS encoding -> (gz PixelFormatType value, channels, bytes per channel).
+ENCODINGS: dict[str, tuple[int, int, int]] = {
+    "mono8": (1, 1, 1),
+    "mono16": (2, 1, 2),
+    "rgb8": (3, 3, 1),
+    "rgba8": (4, 4, 1),
+    "bgra8": (5, 4, 1),
+    "rgb16": (6, 3, 2),
+    "bgr8": (8, 3, 1),
+    "bgr16": (9, 3, 2),
+    "32FC1": (13, 1, 4),
+}
+#: gz PixelFormatType value -> (ROS encoding, bytes per pixel); derived from ENCODINGS.
+PIXEL_FORMATS: dict[int, tuple[str, int]] = {
+    fmt: (encoding, channels * depth) for encoding, (fmt, channels, depth) in ENCODINGS.items()
+}
+
+#: ROS distortion_model <-> gz CameraInfo.Distortion.DistortionModelType value.
+DISTORTION_MODELS: dict[str, int] = {"plumb_bob": 0, "rational_polynomial": 1, "equidistant": 2}
+_DISTORTION_NAMES = {value: name for name, value in DISTORTION_MODELS.items()}
+
+
+def image_to_gz(ros: Any) -> Any:
+    entry = ENCODINGS.get(ros.encoding)
+    if entry is None:
+        msg = (
+            f"sensor_msgs/msg/Image encoding {ros.encoding!r} has no Gazebo pixel format; "
+            f"supported: {', '.join(ENCODINGS)}"
+        )
+        raise ConversionError(msg)
+    pixel_format, channels, depth = entry
+    gz = GzImage()
+    fill_gz_header(ros.header, gz.header)
+    gz.width = ros.width
+    gz.height = ros.height
+    gz.pixel_format_type = pixel_format
+    gz.step = ros.width * channels * depth
+    size = gz.step * ros.height
+    data = ros.data
+    if len(data) < size:
+        msg = (
+            f"sensor_msgs/msg/Image data has {len(data)} bytes, fewer than "
+            f"height*width*bytes_per_pixel = {size} for {ros.width}x{ros.height} {ros.encoding}"
+        )
+        raise ConversionError(msg)
+    gz.data = bytes(memoryview(data)[:size])
+    return gz
+
+
+def image_to_ros(gz: Any) -> Any:
+    entry = PIXEL_FORMATS.get(gz.pixel_format_type)
+    if entry is None:
+        msg = f"gz.msgs.Image pixel_format_type {gz.pixel_format_type} has no ROS encoding"
+        raise ConversionError(msg)
+    encoding, bytes_per_pixel = entry
+    ros = Image()
+    fill_ros_header(gz.header, ros.header)
+    ros.height = gz.height
+    ros.width = gz.width
+    ros.encoding = encoding
+    ros.is_bigendian = 0
+    ros.step = gz.width * bytes_per_pixel
+    size = ros.step * gz.height
+    data: bytes = gz.data
+    if len(data) > size:
+        data = data[:size]
+    elif len(data) < size:
+        data += bytes(size - len(data))
+    ros.data = data
+    return ros
+
+
+def camera_info_to_gz(ros: Any) -> Any:
+    """An unknown distortion model leaves gz ``model`` at 0 (PLUMB_BOB), as in C++."""
+    gz = GzCameraInfo()
+    fill_gz_header(ros.header, gz.header)
+    gz.width = ros.width
+    gz.height = ros.height
+    gz.distortion.SetInParent()
+    gz.distortion.model = DISTORTION_MODELS.get(ros.distortion_model, 0)
+    gz.distortion.k.extend(ros.d)
+    gz.intrinsics.SetInParent()
+    gz.intrinsics.k.extend(ros.k)
+    gz.projection.SetInParent()
+    gz.projection.p.extend(ros.p)
+    gz.rectification_matrix.extend(ros.r)
+    return gz
+
+
+def _fixed(values: Any, size: int) -> list[float]:
+    """The first ``size`` values, zero-padded to ``size``."""
+    head = list(values[:size])
+    return head + [0.0] * (size - len(head))
+
+
+def camera_info_to_ros(gz: Any) -> Any:
+    """An unknown gz distortion model leaves ``distortion_model`` empty, as in C++."""
+    ros = CameraInfo()
+    fill_ros_header(gz.header, ros.header)
+    ros.height = gz.height
+    ros.width = gz.width
+    if gz.HasField("distortion"):
+        ros.distortion_model = _DISTORTION_NAMES.get(gz.distortion.model, "")
+        ros.d = list(gz.distortion.k)
+    if gz.HasField("intrinsics"):
+        ros.k = _fixed(gz.intrinsics.k, 9)
+    if gz.HasField("projection"):
+        ros.p = _fixed(gz.projection.p, 12)
+    ros.r = _fixed(gz.rectification_matrix, 9)
+    return ros

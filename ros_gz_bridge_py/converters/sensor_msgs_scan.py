@@ -1,0 +1,178 @@
+"""sensor_msgs LaserScan, Range and PointCloud2 converters (conversions.md §3.5).
+
+Paired in sensor_msgs.py. ``sensor_msgs/msg/Range`` <-> ``gz.msgs.LaserScan`` follows
+ros_gz PR #736 in spirit (a narrow Gazebo lidar used as a range finder); its upstream source
+was not available to check, so the mapping below is our own and may differ in details:
+- G→R: header as for LaserScan (frame_id from gz ``frame``); ``field_of_view`` =
+  angle_max - angle_min; ``min_range``/``max_range`` from range_min/range_max; ``range`` =
+  the smallest of all gz ranges (the nearest return, NaN ignored); ``radiation_type`` and
+  ``variance`` stay 0.
+- R→G: a one-sample scan: angles ±field_of_view/2, ``angle_step`` = field_of_view,
+  ``count`` = 1, ``ranges`` = [range], range_min/range_max from min_range/max_range.
+
+Differences from ros_gz_bridge:
+- LaserScan R→G pads ranges/intensities shorter than ``count`` with 0.0 (C++ over-reads;
+  an empty intensities array is common).
+- LaserScan R→G raises ConversionError when (angle_max - angle_min) / angle_increment is not
+  a finite non-negative number (UB in C++).
+- LaserScan G→R pads gz ranges/intensities shorter than the selected row with 0.0.
+- Range G→R raises ConversionError for a scan with no ranges.
+"""
+
+from __future__ import annotations
+
+import math
+from array import array
+from typing import Any
+
+import numpy as np
+from sensor_msgs.msg import LaserScan, PointCloud2, PointField, Range
+
+from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header, gz_to_ros_frame
+from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.msgs import message_class
+
+GzLaserScan = message_class("gz.msgs.LaserScan")
+GzPointCloudPacked = message_class("gz.msgs.PointCloudPacked")
+
+#: ROS PointField datatype -> gz PointCloudPacked.Field.DataType: INT8..FLOAT64 are 1..8 / 0..7.
+_GZ_INT8 = 0
+_ROS_INT8 = PointField.INT8
+_DATATYPE_OFFSET = PointField.INT8 - _GZ_INT8
+_ROS_DATATYPES = range(PointField.INT8, PointField.FLOAT64 + 1)
+
+
+def scan_count(angle_min: float, angle_max: float, angle_increment: float) -> int:
+    """``uint32((max - min) / inc)`` evaluated in float32 arithmetic, as the C++ does."""
+    span = np.float32(np.float32(angle_max) - np.float32(angle_min))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = float(span / np.float32(angle_increment))
+    if not math.isfinite(ratio) or ratio < 0:
+        msg = (
+            f"sensor_msgs/msg/LaserScan angles give no sample count: (angle_max={angle_max} - "
+            f"angle_min={angle_min}) / angle_increment={angle_increment} = {ratio}"
+        )
+        raise ConversionError(msg)
+    return int(ratio)
+
+
+def _first(values: Any, count: int) -> Any:
+    """The first ``count`` values, zero-padded when there are fewer."""
+    head = values[:count]
+    if len(head) < count:
+        head = list(head) + [0.0] * (count - len(head))
+    return head
+
+
+def laser_scan_to_gz(ros: Any) -> Any:
+    count = scan_count(ros.angle_min, ros.angle_max, ros.angle_increment)
+    gz = GzLaserScan()
+    fill_gz_header(ros.header, gz.header)
+    gz.frame = ros.header.frame_id
+    gz.angle_min = ros.angle_min
+    gz.angle_max = ros.angle_max
+    gz.angle_step = ros.angle_increment
+    gz.range_min = ros.range_min
+    gz.range_max = ros.range_max
+    gz.count = count
+    gz.ranges.extend(_first(ros.ranges, count))
+    gz.intensities.extend(_first(ros.intensities, count))
+    return gz
+
+
+def _fill_ros_scan_header(gz: Any, ros: Any) -> None:
+    """Header from gz ``header``, then frame_id always overwritten from gz ``frame``."""
+    fill_ros_header(gz.header, ros.header)
+    ros.header.frame_id = gz_to_ros_frame(gz.frame)
+
+
+def laser_scan_to_ros(gz: Any) -> Any:
+    """Only the middle row of a multi-row scan reaches ROS: row ``vertical_count // 2``."""
+    ros = LaserScan()
+    _fill_ros_scan_header(gz, ros)
+    ros.angle_min = gz.angle_min
+    ros.angle_max = gz.angle_max
+    ros.angle_increment = gz.angle_step
+    ros.range_min = gz.range_min
+    ros.range_max = gz.range_max
+    count = gz.count
+    start = (gz.vertical_count // 2) * count
+    ros.ranges = array("f", _first(gz.ranges[start : start + count], count))
+    ros.intensities = array("f", _first(gz.intensities[start : start + count], count))
+    return ros
+
+
+def range_to_gz(ros: Any) -> Any:
+    gz = GzLaserScan()
+    fill_gz_header(ros.header, gz.header)
+    gz.frame = ros.header.frame_id
+    half = float(ros.field_of_view) / 2.0
+    gz.angle_min = -half
+    gz.angle_max = half
+    gz.angle_step = ros.field_of_view
+    gz.range_min = ros.min_range
+    gz.range_max = ros.max_range
+    gz.count = 1
+    gz.ranges.append(ros.range)
+    return gz
+
+
+def range_to_ros(gz: Any) -> Any:
+    if not gz.ranges:
+        msg = "gz.msgs.LaserScan has no ranges: cannot make a sensor_msgs/msg/Range"
+        raise ConversionError(msg)
+    ros = Range()
+    _fill_ros_scan_header(gz, ros)
+    ros.field_of_view = gz.angle_max - gz.angle_min
+    ros.min_range = gz.range_min
+    ros.max_range = gz.range_max
+    ros.range = float(np.nanmin(np.asarray(gz.ranges, dtype=np.float64)))
+    return ros
+
+
+def point_cloud2_to_gz(ros: Any) -> Any:
+    """An unknown ROS datatype becomes gz INT8, silently, as in C++."""
+    gz = GzPointCloudPacked()
+    fill_gz_header(ros.header, gz.header)
+    gz.height = ros.height
+    gz.width = ros.width
+    gz.is_bigendian = ros.is_bigendian
+    gz.point_step = ros.point_step
+    gz.row_step = ros.row_step
+    gz.is_dense = ros.is_dense
+    gz.data = bytes(ros.data)
+    for field in ros.fields:
+        datatype = field.datatype
+        gz.field.add(
+            name=field.name,
+            offset=field.offset,
+            count=field.count,
+            datatype=datatype - _DATATYPE_OFFSET if datatype in _ROS_DATATYPES else _GZ_INT8,
+        )
+    return gz
+
+
+def point_cloud2_to_ros(gz: Any) -> Any:
+    """An unknown gz datatype becomes ROS INT8, silently, as in C++."""
+    ros = PointCloud2()
+    fill_ros_header(gz.header, ros.header)
+    ros.height = gz.height
+    ros.width = gz.width
+    ros.is_bigendian = gz.is_bigendian
+    ros.point_step = gz.point_step
+    ros.row_step = gz.row_step
+    ros.is_dense = gz.is_dense
+    ros.data = gz.data
+    fields = []
+    for field in gz.field:
+        datatype = field.datatype + _DATATYPE_OFFSET
+        fields.append(
+            PointField(
+                name=field.name,
+                offset=field.offset,
+                count=field.count,
+                datatype=datatype if datatype in _ROS_DATATYPES else _ROS_INT8,
+            )
+        )
+    ros.fields = fields
+    return ros

@@ -1,0 +1,257 @@
+"""The transport API every backend implements (ZeroMQ now, Zenoh next).
+
+Callers (the bridge, the image fast path, tests) use only these names; ``create_node`` in
+the package picks the backend. Payloads are serialized protobuf bytes unless a method says
+it decodes.
+"""
+
+from __future__ import annotations
+
+import abc
+import enum
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from typing import Any, Self
+
+from ros_gz_bridge_py.msgs import GENERIC_TYPE
+
+
+class Scope(enum.IntEnum):
+    """How far an advertisement travels (values as in Discovery.Publisher.Scope, §2.6)."""
+
+    PROCESS = 0
+    HOST = 1
+    ALL = 2
+
+
+@dataclass(frozen=True)
+class NodeOptions:
+    """How to create a node.
+
+    ``partition`` None reads GZ_PARTITION, then IGN_PARTITION, else ``<hostname>:<user>``.
+    ``implementation`` None reads GZ_TRANSPORT_IMPLEMENTATION (default ``zeromq``).
+    """
+
+    partition: str | None = None
+    namespace: str = ""
+    implementation: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class MessageInfo:
+    """What a subscription callback learns besides the payload."""
+
+    #: Topic name without the partition, e.g. ``/chatter``.
+    topic: str
+    #: The exact type string of the data frame (``gz.msgs.X`` or ``ignition.msgs.X``).
+    msg_type: str
+    partition: str
+    #: The sender's PUB endpoint ("" for intra-process delivery).
+    publisher_address: str
+    #: True when published by a publisher of this same Node.
+    intra_process: bool
+
+
+@dataclass(frozen=True, slots=True)
+class TopicInfo:
+    """One publisher (or service provider) known to discovery, like a `gz topic -i` row.
+
+    For services ``msg_type`` is ``"<request type>&<response type>"`` and the two types are
+    also in ``request_type``/``response_type`` (empty for topics).
+    """
+
+    topic: str
+    msg_type: str
+    address: str
+    process_uuid: str
+    node_uuid: str
+    request_type: str = ""
+    response_type: str = ""
+
+
+@dataclass
+class TransportStats:
+    """Counters of a node; every bad input from the network lands in one of them."""
+
+    datagrams_received: int = 0
+    datagrams_malformed: int = 0
+    datagrams_wrong_version: int = 0
+    frames_malformed: int = 0
+    payloads_undecodable: int = 0
+    unknown_types: int = 0
+    peers_expired: int = 0
+    messages_received: int = 0
+    messages_dropped: int = 0
+    callback_errors: int = 0
+    requests_unhandled: int = 0
+    responses_unmatched: int = 0
+    send_failures: int = 0
+    io_errors: int = 0
+
+    def as_dict(self) -> dict[str, int]:
+        """The counters by name."""
+        return asdict(self)
+
+
+#: Raw subscription callback: ``callback(payload, info)``.
+RawCallback = Callable[[bytes, MessageInfo], None]
+#: Typed subscription callback: ``callback(message, info)``.
+TypedCallback = Callable[[Any, MessageInfo], None]
+#: Service handler: ``handler(request bytes) -> (success, response bytes)``.
+ServiceHandler = Callable[[bytes], tuple[bool, bytes]]
+#: Async service callback: ``(True/False, reply)`` on a reply, ``(None, b"")`` on timeout.
+ReplyCallback = Callable[[bool | None, bytes], None]
+
+
+class Publisher(abc.ABC):
+    """An advertised topic."""
+
+    topic: str
+    msg_type: str
+
+    @abc.abstractmethod
+    def publish(self, msg: Any) -> None:
+        """Serialize ``msg`` once and send it to every matching subscriber."""
+
+    @abc.abstractmethod
+    def publish_raw(self, payload: bytes | bytearray | memoryview) -> None:
+        """Send an already-serialized message of this publisher's type."""
+
+    @abc.abstractmethod
+    def has_connections(self) -> bool:
+        """True if a remote subscriber or a local subscription would receive a message."""
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Unadvertise; idempotent."""
+
+
+class Subscription(abc.ABC):
+    """One subscription; closing it affects no other."""
+
+    topic: str
+    msg_type: str
+
+    @property
+    @abc.abstractmethod
+    def dropped(self) -> int:
+        """Messages dropped by the bounded queue (0 without a queue)."""
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Unsubscribe; idempotent."""
+
+
+class ServiceOffer(abc.ABC):
+    """An advertised service."""
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Unadvertise the service; idempotent."""
+
+
+class Node(abc.ABC):
+    """A Gazebo Transport participant: advertise, subscribe, provide and call services."""
+
+    @property
+    @abc.abstractmethod
+    def stats(self) -> TransportStats:
+        """A snapshot of the node's counters."""
+
+    @abc.abstractmethod
+    def advertise(self, topic: str, msg_type: str) -> Publisher:
+        """Advertise ``topic`` with the exact type string ``msg_type``."""
+
+    @abc.abstractmethod
+    def subscribe(
+        self,
+        topic: str,
+        callback: RawCallback,
+        msg_type: str = GENERIC_TYPE,
+        *,
+        ignore_local: bool = False,
+        queue_size: int | None = None,
+    ) -> Subscription:
+        """Receive raw payloads of ``msg_type`` (exact string; GENERIC_TYPE = any).
+
+        ``queue_size`` None runs ``callback`` on the node's I/O thread; N gives the
+        subscription its own delivery thread behind a drop-oldest queue of N messages.
+        """
+
+    @abc.abstractmethod
+    def subscribe_typed(
+        self,
+        topic: str,
+        msg_class: type[Any],
+        callback: TypedCallback,
+        *,
+        msg_type: str | None = None,
+        ignore_local: bool = False,
+        queue_size: int | None = None,
+    ) -> Subscription:
+        """Like :meth:`subscribe`, decoding with ``msg_class.FromString``.
+
+        ``msg_type`` defaults to the class's full protobuf name. Undecodable payloads are
+        counted in ``stats.payloads_undecodable``.
+        """
+
+    @abc.abstractmethod
+    def advertise_service(
+        self, service: str, request_type: str, response_type: str, handler: ServiceHandler
+    ) -> ServiceOffer:
+        """Provide ``service``; ``handler`` runs on the I/O thread, an exception means failure."""
+
+    @abc.abstractmethod
+    def request(
+        self, service: str, request: bytes, request_type: str, response_type: str, timeout: float
+    ) -> tuple[bool, bytes]:
+        """Call a service and wait for the reply.
+
+        Raises:
+            TransportTimeoutError: no reply within ``timeout`` seconds.
+            TransportError: called from the node's own I/O thread.
+        """
+
+    @abc.abstractmethod
+    def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
+        self,
+        service: str,
+        request: bytes,
+        request_type: str,
+        response_type: str,
+        timeout: float,
+        callback: ReplyCallback,
+    ) -> None:
+        """Call a service; ``callback`` runs exactly once on the I/O thread."""
+
+    @abc.abstractmethod
+    def topic_list(self) -> list[str]:
+        """Topics with publishers in this partition, like ``gz topic -l``."""
+
+    @abc.abstractmethod
+    def topic_info(self, topic: str) -> list[TopicInfo]:
+        """Publishers of ``topic``, like ``gz topic -i -t``."""
+
+    @abc.abstractmethod
+    def service_list(self) -> list[str]:
+        """Services with providers in this partition, like ``gz service -l``."""
+
+    @abc.abstractmethod
+    def service_info(self, service: str) -> list[TopicInfo]:
+        """Providers of ``service``."""
+
+    @abc.abstractmethod
+    def wait_for_publishers(
+        self, topic: str, timeout: float, msg_type: str | None = None
+    ) -> list[TopicInfo]:
+        """Publishers of ``topic`` (of ``msg_type`` if given) once known; [] on timeout."""
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Say goodbye on the wire, stop the thread, close every socket; idempotent."""
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()

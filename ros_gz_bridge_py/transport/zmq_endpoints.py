@@ -1,0 +1,172 @@
+"""The handles a :class:`~ros_gz_bridge_py.transport.zmq_node.ZmqNode` gives out.
+
+Each handle keeps what it needs to do its job without registry lookups (the precomputed
+FQN, the type matching rule, the decoder) and closes only itself.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from google.protobuf.message import DecodeError
+
+from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
+from ros_gz_bridge_py.transport.delivery import DeliveryQueue
+from ros_gz_bridge_py.transport.wire import Frame, PublisherRecord
+
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.transport.zmq_node import ZmqNode
+
+_LOG = logging.getLogger("ros_gz_bridge_py.transport")
+
+#: One received message: the payload (not copied) and what the callback learns about it.
+Delivery = tuple[Frame, MessageInfo]
+
+
+class ZmqPublisher(Publisher):
+    """An advertised topic of a :class:`ZmqNode`; ``publish`` may be called from any thread."""
+
+    def __init__(self, node: ZmqNode, topic: str, msg_type: str, record: PublisherRecord) -> None:
+        self.topic = topic
+        self.msg_type = msg_type
+        self.fqn = record.topic
+        self.record = record
+        self._node = node
+        self._closed = False
+
+    def publish(self, msg: Any) -> None:
+        """Serialize ``msg`` once and send it (see :meth:`publish_raw`)."""
+        self.publish_raw(msg.SerializeToString())
+
+    def publish_raw(self, payload: bytes | bytearray | memoryview) -> None:
+        """Deliver to local subscriptions, and on the wire if a remote subscriber matches.
+
+        ``bytes`` payloads are sent without a copy; other buffers are copied once so the
+        caller may reuse them. After ``close`` (of this publisher or the node) it does nothing.
+        """
+        if not self._closed:
+            self._node.publish(self, payload)
+
+    def has_connections(self) -> bool:
+        """True if a remote subscriber (NEW_CONNECTION) or a local subscription matches."""
+        return not self._closed and self._node.has_connections(self)
+
+    def close(self) -> None:
+        """Unadvertise; idempotent."""
+        if not self._closed:
+            self._closed = True
+            self._node.unadvertise(self)
+
+
+class ZmqSubscription(Subscription):
+    """One subscription: matching rule, decoder and optional delivery queue."""
+
+    def __init__(
+        self,
+        node: ZmqNode,
+        topic: str,
+        fqn: str,
+        msg_type: str,
+        deliver: Callable[[Frame, MessageInfo], None],
+        *,
+        ignore_local: bool,
+        queue_size: int | None,
+    ) -> None:
+        self.topic = topic
+        self.fqn = fqn
+        self.msg_type = msg_type
+        self.ignore_local = ignore_local
+        self.record: PublisherRecord | None = None
+        self._node = node
+        self._deliver = deliver
+        self._closed = False
+        self._queue: DeliveryQueue[Delivery] | None = None
+        if queue_size is not None:
+            self._queue = DeliveryQueue(queue_size, self._run, f"gz-sub {topic}")
+
+    @property
+    def dropped(self) -> int:
+        """Messages the bounded queue dropped (oldest first)."""
+        return self._queue.dropped if self._queue is not None else 0
+
+    def accepts(self, msg_type: str) -> bool:
+        """True if a message of ``msg_type`` is for this subscription (exact or generic)."""
+        return self.msg_type in (GENERIC_TYPE, msg_type)
+
+    def offer(self, payload: Frame, info: MessageInfo) -> None:
+        """Deliver now, or queue for the delivery thread."""
+        if self._queue is None:
+            self._run((payload, info))
+        elif not self._queue.put((payload, info)):
+            self._node.count("messages_dropped")
+
+    def _run(self, item: Delivery) -> None:
+        if not self._closed:
+            self._deliver(*item)
+
+    def close(self) -> None:
+        """Unsubscribe this subscription only; idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self._node.unsubscribe(self)
+        if self._queue is not None:
+            self._queue.close()
+
+
+def raw_deliverer(
+    node: ZmqNode, callback: Callable[[bytes, MessageInfo], None]
+) -> Callable[[Frame, MessageInfo], None]:
+    """A deliver function that hands ``bytes`` to ``callback``, guarding against its errors."""
+
+    def deliver(payload: Frame, info: MessageInfo) -> None:
+        try:
+            callback(payload if isinstance(payload, bytes) else bytes(payload), info)
+        except Exception:
+            node.count("callback_errors")
+            _LOG.exception("subscription callback for %s raised", info.topic)
+
+    return deliver
+
+
+def typed_deliverer(
+    node: ZmqNode, msg_class: type[Any], callback: Callable[[Any, MessageInfo], None]
+) -> Callable[[Frame, MessageInfo], None]:
+    """A deliver function that decodes with ``msg_class`` first (no copy of the payload)."""
+
+    def deliver(payload: Frame, info: MessageInfo) -> None:
+        try:
+            msg = msg_class.FromString(payload)
+        except (DecodeError, ValueError, TypeError) as error:
+            node.count("payloads_undecodable")
+            _LOG.debug("undecodable %s payload on %s: %s", info.msg_type, info.topic, error)
+            return
+        try:
+            callback(msg, info)
+        except Exception:
+            node.count("callback_errors")
+            _LOG.exception("subscription callback for %s raised", info.topic)
+
+    return deliver
+
+
+@dataclass(eq=False)
+class ZmqServiceOffer(ServiceOffer):
+    """An advertised service of a :class:`ZmqNode`."""
+
+    node: ZmqNode
+    record: PublisherRecord
+    handler: Callable[[bytes], tuple[bool, bytes]]
+    #: (service FQN, request type, response type): what a request must match exactly.
+    key: tuple[str, str, str]
+    closed: bool = False
+
+    def close(self) -> None:
+        """Unadvertise the service; idempotent."""
+        if not self.closed:
+            self.closed = True
+            self.node.unadvertise_service(self)

@@ -1,0 +1,834 @@
+"""The ZeroMQ Gazebo Transport node: sockets and one I/O thread around the sans-IO core.
+
+Each :class:`ZmqNode` is a full gz participant with its own process UUID (two nodes in one
+Python process look like two processes on the wire). It owns two UDP discovery sockets (msg
+and srv port, each with its own :class:`DiscoveryEngine`) and the five ZMQ sockets of
+gz-transport-protocol.md §2.1: PUB (bound), SUB (connected to publishers), replier ROUTER
+(bound), requester ROUTER (connected to providers), responseReceiver ROUTER (bound).
+
+Threading model:
+
+* One I/O thread (``gz-io``) owns the discovery engines, the UDP sockets and every ZMQ socket
+  except PUB. Calls from other threads (advertise, subscribe, close, listings, requests) are
+  posted to it as commands and, where they return something, waited for.
+* The PUB socket is used directly by the publishing thread, under a lock (ZMQ sockets are not
+  thread-safe; the lock also gives the memory barrier between threads).
+* Callbacks: subscription callbacks with ``queue_size=None``, service handlers and
+  ``request_async`` callbacks run on the I/O thread, so they must be quick; with
+  ``queue_size=N`` a subscription's callback runs on its own delivery thread. Intra-process
+  messages are handed over in the publishing thread (to the queue, or to the callback when
+  there is none), as gz-transport does.
+* Publishing, ``has_connections``, ``stats`` and every public method are thread-safe;
+  ``request`` must not be called from the I/O thread (it would wait for itself).
+* Bad network input never raises out of the I/O thread: it is counted in ``stats`` and logged
+  at debug level on ``ros_gz_bridge_py.transport``. A raising callback is logged and counted.
+"""
+
+from __future__ import annotations
+
+import collections
+import concurrent.futures
+import contextlib
+import errno
+import logging
+import socket
+import threading
+import time
+import uuid
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, TypeVar
+
+import zmq
+
+from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError, TransportTimeoutError
+from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.transport.api import (
+    MessageInfo,
+    Node,
+    RawCallback,
+    ReplyCallback,
+    Scope,
+    ServiceHandler,
+    TopicInfo,
+    TransportStats,
+    TypedCallback,
+)
+from ros_gz_bridge_py.transport.discovery import (
+    INIT_DELAY,
+    DiscoveryEngine,
+    Event,
+    Outgoing,
+    PublisherAdded,
+    SubscriberAdded,
+    SubscriberRemoved,
+)
+from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
+from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.udp import DiscoverySocket, determine_host
+from ros_gz_bridge_py.transport.wire import (
+    Frame,
+    MessagePublisher,
+    PublisherRecord,
+    ServicePublisher,
+    ServiceRequest,
+    ServiceResponse,
+    decode_data,
+    decode_request,
+    decode_response,
+    encode_data,
+    encode_request,
+    encode_response,
+)
+from ros_gz_bridge_py.transport.zmq_endpoints import (
+    ZmqPublisher,
+    ZmqServiceOffer,
+    ZmqSubscription,
+    raw_deliverer,
+    typed_deliverer,
+)
+
+_LOG = logging.getLogger("ros_gz_bridge_py.transport")
+T = TypeVar("T")
+
+#: How long a ROUTER send to a peer that is not routable yet is retried (§2.9.3: gz sleeps
+#: 100 ms after connecting; we retry instead of sleeping).
+ROUTE_RETRY = 1.0
+#: Poll timeout while a retry is pending, and the longest poll otherwise (§2.5: 250 ms).
+RETRY_POLL = 0.005
+MAX_POLL = 0.25
+#: Messages read from one socket per loop turn, so no socket starves the others.
+READ_BATCH = 64
+#: Response types that make a call one-way (§2.9.3).
+ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
+
+
+@dataclass(eq=False)
+class _Call:
+    """A service call waiting for a provider, a route or a response."""
+
+    fqn: str
+    request: bytes
+    request_type: str
+    response_type: str
+    deadline: float
+    callback: ReplyCallback
+    request_uuid: str = field(default_factory=lambda: str(uuid.uuid4()))
+    dispatched: bool = False
+
+
+@dataclass(eq=False)
+class _RoutedSend:
+    """A ROUTER send retried while the peer is not routable yet."""
+
+    sock: Any
+    frames: list[Frame]
+    deadline: float
+    on_sent: Callable[[], None] | None = None
+
+
+class ZmqNode(Node):
+    """A Gazebo Transport node speaking the ZeroMQ protocol (gz-transport wire version 10)."""
+
+    def __init__(
+        self,
+        partition: str | None = None,
+        namespace: str = "",
+        settings: TransportSettings | None = None,
+    ) -> None:
+        self.settings = settings or TransportSettings.from_env()
+        self.partition = self.settings.partition if partition is None else partition
+        self.namespace = namespace
+        fully_qualified_name(self.partition, namespace, "/check")
+        self.process_uuid = str(uuid.uuid4())
+        self.node_uuid = str(uuid.uuid4())
+        self.host = determine_host(self.settings.ip, self.settings.multicast_ip)
+        self._counts: collections.Counter[str] = collections.Counter()
+        self._count_lock = threading.Lock()
+        self._closed = False
+        self._commands: collections.deque[Callable[[], None]] = collections.deque()
+        # Discovery changes, for wait_for_publishers: a counter and its condition.
+        self._changed = threading.Condition()
+        self._generation = 0
+        self._io_thread: threading.Thread | None = None
+        self._stopping = False
+        # Read by publishing threads without the I/O thread; replaced, never mutated.
+        self._subscriptions: dict[str, tuple[ZmqSubscription, ...]] = {}
+        self._wire_types: dict[str, frozenset[str]] = {}
+        self._sub_lock = threading.Lock()
+        # I/O thread only. Like gz, the SUB socket never disconnects from an address: ZMQ
+        # reconnects if the publisher comes back there, and disconnecting a pipe with data in
+        # flight trips a libzmq assertion (fq.cpp, seen with ign-transport11's `-p`).
+        self._sub_connected: set[str] = set()
+        self._requester_connected: set[str] = set()
+        self._replier_connected: set[str] = set()
+        self._offers: dict[tuple[str, str, str], ZmqServiceOffer] = {}
+        self._calls: dict[str, _Call] = {}
+        self._routed: list[_RoutedSend] = []
+        self._open_resources()
+
+    # --- start and stop --------------------------------------------------------------------
+
+    def _open_resources(self) -> None:
+        self._udp: list[DiscoverySocket] = []
+        self._context = zmq.Context(io_threads=1)
+        self._pub_lock = threading.Lock()
+        self._wake_r, self._wake_w = socket.socketpair()
+        try:
+            self._msg_udp = self._add_udp(self.settings.msg_port)
+            self._srv_udp = self._add_udp(self.settings.srv_port)
+            self.host = self._msg_udp.interface_ip
+            self._pub = self._bound(zmq.PUB, sndhwm=self.settings.sndhwm)
+            self._sub = self._socket(zmq.SUB, rcvhwm=self.settings.rcvhwm)
+            self.replier_id = str(uuid.uuid4())
+            self._replier = self._bound(zmq.ROUTER, routing_id=self.replier_id, mandatory=True)
+            self._requester = self._socket(zmq.ROUTER, mandatory=True)
+            self.response_id = str(uuid.uuid4())
+            self._responses = self._bound(zmq.ROUTER, routing_id=self.response_id)
+        except (OSError, zmq.ZMQError) as error:
+            self._release()
+            msg = f"cannot open the Gazebo Transport sockets on {self.host}: {error}"
+            raise TransportError(msg) from error
+        self.pub_address: str = self._pub.getsockopt_string(zmq.LAST_ENDPOINT)
+        self.replier_address: str = self._replier.getsockopt_string(zmq.LAST_ENDPOINT)
+        self.response_address: str = self._responses.getsockopt_string(zmq.LAST_ENDPOINT)
+        now = time.monotonic()
+        engine_args: dict[str, Any] = {"local_ips": {self.host}, "relays": self.settings.relays}
+        self._msg = DiscoveryEngine(self.process_uuid, now, **engine_args)
+        self._srv = DiscoveryEngine(self.process_uuid, now, **engine_args)
+        self._wake_r.setblocking(False)
+        self._wake_w.setblocking(False)
+        self._io_thread = threading.Thread(target=self._io_main, name="gz-io", daemon=True)
+        self._io_thread.start()
+
+    def _add_udp(self, port: int) -> DiscoverySocket:
+        udp = DiscoverySocket(self.settings.multicast_ip, port, self.host)
+        self._udp.append(udp)
+        return udp
+
+    def _socket(
+        self, kind: int, *, rcvhwm: int = 0, routing_id: str = "", mandatory: bool = False
+    ) -> Any:
+        sock = self._context.socket(kind)
+        sock.setsockopt(zmq.LINGER, 0)
+        if rcvhwm:
+            sock.setsockopt(zmq.RCVHWM, rcvhwm)
+        if routing_id:
+            sock.setsockopt(zmq.ROUTING_ID, routing_id.encode())
+        if mandatory:
+            sock.setsockopt(zmq.ROUTER_MANDATORY, 1)
+        return sock
+
+    def _bound(
+        self, kind: int, *, sndhwm: int = 0, routing_id: str = "", mandatory: bool = False
+    ) -> Any:
+        sock = self._socket(kind, routing_id=routing_id, mandatory=mandatory)
+        if sndhwm:
+            sock.setsockopt(zmq.SNDHWM, sndhwm)
+        sock.bind(f"tcp://{self.host}:*")
+        return sock
+
+    def close(self) -> None:
+        """UNADVERTISE, END_CONNECTION and BYE, stop the I/O thread, close every socket."""
+        if self._closed:
+            return
+        subscriptions = [sub for subs in self._subscriptions.values() for sub in subs]
+        with contextlib.suppress(TransportError):
+            self._call(self._say_goodbye)
+        self._closed = True
+        self._stopping = True
+        self._wake()
+        if self._io_thread is not None and self._io_thread is not threading.current_thread():
+            self._io_thread.join()
+        for sub in subscriptions:
+            sub.close()
+        self._release()
+
+    def _say_goodbye(self) -> None:
+        for subs in list(self._subscriptions.values()):
+            for sub in subs:
+                self._end_subscription(sub)
+        for engine, udp in ((self._msg, self._msg_udp), (self._srv, self._srv_udp)):
+            self._send(udp, engine.bye())
+        for call in list(self._calls.values()):
+            self._finish(call, None, b"")
+
+    def _release(self) -> None:
+        with self._pub_lock:
+            for udp in self._udp:
+                udp.close()
+            self._context.destroy(linger=0)
+        self._wake_r.close()
+        self._wake_w.close()
+
+    # --- commands into the I/O thread -----------------------------------------------------
+
+    def _wake(self) -> None:
+        with contextlib.suppress(OSError):
+            self._wake_w.send(b"\0")
+
+    def _post(self, command: Callable[[], None]) -> None:
+        if self._closed:
+            msg = "the Gazebo Transport node is closed"
+            raise TransportError(msg)
+        self._commands.append(command)
+        self._wake()
+
+    def _call(self, function: Callable[[], T]) -> T:
+        """Run ``function`` on the I/O thread and return its result."""
+        if threading.current_thread() is self._io_thread:
+            return function()
+        future: concurrent.futures.Future[T] = concurrent.futures.Future()
+
+        def command() -> None:
+            try:
+                future.set_result(function())
+            except Exception as error:  # handed to the caller
+                future.set_exception(error)
+
+        self._post(command)
+        return future.result()
+
+    def count(self, name: str, amount: int = 1) -> None:
+        """Add to one of the ``stats`` counters (thread-safe)."""
+        with self._count_lock:
+            self._counts[name] += amount
+
+    @property
+    def stats(self) -> TransportStats:
+        """A snapshot of the counters of the node and of both discovery engines."""
+        with self._count_lock:
+            counts = dict(self._counts)
+        engines = (self._msg.counts, self._srv.counts)
+        return TransportStats(
+            datagrams_received=sum(c["received"] for c in engines),
+            datagrams_malformed=sum(c["malformed"] for c in engines),
+            datagrams_wrong_version=sum(c["wrong_version"] for c in engines),
+            peers_expired=sum(c["peers_expired"] for c in engines),
+            unknown_types=sum(c["unknown_type"] for c in engines),
+            **counts,
+        )
+
+    # --- topics -----------------------------------------------------------------------------
+
+    def _fqn(self, topic: str) -> str:
+        return fully_qualified_name(self.partition, self.namespace, topic)
+
+    def advertise(self, topic: str, msg_type: str) -> ZmqPublisher:
+        """Advertise ``topic``; announced at once and re-announced every second."""
+        record = PublisherRecord(
+            self._fqn(topic), self.pub_address, self.process_uuid, self.node_uuid, Scope.ALL,
+            MessagePublisher(msg_type),
+        )  # fmt: skip
+        publisher = ZmqPublisher(self, topic, msg_type, record)
+        self._call(lambda: self._send(self._msg_udp, self._msg.advertise(record)))
+        return publisher
+
+    def unadvertise(self, publisher: ZmqPublisher) -> None:
+        """Withdraw ``publisher`` (called by its ``close``)."""
+
+        def command() -> None:
+            self._send(self._msg_udp, self._msg.unadvertise(publisher.record))
+            self._wire_types[publisher.fqn] = self._msg.subscriber_types(publisher.fqn)
+
+        with contextlib.suppress(TransportError):
+            self._call(command)
+
+    def publish(self, publisher: ZmqPublisher, payload: bytes | bytearray | memoryview) -> None:
+        """Local delivery, then the wire if a remote subscriber matches (§2.8.1 step 7)."""
+        fqn, msg_type = publisher.fqn, publisher.msg_type
+        local = [
+            sub
+            for sub in self._subscriptions.get(fqn, ())
+            if not sub.ignore_local and sub.accepts(msg_type)
+        ]
+        if local:
+            data = payload if isinstance(payload, bytes) else bytes(payload)
+            info = MessageInfo(publisher.topic, msg_type, self.partition, "", intra_process=True)
+            for sub in local:
+                sub.offer(data, info)
+        types = self._wire_types.get(fqn)
+        if not types or not (msg_type in types or GENERIC_TYPE in types):
+            return
+        frames = encode_data(fqn, self.pub_address, payload, msg_type)
+        with self._pub_lock:
+            if self._closed:
+                return
+            try:
+                self._pub.send_multipart(frames, copy=not isinstance(payload, bytes))
+            except zmq.ZMQError as error:
+                self.count("send_failures")
+                _LOG.debug("publish on %s failed: %s", publisher.topic, error)
+
+    def has_connections(self, publisher: ZmqPublisher) -> bool:
+        """True if a remote subscriber or a local subscription matches ``publisher``."""
+        types = self._wire_types.get(publisher.fqn, frozenset())
+        if publisher.msg_type in types or GENERIC_TYPE in types:
+            return True
+        return any(
+            not sub.ignore_local and sub.accepts(publisher.msg_type)
+            for sub in self._subscriptions.get(publisher.fqn, ())
+        )
+
+    def subscribe(
+        self,
+        topic: str,
+        callback: RawCallback,
+        msg_type: str = GENERIC_TYPE,
+        *,
+        ignore_local: bool = False,
+        queue_size: int | None = None,
+    ) -> ZmqSubscription:
+        """Receive raw payloads of ``msg_type`` on ``topic`` (see :class:`Node`)."""
+        deliver = raw_deliverer(self, callback)
+        return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
+
+    def subscribe_typed(
+        self,
+        topic: str,
+        msg_class: type[Any],
+        callback: TypedCallback,
+        *,
+        msg_type: str | None = None,
+        ignore_local: bool = False,
+        queue_size: int | None = None,
+    ) -> ZmqSubscription:
+        """Receive decoded messages. To match a Fortress publisher pass
+        ``msg_type="ignition.msgs.X"``: the class's own name is ``gz.msgs.X``.
+        """
+        deliver = typed_deliverer(self, msg_class, callback)
+        wanted = msg_type or msg_class.DESCRIPTOR.full_name
+        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size)
+
+    def _add_subscription(
+        self,
+        topic: str,
+        msg_type: str,
+        deliver: Callable[[Frame, MessageInfo], None],
+        ignore_local: bool,
+        queue_size: int | None,
+    ) -> ZmqSubscription:
+        sub = ZmqSubscription(
+            self, topic, self._fqn(topic), msg_type, deliver,
+            ignore_local=ignore_local, queue_size=queue_size,
+        )  # fmt: skip
+        try:
+            self._call(lambda: self._start_subscription(sub))
+        except TransportError:
+            sub.close()
+            raise
+        return sub
+
+    def _start_subscription(self, sub: ZmqSubscription) -> None:
+        """§2.8.1 steps 2 and 4-5 for a new local subscription."""
+        fqn = sub.fqn
+        with self._sub_lock:
+            known = self._subscriptions.get(fqn, ())
+            self._subscriptions[fqn] = (*known, sub)
+        if not known:
+            self._sub.setsockopt(zmq.SUBSCRIBE, fqn.encode())
+        sub.record = PublisherRecord(
+            fqn, self.pub_address, self.process_uuid, self.node_uuid, Scope.ALL,
+            MessagePublisher(sub.msg_type, ctrl=""),
+        )  # fmt: skip
+        self._msg.add_local_subscriber(sub.record)
+        self._send(self._msg_udp, self._msg.subscribe(fqn))
+        for record in self._msg.remote_publishers(fqn):
+            self._connect_publisher(record, [sub])
+
+    def unsubscribe(self, sub: ZmqSubscription) -> None:
+        """Remove ``sub`` (called by its ``close``); END_CONNECTION if it was the last."""
+        with contextlib.suppress(TransportError):
+            self._call(lambda: self._end_subscription(sub))
+
+    def _end_subscription(self, sub: ZmqSubscription) -> None:
+        fqn = sub.fqn
+        with self._sub_lock:
+            remaining = tuple(s for s in self._subscriptions.get(fqn, ()) if s is not sub)
+            if remaining:
+                self._subscriptions[fqn] = remaining
+            else:
+                self._subscriptions.pop(fqn, None)
+        if sub.record is not None:
+            self._msg.remove_local_subscriber(sub.record)
+        if remaining:
+            return
+        self._sub.setsockopt(zmq.UNSUBSCRIBE, fqn.encode())
+        processes = [r.process_uuid for r in self._msg.remote_publishers(fqn)]
+        self._send(
+            self._msg_udp, self._msg.disconnect(fqn, self.node_uuid, self.pub_address, processes)
+        )
+
+    def _connect_publisher(self, record: PublisherRecord, subs: Sequence[ZmqSubscription]) -> None:
+        """§2.8.1 step 4-5: connect the SUB once per address, NEW_CONNECTION if a type matches."""
+        if record.address not in self._sub_connected:
+            try:
+                self._sub.connect(record.address)
+            except zmq.ZMQError as error:
+                self.count("frames_malformed")
+                _LOG.debug("cannot connect to publisher %r: %s", record.address, error)
+                return
+            self._sub_connected.add(record.address)
+        if any(sub.accepts(record.msg_type) for sub in subs):
+            self._send(self._msg_udp, self._msg.connect(record, self.node_uuid))
+
+    # --- services ---------------------------------------------------------------------------
+
+    def advertise_service(
+        self, service: str, request_type: str, response_type: str, handler: ServiceHandler
+    ) -> ZmqServiceOffer:
+        """Provide ``service`` for exactly these type strings (§2.9.1)."""
+        record = PublisherRecord(
+            self._fqn(service), self.replier_address, self.process_uuid, self.node_uuid,
+            Scope.ALL, srv=ServicePublisher(self.replier_id, request_type, response_type),
+        )  # fmt: skip
+        offer = ZmqServiceOffer(self, record, handler, (record.topic, request_type, response_type))
+
+        def command() -> None:
+            self._offers[offer.key] = offer
+            self._send(self._srv_udp, self._srv.advertise(record))
+
+        self._call(command)
+        return offer
+
+    def unadvertise_service(self, offer: ZmqServiceOffer) -> None:
+        """Withdraw ``offer`` (called by its ``close``)."""
+
+        def command() -> None:
+            self._offers.pop(offer.key, None)
+            self._send(self._srv_udp, self._srv.unadvertise(offer.record))
+
+        with contextlib.suppress(TransportError):
+            self._call(command)
+
+    def request(
+        self, service: str, request: bytes, request_type: str, response_type: str, timeout: float
+    ) -> tuple[bool, bytes]:
+        """Call ``service`` and wait; one-way calls return (True, b"") once sent."""
+        if threading.current_thread() is self._io_thread:
+            msg = "request() would block the I/O thread; use request_async() in callbacks"
+            raise TransportError(msg)
+        done = threading.Event()
+        result: list[tuple[bool | None, bytes]] = []
+
+        def on_reply(ok: bool | None, payload: bytes) -> None:
+            result.append((ok, payload))
+            done.set()
+
+        self.request_async(service, request, request_type, response_type, timeout, on_reply)
+        done.wait()
+        ok, payload = result[0]
+        if ok is None:
+            msg = f"service {service!r} did not answer within {timeout} s"
+            raise TransportTimeoutError(msg)
+        return ok, payload
+
+    def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
+        self,
+        service: str,
+        request: bytes,
+        request_type: str,
+        response_type: str,
+        timeout: float,
+        callback: ReplyCallback,
+    ) -> None:
+        """Call ``service``; ``callback`` runs exactly once on the I/O thread."""
+        call = _Call(
+            self._fqn(service), bytes(request), request_type, response_type,
+            time.monotonic() + timeout, callback,
+        )  # fmt: skip
+        self._post(lambda: self._start_call(call))
+
+    def _start_call(self, call: _Call) -> None:
+        offer = self._offers.get((call.fqn, call.request_type, call.response_type))
+        if offer is not None:
+            ok, payload = self._run_handler(offer, call.request)
+            self._finish(call, ok, b"" if call.response_type in ONE_WAY_TYPES else payload)
+            return
+        self._calls[call.request_uuid] = call
+        if not self._dispatch_call(call):
+            self._send(self._srv_udp, self._srv.subscribe(call.fqn))
+
+    def _dispatch_call(self, call: _Call) -> bool:
+        """Send ``call`` to the first provider with exactly its types; False if none is known."""
+        for record in self._srv.remote_publishers(call.fqn):
+            srv = record.srv
+            if srv is None or (srv.request_type, srv.response_type) != (
+                call.request_type,
+                call.response_type,
+            ):
+                continue
+            if record.address not in self._requester_connected:
+                self._requester.connect(record.address)
+                self._requester_connected.add(record.address)
+            request = ServiceRequest(
+                call.fqn, self.response_address, self.response_id, self.node_uuid,
+                call.request_uuid, call.request, call.request_type, call.response_type,
+            )  # fmt: skip
+            one_way = call.response_type in ONE_WAY_TYPES
+            call.dispatched = True
+            self._routed.append(
+                _RoutedSend(
+                    self._requester,
+                    encode_request(srv.socket_id, request),
+                    min(call.deadline, time.monotonic() + ROUTE_RETRY),
+                    (lambda: self._finish(call, True, b"")) if one_way else None,
+                )
+            )
+            return True
+        return False
+
+    def _finish(self, call: _Call, ok: bool | None, payload: bytes) -> None:
+        self._calls.pop(call.request_uuid, None)
+        try:
+            call.callback(ok, payload)
+        except Exception:
+            self.count("callback_errors")
+            _LOG.exception("service reply callback for %s raised", call.fqn)
+
+    def _run_handler(self, offer: ZmqServiceOffer, request: bytes) -> tuple[bool, bytes]:
+        try:
+            ok, payload = offer.handler(request)
+        except Exception:
+            self.count("callback_errors")
+            _LOG.exception("service handler for %s raised", offer.record.topic)
+            return False, b""
+        return ok, payload if ok else b""
+
+    def _on_request(self, frames: list[Frame]) -> None:
+        """§2.9.3: look up the handler, run it, answer unless one-way."""
+        request = decode_request(frames)
+        key = (request.service, request.request_type, request.response_type)
+        offer = self._offers.get(key)
+        if offer is None:
+            self.count("requests_unhandled")
+            _LOG.debug("no handler for service request %s", key)
+            return
+        ok, payload = self._run_handler(offer, bytes(request.payload))
+        if request.response_type in ONE_WAY_TYPES:
+            return
+        if request.response_address not in self._replier_connected:
+            self._replier.connect(request.response_address)
+            self._replier_connected.add(request.response_address)
+        response = ServiceResponse(
+            request.service, request.node_uuid, request.request_uuid, payload, ok
+        )
+        self._routed.append(
+            _RoutedSend(
+                self._replier,
+                encode_response(request.response_id, response),
+                time.monotonic() + ROUTE_RETRY,
+            )
+        )
+
+    def _on_response(self, frames: list[Frame]) -> None:
+        response = decode_response(frames)
+        call = self._calls.get(response.request_uuid)
+        if call is None or call.fqn != response.service or response.node_uuid != self.node_uuid:
+            self.count("responses_unmatched")
+            _LOG.debug("unmatched service response for %s", response.service)
+            return
+        self._finish(call, response.ok, bytes(response.payload))
+
+    # --- listings ---------------------------------------------------------------------------
+
+    def _wait_for_init(self) -> None:
+        remaining = self._msg.started + INIT_DELAY - time.monotonic()
+        if remaining > 0:
+            time.sleep(remaining)
+
+    def _names(self, engine: DiscoveryEngine, services: bool) -> list[str]:
+        names: set[str] = set()
+        for record in engine.all_publishers():
+            parts = decompose(record.topic)
+            if parts is None or (record.srv is not None) != services:
+                continue
+            partition, name = parts
+            if partition.removeprefix("/") == self.partition:
+                names.add(name)
+        return sorted(names)
+
+    def _infos(self, engine: DiscoveryEngine, topic: str) -> list[TopicInfo]:
+        fqn = self._fqn(topic)
+        name = (decompose(fqn) or ("", topic))[1]
+        infos = []
+        for record in engine.all_publishers():
+            if record.topic != fqn:
+                continue
+            req = rep = ""
+            msg_type = record.msg_type
+            if record.srv is not None:
+                req, rep = record.srv.request_type, record.srv.response_type
+                msg_type = f"{req}&{rep}"
+            ids = (record.address, record.process_uuid, record.node_uuid)
+            infos.append(TopicInfo(name, msg_type, *ids, request_type=req, response_type=rep))
+        return infos
+
+    def topic_list(self) -> list[str]:
+        """Topics with a publisher in this partition (waits until discovery is initialised)."""
+        self._wait_for_init()
+        return self._call(lambda: self._names(self._msg, services=False))
+
+    def topic_info(self, topic: str) -> list[TopicInfo]:
+        """Publishers of ``topic`` (waits until discovery is initialised)."""
+        self._wait_for_init()
+        return self._call(lambda: self._infos(self._msg, topic))
+
+    def service_list(self) -> list[str]:
+        """Services with a provider in this partition (waits until discovery is initialised)."""
+        self._wait_for_init()
+        return self._call(lambda: self._names(self._srv, services=True))
+
+    def service_info(self, service: str) -> list[TopicInfo]:
+        """Providers of ``service``; ``msg_type`` is ``"<request type>&<response type>"``."""
+        self._wait_for_init()
+        return self._call(lambda: self._infos(self._srv, service))
+
+    def wait_for_publishers(
+        self, topic: str, timeout: float, msg_type: str | None = None
+    ) -> list[TopicInfo]:
+        """Publishers of ``topic`` (of ``msg_type`` if given) as soon as one is known."""
+        deadline = time.monotonic() + timeout
+        while True:
+            seen = self._generation
+            infos = self._call(lambda: self._infos(self._msg, topic))
+            found = [i for i in infos if msg_type is None or i.msg_type == msg_type]
+            remaining = deadline - time.monotonic()
+            if found or remaining <= 0:
+                return found
+            self._wait_for_change(seen, remaining)
+
+    def _wait_for_change(self, seen: int, timeout: float) -> None:
+        with self._changed:
+            self._changed.wait_for(lambda: self._generation != seen, timeout)
+
+    # --- the I/O thread ---------------------------------------------------------------------
+
+    def _send(self, udp: DiscoverySocket, datagrams: list[Outgoing]) -> None:
+        for out in datagrams:
+            if not udp.send(out.data, out.relay_ip):
+                self.count("send_failures")
+
+    def _io_main(self) -> None:
+        poller = zmq.Poller()
+        poller.register(self._wake_r.fileno(), zmq.POLLIN)
+        for udp in self._udp:
+            poller.register(udp.fileno(), zmq.POLLIN)
+        for sock in (self._sub, self._replier, self._responses):
+            poller.register(sock, zmq.POLLIN)
+        while not self._stopping:
+            try:
+                ready = dict(poller.poll(int(self._poll_timeout() * 1000)))
+                self._io_turn(ready)
+            except Exception:  # the I/O thread must survive anything
+                self.count("io_errors")
+                _LOG.exception("unexpected error in the Gazebo Transport I/O thread")
+
+    def _poll_timeout(self) -> float:
+        now = time.monotonic()
+        if self._routed or self._commands:
+            return RETRY_POLL if self._routed else 0.0
+        deadline = min(self._msg.next_deadline(), self._srv.next_deadline(), now + MAX_POLL)
+        for call in self._calls.values():
+            deadline = min(deadline, call.deadline)
+        return max(0.0, deadline - now)
+
+    def _io_turn(self, ready: dict[Any, int]) -> None:
+        if self._wake_r.fileno() in ready:
+            with contextlib.suppress(BlockingIOError):
+                self._wake_r.recv(4096)
+        while self._commands:
+            self._commands.popleft()()
+        for udp, engine in ((self._msg_udp, self._msg), (self._srv_udp, self._srv)):
+            if udp.fileno() in ready:
+                self._read_discovery(udp, engine)
+        handlers = (
+            (self._sub, self._on_data),
+            (self._replier, self._on_request),
+            (self._responses, self._on_response),
+        )
+        for sock, handler in handlers:
+            if sock in ready:
+                self._read_frames(sock, handler)
+        now = time.monotonic()
+        for udp, engine in ((self._msg_udp, self._msg), (self._srv_udp, self._srv)):
+            out, events = engine.tick(now)
+            self._send(udp, out)
+            self._handle_events(engine, events)
+        self._retry_routed(now)
+        for call in [c for c in self._calls.values() if c.deadline <= now]:
+            self._finish(call, None, b"")
+
+    def _read_discovery(self, udp: DiscoverySocket, engine: DiscoveryEngine) -> None:
+        for _ in range(READ_BATCH):
+            received = udp.receive()
+            if received is None:
+                return
+            out, events = engine.datagram_received(*received, time.monotonic())
+            self._send(udp, out)
+            self._handle_events(engine, events)
+
+    def _read_frames(self, sock: Any, handler: Callable[[list[Frame]], None]) -> None:
+        for _ in range(READ_BATCH):
+            try:
+                messages = sock.recv_multipart(zmq.NOBLOCK, copy=False)
+            except zmq.Again:
+                return
+            frames: list[Frame] = [m.buffer for m in messages]
+            try:
+                handler(frames)
+            except RemoteProtocolError as error:
+                self.count("frames_malformed")
+                _LOG.debug("dropped ZMQ message: %s", error)
+
+    def _on_data(self, frames: list[Frame]) -> None:
+        """§2.8.1 step 8: exact FQN, exact or generic type."""
+        message = decode_data(frames)
+        subs = self._subscriptions.get(message.topic)
+        if not subs:
+            return
+        self.count("messages_received")
+        name = (decompose(message.topic) or ("", message.topic))[1]
+        info = MessageInfo(
+            name, message.msg_type, self.partition, message.sender, intra_process=False
+        )
+        for sub in subs:
+            if sub.accepts(message.msg_type):
+                sub.offer(message.payload, info)
+
+    def _handle_events(self, engine: DiscoveryEngine, events: list[Event]) -> None:
+        if not events:
+            return
+        for event in events:
+            if engine is self._msg:
+                self._handle_topic_event(event)
+            elif isinstance(event, PublisherAdded):
+                for call in [c for c in self._calls.values() if not c.dispatched]:
+                    if call.fqn == event.record.topic:
+                        self._dispatch_call(call)
+        with self._changed:
+            self._generation += 1
+            self._changed.notify_all()
+
+    def _handle_topic_event(self, event: Event) -> None:
+        if isinstance(event, PublisherAdded):
+            subs = self._subscriptions.get(event.record.topic)
+            if subs:
+                self._connect_publisher(event.record, subs)
+        elif isinstance(event, SubscriberAdded | SubscriberRemoved):
+            self._wire_types[event.topic] = self._msg.subscriber_types(event.topic)
+
+    def _retry_routed(self, now: float) -> None:
+        pending, self._routed = self._routed, []
+        for routed in pending:
+            try:
+                routed.sock.send_multipart(routed.frames, zmq.NOBLOCK)
+            except zmq.ZMQError as error:
+                if error.errno in (errno.EHOSTUNREACH, zmq.EAGAIN) and now < routed.deadline:
+                    self._routed.append(routed)
+                else:
+                    self.count("send_failures")
+                    _LOG.debug("service message not routable: %s", error)
+                continue
+            if routed.on_sent is not None:
+                routed.on_sent()

@@ -1,0 +1,29 @@
+"""Test-session set-up shared by every test: keep all traffic on this host.
+
+The environment is set at import time, before any test imports rclpy or opens a Gazebo
+Transport node, and is inherited by every subprocess a test starts (real ign tools, rclpy
+processes). It mirrors ``../shared/tools/loopback-env`` with a domain and partition unique
+to this pytest process, so parallel runs never meet.
+"""
+
+from __future__ import annotations
+
+import os
+import uuid
+
+_PARTITION = f"rgbp-test-{os.getpid()}-{uuid.uuid4().hex[:6]}"
+
+os.environ.update(
+    {
+        "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        "ROS_LOCALHOST_ONLY": "1",
+        "GZ_IP": "127.0.0.1",
+        "IGN_IP": "127.0.0.1",
+        "ROS_DOMAIN_ID": str(os.getpid() % 200 + 1),
+        "GZ_PARTITION": _PARTITION,
+        "IGN_PARTITION": _PARTITION,
+    }
+)
+os.environ.pop("GZ_RELAY", None)
+os.environ.pop("IGN_RELAY", None)
+os.environ.pop("GZ_TRANSPORT_IMPLEMENTATION", None)

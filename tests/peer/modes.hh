@@ -1,0 +1,16 @@
+// The peer's modes; each returns the process exit status. Usage is in main.cc.
+#pragma once
+
+#include "args.hh"
+
+namespace peer {
+
+int RunPub(const Args &args);
+int RunEcho(const Args &args);
+int RunRelay(const Args &args);
+int RunReply(const Args &args);
+int RunCall(const Args &args);
+int RunBenchPub(const Args &args);
+int RunBenchSub(const Args &args);
+
+}  // namespace peer

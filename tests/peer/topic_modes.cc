@@ -1,0 +1,145 @@
+// pub, echo and relay: the topic side of the peer.
+#include <ignition/msgs/Factory.hh>
+#include <ignition/transport/Node.hh>
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+#include "messages.hh"
+#include "modes.hh"
+#include "output.hh"
+
+namespace peer {
+namespace {
+
+// Waits up to `seconds` for a subscriber; prints CONNECTED or NO_CONNECTIONS.
+bool WaitForConnections(const ignition::transport::Node::Publisher &pub, double seconds) {
+  const std::int64_t end = MonotonicNs() + static_cast<std::int64_t>(seconds * 1e9);
+  while (!pub.HasConnections() && MonotonicNs() < end && !StopRequested()) SleepFor(0.02);
+  const bool connected = pub.HasConnections();
+  Line(connected ? "CONNECTED" : "NO_CONNECTIONS");
+  return connected;
+}
+
+}  // namespace
+
+// pub TOPIC TYPE HZ COUNT [TEXTPROTO] [--bytes N] [--wait S] [--settle S] [--linger S]
+// COUNT <= 0 publishes until stopped; HZ <= 0 publishes back to back.
+int RunPub(const Args &args) {
+  const std::string topic = args.Word(1, "TOPIC");
+  const std::string type = args.Word(2, "TYPE");
+  const double hz = ToNumber(args.Word(3, "HZ"), "HZ");
+  const long count = static_cast<long>(ToNumber(args.Word(4, "COUNT"), "COUNT"));
+  auto msg = MakeMessage(type, args.WordCount() > 5 ? args.Word(5, "TEXTPROTO") : "");
+  if (args.Has("bytes")) {
+    auto *field = msg->GetDescriptor()->FindFieldByName("data");
+    if (!field || field->type() != google::protobuf::FieldDescriptor::TYPE_BYTES) {
+      throw UsageError("--bytes needs a type with a bytes field `data`, not " + type);
+    }
+    const auto size = static_cast<std::size_t>(args.Number("bytes", 0));
+    msg->GetReflection()->SetString(msg.get(), field, PatternBytes(size));
+  }
+  std::string payload;
+  msg->SerializeToString(&payload);
+
+  ignition::transport::Node node;
+  auto pub = node.Advertise(topic, type);
+  if (!pub) {
+    Line("ERROR advertise failed for " + topic);
+    return 1;
+  }
+  Line("READY");
+  Line("PAYLOAD " + Digest(payload.data(), payload.size()));
+  // A NEW_CONNECTION can arrive just before the subscriber's ZeroMQ connection is up.
+  if (WaitForConnections(pub, args.Number("wait", 5))) SleepFor(args.Number("settle", 0.2));
+
+  long sent = 0;
+  for (; (count <= 0 || sent < count) && !StopRequested(); ++sent) {
+    pub.PublishRaw(payload, type);
+    if (hz > 0) SleepFor(1.0 / hz);
+  }
+  Line("SENT " + std::to_string(sent));
+  SleepFor(args.Number("linger", 0.5));
+  return 0;
+}
+
+// echo TOPIC TYPE SECONDS [--count N] [--sha | --hex]
+// Prints `MSG <type> <text|hex|sha256=.. len=..>` per message, then `COUNT n BYTES b`.
+int RunEcho(const Args &args) {
+  const std::string topic = args.Word(1, "TOPIC");
+  const std::string type = args.Word(2, "TYPE");
+  const double seconds = ToNumber(args.Word(3, "SECONDS"), "SECONDS");
+  const long wanted = static_cast<long>(args.Number("count", 0));
+  const bool sha = args.Has("sha");
+  const bool hex = args.Has("hex");
+  std::atomic<long> received{0};
+  std::atomic<long> bytes{0};
+  std::mutex printing;
+
+  ignition::transport::Node node;
+  auto callback = [&](const char *data, std::size_t size,
+                      const ignition::transport::MessageInfo &info) {
+    const std::lock_guard<std::mutex> lock(printing);
+    if (wanted > 0 && received >= wanted) return;
+    std::string body;
+    if (sha) {
+      body = Digest(data, size);
+    } else if (hex) {
+      body = Hex(data, size);
+    } else {
+      auto msg = ignition::msgs::Factory::New(info.Type());
+      body = msg && msg->ParseFromArray(data, static_cast<int>(size)) ? OneLine(*msg)
+                                                                      : "UNDECODABLE " + Hex(data, size);
+    }
+    Line("MSG " + info.Type() + " " + body);
+    bytes += static_cast<long>(size);
+    ++received;
+  };
+  if (!node.SubscribeRaw(topic, callback, type)) {
+    Line("ERROR subscribe failed for " + topic);
+    return 1;
+  }
+  Line("READY");
+  const std::int64_t end = MonotonicNs() + static_cast<std::int64_t>(seconds * 1e9);
+  while (!StopRequested() && MonotonicNs() < end && (wanted <= 0 || received < wanted)) {
+    SleepFor(0.01);
+  }
+  node.Unsubscribe(topic);
+  const std::lock_guard<std::mutex> lock(printing);
+  Line("COUNT " + std::to_string(received.load()) + " BYTES " + std::to_string(bytes.load()));
+  return 0;
+}
+
+// relay IN OUT TYPE SECONDS: republishes every message of IN on OUT unchanged.
+int RunRelay(const Args &args) {
+  const std::string in = args.Word(1, "IN");
+  const std::string out = args.Word(2, "OUT");
+  const std::string type = args.Word(3, "TYPE");
+  const double seconds = ToNumber(args.Word(4, "SECONDS"), "SECONDS");
+  std::atomic<long> relayed{0};
+
+  ignition::transport::Node node;
+  auto pub = node.Advertise(out, type);
+  if (!pub) {
+    Line("ERROR advertise failed for " + out);
+    return 1;
+  }
+  auto callback = [&](const char *data, std::size_t size,
+                      const ignition::transport::MessageInfo &info) {
+    pub.PublishRaw(std::string(data, size), info.Type());
+    ++relayed;
+  };
+  if (!node.SubscribeRaw(in, callback, type)) {
+    Line("ERROR subscribe failed for " + in);
+    return 1;
+  }
+  Line("READY");
+  RunFor(seconds);
+  node.Unsubscribe(in);
+  Line("RELAYED " + std::to_string(relayed.load()));
+  return 0;
+}
+
+}  // namespace peer

