@@ -1,0 +1,244 @@
+"""The bridge: channels and service bridges on one rclpy node and one Gazebo Transport node.
+
+Embedding::
+
+    import rclpy
+    from rclpy.node import Node
+    from ros_gz_bridge_py import Bridge
+    from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+
+    rclpy.init()
+    node = Node("my_node")
+    bridge = Bridge(node)
+    handle = bridge.add(TopicBridgeSpec("/chatter", "/chatter", "std_msgs/msg/String",
+                                        "gz.msgs.StringMsg", Direction.GZ_TO_ROS))
+    ...                      # spin the node with any executor
+    bridge.remove(handle)    # bridges come and go at run time
+    bridge.close()
+
+The bridge creates a wall-clock (steady) timer on the node that re-evaluates lazy channels every
+``heartbeat`` seconds, as the C++ bridge does with ``subscription_heartbeat``.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+from rclpy.clock import Clock, ClockType
+
+from ros_gz_bridge_py.channel import (
+    Channel,
+    ChannelContext,
+    GzToRosChannel,
+    RosToGzChannel,
+)
+from ros_gz_bridge_py.config import (
+    BridgeSpec,
+    Direction,
+    ServiceBridgeSpec,
+    TopicBridgeSpec,
+)
+from ros_gz_bridge_py.converters.registry import Registry, default_registry
+from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
+from ros_gz_bridge_py.services import DEFAULT_TIMEOUT, ServiceBridge, ServiceHost
+from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import NodeOptions, create_node
+
+
+@dataclass
+class BridgeHandle:
+    """What one :meth:`Bridge.add` created: its channels (topic) or its service bridge."""
+
+    spec: BridgeSpec
+    channels: list[Channel] = field(default_factory=list)
+    service: ServiceBridge | None = None
+
+
+@dataclass(frozen=True)
+class BridgeOptions:
+    """Node-wide settings (the C++ node parameters of the same names)."""
+
+    lazy: bool = False
+    heartbeat: float = 1.0
+    override_timestamps_with_wall_time: bool = False
+    override_frame_id: str = ""
+    service_timeout: float = DEFAULT_TIMEOUT
+
+
+class Bridge:
+    """Owns the bridges of one rclpy node; thread-safe ``add``/``remove``/``close``."""
+
+    def __init__(
+        self,
+        ros_node: Any,
+        gz_node: GzNode | None = None,
+        options: BridgeOptions | None = None,
+        *,
+        registry: Registry | None = None,
+        gz_options: NodeOptions | None = None,
+    ) -> None:
+        self.options = options or BridgeOptions()
+        self.ros_node = ros_node
+        self.registry = registry or default_registry()
+        self._owns_gz_node = gz_node is None
+        self.gz_node = gz_node if gz_node is not None else create_node(gz_options)
+        self._ctx = ChannelContext(
+            ros_node=ros_node,
+            gz_node=self.gz_node,
+            wall_time_stamps=self.options.override_timestamps_with_wall_time,
+            override_frame_id=self.options.override_frame_id,
+        )
+        self._logger = ros_node.get_logger()
+        self._lock = threading.RLock()
+        self._handles: list[BridgeHandle] = []
+        self._closed = False
+        self._service_host: ServiceHost | None = None
+        self._timer = ros_node.create_timer(
+            self.options.heartbeat, self.heartbeat, clock=Clock(clock_type=ClockType.STEADY_TIME)
+        )
+
+    @property
+    def handles(self) -> list[BridgeHandle]:
+        with self._lock:
+            return list(self._handles)
+
+    @property
+    def channels(self) -> list[Channel]:
+        return [channel for handle in self.handles for channel in handle.channels]
+
+    @property
+    def services(self) -> list[ServiceBridge]:
+        return [h.service for h in self.handles if h.service is not None]
+
+    def add(self, spec: BridgeSpec) -> BridgeHandle:
+        """Create the channels (or service bridge) of ``spec`` and start them.
+
+        Raises:
+            ConfigError: the spec cannot be bridged (unsupported type pair, bad name, ...);
+                nothing of it is left open.
+        """
+        with self._lock:
+            if self._closed:
+                msg = "the bridge is closed"
+                raise BridgeError(msg)
+            handle = (
+                self._add_service(spec)
+                if isinstance(spec, ServiceBridgeSpec)
+                else self._add_topic(spec)
+            )
+            self._handles.append(handle)
+            return handle
+
+    def add_all(self, specs: Iterable[BridgeSpec]) -> list[ConfigError]:
+        """Add every spec; a spec that fails is logged and skipped. Returns the failures."""
+        failures = []
+        for spec in specs:
+            try:
+                self.add(spec)
+            except ConfigError as err:
+                failures.append(err)
+                self._logger.error(str(err))
+        return failures
+
+    def remove(self, handle: BridgeHandle) -> None:
+        """Close what ``handle`` created. Unknown or already removed handles are ignored."""
+        with self._lock:
+            if handle not in self._handles:
+                return
+            self._handles.remove(handle)
+        _close_handle(handle)
+
+    def heartbeat(self) -> None:
+        """Re-evaluate lazy channels (called by the bridge's timer)."""
+        for channel in self.channels:
+            if channel.lazy:
+                try:
+                    channel.heartbeat()
+                except Exception as err:
+                    self._logger.error(f"{channel.describe()}: lazy check failed: {err}")
+
+    def close(self) -> None:
+        """Close every bridge, the heartbeat timer and the Gazebo node if the bridge made it."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            handles, self._handles = self._handles, []
+        self.ros_node.destroy_timer(self._timer)
+        for handle in reversed(handles):
+            _close_handle(handle)
+        if self._service_host is not None:
+            self._service_host.close()
+        if self._owns_gz_node:
+            self.gz_node.close()
+
+    def __enter__(self) -> Bridge:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
+
+    def _add_topic(self, spec: TopicBridgeSpec) -> BridgeHandle:
+        try:
+            pair = self.registry.get(spec.ros_type, spec.gz_type)
+        except UnsupportedTypeError as err:
+            raise UnsupportedTypeError(
+                _failed_text(spec, err.message), spec.source or None
+            ) from None
+        lazy = self.options.lazy if spec.lazy is None else spec.lazy
+        handle = BridgeHandle(spec)
+        kinds: list[type[Channel]] = []
+        if spec.direction in (Direction.BIDIRECTIONAL, Direction.GZ_TO_ROS):
+            kinds.append(GzToRosChannel)
+        if spec.direction in (Direction.BIDIRECTIONAL, Direction.ROS_TO_GZ):
+            kinds.append(RosToGzChannel)
+        try:
+            for kind in kinds:
+                channel = kind(self._ctx, spec, pair, lazy)
+                self._logger.info(f"Creating {channel.describe()} (Lazy {int(lazy)})")
+                handle.channels.append(channel)
+                channel.start()
+        except Exception as err:
+            _close_handle(handle)
+            raise ConfigError(_failed_text(spec, str(err)), spec.source or None) from err
+        return handle
+
+    def _add_service(self, spec: ServiceBridgeSpec) -> BridgeHandle:
+        try:
+            pair = self.registry.get_service(spec.ros_type)
+        except UnsupportedTypeError as err:
+            msg = f"Failed to create a bridge for service [{spec.service}]: {err.message}"
+            raise UnsupportedTypeError(msg, spec.source or None) from None
+        if self._service_host is None:
+            self._service_host = ServiceHost(self.ros_node)
+        try:
+            service = ServiceBridge(
+                self._service_host, self.gz_node, spec, pair, self.options.service_timeout
+            )
+        except ConfigError:
+            raise
+        except Exception as err:
+            msg = (
+                f"Failed to create a bridge for service [{spec.service}] with ROS2 type "
+                f"[{spec.ros_type}]: {err}"
+            )
+            raise ConfigError(msg, spec.source or None) from err
+        self._logger.info(f"Creating {service.describe()}")
+        return BridgeHandle(spec, service=service)
+
+
+def _failed_text(spec: TopicBridgeSpec, why: str) -> str:
+    return (
+        f"Failed to create a bridge for topic [{spec.ros_topic}] with ROS2 type [{spec.ros_type}] "
+        f"to topic [{spec.gz_topic}] with Gazebo Transport type [{spec.gz_type}]: {why}"
+    )
+
+
+def _close_handle(handle: BridgeHandle) -> None:
+    for channel in reversed(handle.channels):
+        channel.close()
+    if handle.service is not None:
+        handle.service.close()

@@ -1,0 +1,346 @@
+"""Channels: one direction of one bridged topic.
+
+A channel pairs a ROS endpoint with a Gazebo Transport endpoint through one converter pair. The
+output side (the ROS publisher of a Gazebo->ROS channel, the Gazebo publisher of a ROS->Gazebo
+channel) exists for the channel's whole life. The input side is opened at start, or, for a lazy
+channel, only while the output side has subscribers other than the bridge itself; the bridge
+re-checks that every heartbeat (:meth:`Channel.heartbeat`). Each channel owns its endpoints and
+closes exactly those (never "everything on this topic").
+
+Threads: Gazebo->ROS messages are decoded, converted and published on the channel's own
+delivery thread (a bounded, drop-oldest queue in the transport), so a heavy topic never delays
+a light one and never touches the ROS executor. ROS->Gazebo messages arrive on the executor.
+"""
+
+from __future__ import annotations
+
+import abc
+import enum
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.loop_guard import OwnPublications
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.qos import (
+    PUBLISHER_OVERRIDES,
+    SUBSCRIPTION_OVERRIDES,
+    endpoint_qos,
+    gz_to_ros_publisher_qos,
+)
+from ros_gz_bridge_py.transport import MessageInfo, Node, Publisher, Subscription
+
+#: Minimum seconds between two log lines about conversion errors of one channel.
+ERROR_LOG_PERIOD = 5.0
+
+
+class ChannelState(enum.Enum):
+    CREATED = "created"
+    ACTIVE = "active"
+    LAZY_IDLE = "lazy_idle"
+    CLOSED = "closed"
+
+
+@dataclass
+class ChannelStats:
+    """Counters of one channel; plain ints updated from one thread each, read from any."""
+
+    received: int = 0
+    published: int = 0
+    conversion_errors: int = 0
+    own_skipped: int = 0
+    last_error: str = ""
+    started_at: float = field(default_factory=time.monotonic)
+
+    def as_dict(self) -> dict[str, int | float | str]:
+        return {
+            "received": self.received,
+            "published": self.published,
+            "conversion_errors": self.conversion_errors,
+            "own_skipped": self.own_skipped,
+            "last_error": self.last_error,
+        }
+
+
+def _own_publications_table() -> Callable[[str], OwnPublications]:
+    table: dict[str, OwnPublications] = {}
+    lock = threading.Lock()
+
+    def get(topic: str) -> OwnPublications:
+        with lock:
+            return table.setdefault(topic, OwnPublications())
+
+    return get
+
+
+@dataclass
+class ChannelContext:
+    """What channels share: the two nodes and the node-wide options."""
+
+    ros_node: Any
+    gz_node: Node
+    wall_time_stamps: bool = False
+    override_frame_id: str = ""
+    #: OwnPublications per resolved ROS topic, shared by the two halves of a bidirectional bridge.
+    own_publications: Callable[[str], OwnPublications] = field(
+        default_factory=_own_publications_table
+    )
+
+    def resolve(self, ros_topic: str) -> str:
+        return str(self.ros_node.resolve_topic_name(ros_topic))
+
+
+class Channel(abc.ABC):
+    """One direction of one topic: lifecycle, lazy switching and counters."""
+
+    direction: Direction
+
+    def __init__(self, ctx: ChannelContext, spec: TopicBridgeSpec, pair: Pair, lazy: bool) -> None:
+        self.ctx = ctx
+        self.spec = spec
+        self.pair = pair
+        self.lazy = lazy
+        self.state = ChannelState.CREATED
+        self.stats = ChannelStats()
+        self.ros_topic = ctx.resolve(spec.ros_topic)
+        self._logger = ctx.ros_node.get_logger()
+        self._last_error_log = 0.0
+
+    def start(self) -> None:
+        """Open the output side, and the input side unless the channel is lazy."""
+        self._open_output()
+        if self.lazy:
+            self.state = ChannelState.LAZY_IDLE
+            self.heartbeat()
+        else:
+            self._open_input()
+            self.state = ChannelState.ACTIVE
+
+    def heartbeat(self) -> None:
+        """Lazy channels: open or close the input side as the output gains or loses readers."""
+        if not self.lazy or self.state is ChannelState.CLOSED:
+            return
+        wanted = self._output_has_subscribers()
+        if wanted and self.state is ChannelState.LAZY_IDLE:
+            self._logger.debug(f"Bridge [{self.ros_topic}] - Subscriptions found, starting bridge")
+            self._open_input()
+            self.state = ChannelState.ACTIVE
+        elif not wanted and self.state is ChannelState.ACTIVE:
+            self._logger.debug(
+                f"Bridge [{self.ros_topic}] - No subscriptions found, stopping bridge"
+            )
+            self._close_input()
+            self.state = ChannelState.LAZY_IDLE
+
+    def close(self) -> None:
+        if self.state is ChannelState.CLOSED:
+            return
+        if self.state is ChannelState.ACTIVE:
+            self._close_input()
+        self._close_output()
+        self.state = ChannelState.CLOSED
+
+    @property
+    def input_open(self) -> bool:
+        return self.state is ChannelState.ACTIVE
+
+    def _conversion_failed(self, err: Exception) -> None:
+        self.stats.conversion_errors += 1
+        self.stats.last_error = str(err)
+        now = time.monotonic()
+        if now - self._last_error_log >= ERROR_LOG_PERIOD:
+            self._last_error_log = now
+            self._logger.error(
+                f"{self.describe()}: message skipped: {err} "
+                f"({self.stats.conversion_errors} conversion errors so far)"
+            )
+
+    @abc.abstractmethod
+    def describe(self) -> str: ...
+
+    @abc.abstractmethod
+    def _open_output(self) -> None: ...
+
+    @abc.abstractmethod
+    def _close_output(self) -> None: ...
+
+    @abc.abstractmethod
+    def _open_input(self) -> None: ...
+
+    @abc.abstractmethod
+    def _close_input(self) -> None: ...
+
+    @abc.abstractmethod
+    def _output_has_subscribers(self) -> bool: ...
+
+
+def has_top_level_header(ros_class: type[Any]) -> bool:
+    fields: dict[str, str] = ros_class.get_fields_and_field_types()
+    return fields.get("header") == "std_msgs/Header"
+
+
+class GzToRosChannel(Channel):
+    """Gazebo subscription -> converter -> ROS publisher."""
+
+    direction = Direction.GZ_TO_ROS
+
+    def __init__(self, ctx: ChannelContext, spec: TopicBridgeSpec, pair: Pair, lazy: bool) -> None:
+        super().__init__(ctx, spec, pair, lazy)
+        self._gz_class = message_class(spec.gz_type)
+        self._qos = gz_to_ros_publisher_qos(self.ros_topic, spec.qos_profile, spec.publisher_queue)
+        self._publisher: Any = None
+        self._publish: Callable[[Any], None] = _closed_publish
+        self._subscription: Subscription | None = None
+        self._finish = self._make_finisher()
+
+    def describe(self) -> str:
+        return (
+            f"GZ->ROS [{self.spec.gz_topic} ({self.spec.gz_type}) -> "
+            f"{self.ros_topic} ({self.spec.ros_type})]"
+        )
+
+    @property
+    def dropped(self) -> int:
+        return self._subscription.dropped if self._subscription is not None else 0
+
+    def _make_finisher(self) -> Callable[[Any], None] | None:
+        """The per-message header rewrite the node options ask for, bound once."""
+        frame_id = self.spec.frame_id or self.ctx.override_frame_id
+        stamp = self.ctx.wall_time_stamps
+        if not (frame_id or stamp) or not has_top_level_header(self.pair.ros_class):
+            return None
+
+        def finish(msg: Any) -> None:
+            if frame_id:
+                msg.header.frame_id = frame_id
+            if stamp:
+                sec, nanosec = divmod(time.time_ns(), 1_000_000_000)
+                msg.header.stamp.sec = sec
+                msg.header.stamp.nanosec = nanosec
+
+        return finish
+
+    def _open_output(self) -> None:
+        node = self.ctx.ros_node
+        self._publisher = node.create_publisher(
+            self.pair.ros_class,
+            self.spec.ros_topic,
+            self._qos,
+            qos_overriding_options=PUBLISHER_OVERRIDES,
+        )
+        self._publish = self.ctx.own_publications(self.ros_topic).wrap(self._publisher)
+
+    def _close_output(self) -> None:
+        self._publish = _closed_publish
+        if self._publisher is not None:
+            self.ctx.ros_node.destroy_publisher(self._publisher)
+            self._publisher = None
+
+    def _open_input(self) -> None:
+        self._subscription = self.ctx.gz_node.subscribe_typed(
+            self.spec.gz_topic,
+            self._gz_class,
+            self._on_gz_message,
+            msg_type=self.spec.gz_type,
+            ignore_local=True,
+            queue_size=self._qos.depth or 1,
+        )
+
+    def _close_input(self) -> None:
+        if self._subscription is not None:
+            self._subscription.close()
+            self._subscription = None
+
+    def _output_has_subscribers(self) -> bool:
+        node = self.ctx.ros_node
+        own = (node.get_name(), node.get_namespace())
+        return any(
+            (info.node_name, info.node_namespace) != own
+            for info in node.get_subscriptions_info_by_topic(self.ros_topic)
+        )
+
+    def _on_gz_message(self, gz_msg: Any, _info: MessageInfo) -> None:
+        self.stats.received += 1
+        try:
+            ros_msg = self.pair.to_ros(gz_msg)
+            if self._finish is not None:
+                self._finish(ros_msg)
+        except Exception as err:
+            self._conversion_failed(err)
+            return
+        self._publish(ros_msg)
+        self.stats.published += 1
+
+
+class RosToGzChannel(Channel):
+    """ROS subscription -> converter -> Gazebo publisher."""
+
+    direction = Direction.ROS_TO_GZ
+
+    def __init__(self, ctx: ChannelContext, spec: TopicBridgeSpec, pair: Pair, lazy: bool) -> None:
+        super().__init__(ctx, spec, pair, lazy)
+        self._qos = endpoint_qos(spec.qos_profile, spec.subscriber_queue)
+        self._own = ctx.own_publications(self.ros_topic)
+        self._gz_publisher: Publisher | None = None
+        self._subscription: Any = None
+        self._announced = False
+
+    def describe(self) -> str:
+        return (
+            f"ROS->GZ [{self.ros_topic} ({self.spec.ros_type}) -> "
+            f"{self.spec.gz_topic} ({self.spec.gz_type})]"
+        )
+
+    def _open_output(self) -> None:
+        self._gz_publisher = self.ctx.gz_node.advertise(self.spec.gz_topic, self.spec.gz_type)
+
+    def _close_output(self) -> None:
+        if self._gz_publisher is not None:
+            self._gz_publisher.close()
+            self._gz_publisher = None
+
+    def _open_input(self) -> None:
+        self._subscription = self.ctx.ros_node.create_subscription(
+            self.pair.ros_class,
+            self.spec.ros_topic,
+            self._on_ros_message,
+            self._qos,
+            qos_overriding_options=SUBSCRIPTION_OVERRIDES,
+        )
+
+    def _close_input(self) -> None:
+        if self._subscription is not None:
+            self.ctx.ros_node.destroy_subscription(self._subscription)
+            self._subscription = None
+
+    def _output_has_subscribers(self) -> bool:
+        return self._gz_publisher is not None and self._gz_publisher.has_connections()
+
+    def _on_ros_message(self, ros_msg: Any, info: Any) -> None:
+        if self._own.is_own(info):
+            self.stats.own_skipped += 1
+            return
+        self.stats.received += 1
+        publisher = self._gz_publisher
+        if publisher is None:
+            return
+        try:
+            publisher.publish(self.pair.to_gz(ros_msg))
+        except Exception as err:
+            self._conversion_failed(err)
+            return
+        self.stats.published += 1
+        if not self._announced:
+            self._announced = True
+            self._logger.info(
+                f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
+                "(showing msg only once per type)"
+            )
+
+
+def _closed_publish(_msg: Any) -> None:
+    """Publishing after close: nothing to do (a late message from the delivery thread)."""

@@ -1,0 +1,68 @@
+"""Recognise, on a ROS subscription, the messages the bridge itself published.
+
+A bidirectional bridge publishes Gazebo messages on a ROS topic it also subscribes to; without a
+filter every message would go back to Gazebo. The C++ bridge (Jazzy 1.0.21+) skips samples whose
+publisher GID is one of its own. rclpy does not expose the publisher GID of a received sample,
+but it does expose the writer's ``publication_sequence_number`` and the ``source_timestamp``
+(the wall clock when the writer wrote it). A sample is ours when its sequence number is one our
+publisher used and its source timestamp falls inside the wall-clock window of that publish call.
+Another writer would need the same sequence number *and* a write inside that microseconds-wide
+window, which a sample from a different process or publisher practically never has (tests check
+both directions). Unlike ``ignore_local_publications``, this never drops messages from other
+nodes in the same process (ros_gz issue #788).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import OrderedDict
+from collections.abc import Callable, Mapping
+from typing import Any
+
+#: How many recent publications per ROS topic are remembered (covers bursts and slow executors).
+HISTORY = 1024
+
+
+class OwnPublications:
+    """Windows of our own recent publications on one ROS topic, from one or more publishers."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        # (publisher id, sequence number) -> (start ns, end ns) of the publish call.
+        self._windows: OrderedDict[tuple[int, int], tuple[int, int]] = OrderedDict()
+        self._sequences: dict[int, int] = {}
+
+    def wrap(self, publisher: Any) -> Callable[[Any], None]:
+        """A publish function for ``publisher`` that records each publication's window.
+
+        Must be the only way ``publisher`` publishes, so the sequence numbers stay in step.
+        """
+        key = id(publisher)
+        publish = publisher.publish
+
+        def publish_and_record(msg: Any) -> None:
+            start = time.time_ns()
+            publish(msg)
+            end = time.time_ns()
+            with self._lock:
+                sequence = self._sequences.get(key, 0) + 1
+                self._sequences[key] = sequence
+                self._windows[(key, sequence)] = (start, end)
+                if len(self._windows) > HISTORY:
+                    self._windows.popitem(last=False)
+
+        return publish_and_record
+
+    def is_own(self, info: Mapping[str, Any]) -> bool:
+        """True when the sample described by rclpy's message info is one we published."""
+        sequence = info.get("publication_sequence_number")
+        stamp = info.get("source_timestamp")
+        if not sequence or not stamp:
+            return False
+        with self._lock:
+            for key in self._sequences:
+                window = self._windows.get((key, sequence))
+                if window is not None and window[0] <= stamp <= window[1]:
+                    return True
+        return False

@@ -1,0 +1,178 @@
+"""``parameter_bridge``: the node parameters, the configuration sources, and the main loop.
+
+Configuration is parsed completely first (arguments, the ``config_file`` YAML, ``bridge_names``
+parameters), then every bridge is created; an entry that fails is reported with its location and
+skipped, the others bridge. Unlike the C++ bridge, the YAML file is read once at start (not on
+the first heartbeat, and not again on every heartbeat when it fails), and it applies together
+with command-line bridges.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+import rclpy
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.signals import SignalHandlerOptions
+from rclpy.utilities import remove_ros_args
+
+from ros_gz_bridge_py.bridge import Bridge, BridgeOptions
+from ros_gz_bridge_py.config import (
+    USAGE,
+    BridgeSpec,
+    ParseResult,
+    TopicBridgeSpec,
+    UsageError,
+    expand_topic_name,
+    parse_cli_args,
+    parse_parameter_bridges,
+    read_yaml_file,
+)
+from ros_gz_bridge_py.runtime import make_executor, spin_until_stopped, tune_allocator
+from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.transport import NodeOptions
+
+NODE_NAME = "ros_gz_bridge"
+#: Exit status for bad arguments, as the C++ bridge (``return -1``).
+USAGE_EXIT = 255
+BRIDGE_PARAMETER_KEYS = (
+    "ros_topic_name",
+    "gz_topic_name",
+    "ros_type_name",
+    "gz_type_name",
+    "direction",
+    "lazy",
+    "publisher_queue",
+    "subscriber_queue",
+    "qos_profile",
+    "frame_id",
+    "service_name",
+    "gz_req_type_name",
+    "gz_rep_type_name",
+)
+
+
+def declare_parameters(node: Node) -> dict[str, Any]:
+    """Declare the node parameters of the C++ bridge (and ours) and return their values."""
+    defaults: dict[str, Any] = {
+        "config_file": "",
+        "expand_gz_topic_names": False,
+        "lazy": False,
+        "subscription_heartbeat": 1000,
+        "override_timestamps_with_wall_time": False,
+        "override_frame_id": "",
+        # Ours: seconds a ROS service call waits for Gazebo before answering success=false.
+        "service_timeout": DEFAULT_TIMEOUT,
+        # Ours: "zeromq" or "zenoh"; empty = GZ_TRANSPORT_IMPLEMENTATION, as gz-transport does.
+        "gz_transport_implementation": "",
+    }
+    values = {name: node.declare_parameter(name, value).value for name, value in defaults.items()}
+    names = node.declare_parameter("bridge_names", Parameter.Type.STRING_ARRAY).value
+    values["bridge_names"] = list(names or [])
+    return values
+
+
+def parameter_bridge_specs(node: Node, names: Sequence[str]) -> ParseResult:
+    """The ``bridges.<name>.*`` bridges (Jazzy 1.0.15+ form)."""
+    dynamic = ParameterDescriptor(dynamic_typing=True)
+    for name in names:
+        for key in BRIDGE_PARAMETER_KEYS:
+            node.declare_parameter(f"bridges.{name}.{key}", None, dynamic)
+
+    def get(full_name: str) -> object | None:
+        value: object | None = node.get_parameter(full_name).value
+        return value
+
+    return parse_parameter_bridges(names, get)
+
+
+def expand_gz_names(result: ParseResult, node: Node) -> ParseResult:
+    """Apply ``expand_gz_topic_names`` to the topic bridges of a config source."""
+    specs: list[BridgeSpec] = [
+        dataclasses.replace(
+            spec,
+            gz_topic=expand_topic_name(spec.gz_topic, node.get_namespace(), node.get_name()),
+        )
+        if isinstance(spec, TopicBridgeSpec)
+        else spec
+        for spec in result.specs
+    ]
+    return dataclasses.replace(result, specs=tuple(specs))
+
+
+def report(node: Node, result: ParseResult) -> None:
+    logger = node.get_logger()
+    for warning in result.warnings:
+        logger.warning(warning)
+    for error in result.errors:
+        logger.error(str(error))
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv if argv is None else argv)
+    args = argv[1:]
+    positional = remove_ros_args(argv)[1:]
+    if any(arg in ("-h", "--help") for arg in positional):
+        print(USAGE)
+        return 0
+    if not args:
+        print(USAGE)
+        return USAGE_EXIT
+    try:
+        cli = parse_cli_args(positional)
+    except UsageError as err:
+        print(USAGE)
+        print(f"parameter_bridge: {err}", file=sys.stderr)
+        return USAGE_EXIT
+
+    tune_allocator()
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    node = Node(NODE_NAME)
+    bridge: Bridge | None = None
+    try:
+        params = declare_parameters(node)
+        sources = [cli]
+        if params["config_file"]:
+            sources.append(expand_if(read_yaml_file(params["config_file"]), node, params))
+        if params["bridge_names"]:
+            sources.append(
+                expand_if(parameter_bridge_specs(node, params["bridge_names"]), node, params)
+            )
+        for source in sources:
+            report(node, source)
+        bridge = Bridge(
+            node,
+            options=BridgeOptions(
+                lazy=params["lazy"],
+                heartbeat=max(params["subscription_heartbeat"], 1) / 1000.0,
+                override_timestamps_with_wall_time=params["override_timestamps_with_wall_time"],
+                override_frame_id=params["override_frame_id"],
+                service_timeout=params["service_timeout"],
+            ),
+            gz_options=NodeOptions(implementation=params["gz_transport_implementation"] or None),
+        )
+        specs = [spec for source in sources for spec in source.specs]
+        bridge.add_all(specs)
+        if not bridge.handles:
+            node.get_logger().warning(
+                "No bridges are running: give topic arguments, or -p config_file:=<yaml>, "
+                "or bridge_names parameters (parameter_bridge -h shows the syntax)"
+            )
+        executor = make_executor()
+        executor.add_node(node)
+        spin_until_stopped(executor)
+    finally:
+        if bridge is not None:
+            bridge.close()
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+def expand_if(result: ParseResult, node: Node, params: dict[str, Any]) -> ParseResult:
+    return expand_gz_names(result, node) if params["expand_gz_topic_names"] else result

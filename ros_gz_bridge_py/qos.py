@@ -1,0 +1,131 @@
+"""ROS QoS for bridge endpoints: the C++ defaults, the named profiles and per-topic overrides.
+
+Defaults follow ros_gz_bridge: reliable, volatile, keep-last 10 on both ROS endpoints. One
+deliberate difference: a Gazebo->ROS publisher on ``/tf_static`` is transient-local by default,
+so late-joining TF listeners get the static transforms (ros_gz issues #250, ardupilot_gz#36).
+Users still override everything with ``qos_overrides.<topic>.publisher|subscription.<policy>``,
+which rclpy reads from the node's parameters when the endpoint is created.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rclpy.duration import Duration
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    QoSProfile,
+    ReliabilityPolicy,
+    qos_profile_best_available,
+    qos_profile_parameter_events,
+    qos_profile_parameters,
+    qos_profile_sensor_data,
+    qos_profile_services_default,
+    qos_profile_system_default,
+)
+from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
+
+from ros_gz_bridge_py.errors import ConfigError
+
+DEFAULT_DEPTH = 10
+TF_STATIC_TOPIC = "/tf_static"
+
+
+def _clock_profile() -> QoSProfile:
+    # rclcpp::ClockQoS: keep-last 1, best effort, volatile.
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST,
+        depth=1,
+        reliability=ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.VOLATILE,
+    )
+
+
+def _rosout_profile() -> QoSProfile:
+    # rclcpp::RosoutQoS: keep-last 1000, reliable, transient local, 10 s lifespan.
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST,
+        depth=1000,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        lifespan=Duration(seconds=10),
+    )
+
+
+#: ``qos_profile`` names (as the C++ bridge spells them) -> a function returning a fresh profile.
+NAMED_PROFILES: dict[str, Any] = {
+    "CLOCK": _clock_profile,
+    "SENSOR_DATA": lambda: QoSProfile(**_fields(qos_profile_sensor_data)),
+    "PARAMETERS": lambda: QoSProfile(**_fields(qos_profile_parameters)),
+    "SERVICES": lambda: QoSProfile(**_fields(qos_profile_services_default)),
+    "PARAMETER_EVENTS": lambda: QoSProfile(**_fields(qos_profile_parameter_events)),
+    "ROSOUT": _rosout_profile,
+    "SYSTEM_DEFAULT": lambda: QoSProfile(**_fields(qos_profile_system_default)),
+    "BEST_AVAILABLE": lambda: QoSProfile(**_fields(qos_profile_best_available)),
+}
+
+#: Policies users may override per publisher (rclcpp Jazzy set) and per subscription.
+PUBLISHER_OVERRIDES = QoSOverridingOptions(
+    policy_kinds=(
+        QoSPolicyKind.DEADLINE,
+        QoSPolicyKind.DEPTH,
+        QoSPolicyKind.DURABILITY,
+        QoSPolicyKind.HISTORY,
+        QoSPolicyKind.LIVELINESS,
+        QoSPolicyKind.RELIABILITY,
+    )
+)
+SUBSCRIPTION_OVERRIDES = QoSOverridingOptions.with_default_policies()
+
+
+def _fields(profile: QoSProfile) -> dict[str, Any]:
+    return {
+        "history": profile.history,
+        "depth": profile.depth,
+        "reliability": profile.reliability,
+        "durability": profile.durability,
+        "lifespan": profile.lifespan,
+        "deadline": profile.deadline,
+        "liveliness": profile.liveliness,
+        "liveliness_lease_duration": profile.liveliness_lease_duration,
+    }
+
+
+def endpoint_qos(profile_name: str | None, depth: int | None) -> QoSProfile:
+    """The QoS for one ROS endpoint of a bridge.
+
+    ``depth`` is the entry's ``publisher_queue``/``subscriber_queue`` (None: unset). Without a
+    profile it is the C++ default (reliable, volatile, keep-last ``depth`` or 10); with one, the
+    profile, its depth replaced by ``depth`` when that is set.
+
+    Raises:
+        ConfigError: ``profile_name`` is not one of :data:`NAMED_PROFILES`.
+    """
+    if profile_name is None:
+        return QoSProfile(
+            history=HistoryPolicy.KEEP_LAST,
+            depth=DEFAULT_DEPTH if depth is None else depth,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.VOLATILE,
+        )
+    make = NAMED_PROFILES.get(profile_name)
+    if make is None:
+        known = ", ".join(sorted(NAMED_PROFILES))
+        msg = f"unknown QoS profile [{profile_name}]; use one of {known}"
+        raise ConfigError(msg)
+    profile: QoSProfile = make()
+    if depth is not None:
+        profile.history = HistoryPolicy.KEEP_LAST
+        profile.depth = depth
+    return profile
+
+
+def gz_to_ros_publisher_qos(
+    resolved_topic: str, profile_name: str | None, depth: int | None
+) -> QoSProfile:
+    """Publisher QoS of a Gazebo->ROS channel, with ``/tf_static`` latched by default."""
+    profile = endpoint_qos(profile_name, depth)
+    if profile_name is None and resolved_topic == TF_STATIC_TOPIC:
+        profile.durability = DurabilityPolicy.TRANSIENT_LOCAL
+    return profile
