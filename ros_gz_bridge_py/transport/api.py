@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import abc
 import enum
+import threading
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any, Self
 
+from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 
 
@@ -201,16 +203,36 @@ class Node(abc.ABC):
     ) -> ServiceOffer:
         """Provide ``service``; ``handler`` runs on the I/O thread, an exception means failure."""
 
-    @abc.abstractmethod
     def request(
         self, service: str, request: bytes, request_type: str, response_type: str, timeout: float
     ) -> tuple[bool, bytes]:
-        """Call a service and wait for the reply.
+        """Call a service and wait for the reply (one-way calls return (True, b"") once sent).
 
         Raises:
             TransportTimeoutError: no reply within ``timeout`` seconds.
-            TransportError: called from the node's own I/O thread.
+            TransportError: called from the node's own thread, which would wait for itself.
         """
+        if self._on_node_thread():
+            msg = "request() would block the node's own thread; use request_async() in callbacks"
+            raise TransportError(msg)
+        done = threading.Event()
+        result: list[tuple[bool | None, bytes]] = []
+
+        def on_reply(ok: bool | None, payload: bytes) -> None:
+            result.append((ok, payload))
+            done.set()
+
+        self.request_async(service, request, request_type, response_type, timeout, on_reply)
+        done.wait()
+        ok, payload = result[0]
+        if ok is None:
+            msg = f"service {service!r} did not answer within {timeout} s"
+            raise TransportTimeoutError(msg)
+        return ok, payload
+
+    @abc.abstractmethod
+    def _on_node_thread(self) -> bool:
+        """True when the caller runs on the node's own thread (where blocking is forbidden)."""
 
     @abc.abstractmethod
     def request_async(  # noqa: PLR0917 - positional order fixed by the API contract

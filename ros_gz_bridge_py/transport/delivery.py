@@ -8,11 +8,60 @@ the oldest message is dropped and counted, the same policy as ROS "keep last N".
 from __future__ import annotations
 
 import collections
+import logging
 import threading
 from collections.abc import Callable
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
+
+from google.protobuf.message import DecodeError
+
+from ros_gz_bridge_py.transport.api import MessageInfo
 
 T = TypeVar("T")
+_LOG = logging.getLogger("ros_gz_bridge_py.transport")
+
+#: Payload bytes as a backend hands them over (bytes, or a zero-copy buffer view).
+Payload = bytes | bytearray | memoryview
+#: A node's counter increment, e.g. ``node.count("callback_errors")``.
+Count = Callable[[str], None]
+Deliver = Callable[[Payload, MessageInfo], None]
+
+
+def raw_deliverer(count: Count, callback: Callable[[bytes, MessageInfo], None]) -> Deliver:
+    """A deliver function that hands ``bytes`` to ``callback``, counting its errors."""
+
+    def deliver(payload: Payload, info: MessageInfo) -> None:
+        try:
+            callback(payload if isinstance(payload, bytes) else bytes(payload), info)
+        except Exception:
+            count("callback_errors")
+            _LOG.exception("subscription callback for %s raised", info.topic)
+
+    return deliver
+
+
+def typed_deliverer(
+    count: Count, msg_class: type[Any], callback: Callable[[Any, MessageInfo], None]
+) -> Deliver:
+    """A deliver function that decodes with ``msg_class`` first (no copy of the payload).
+
+    Garbage payloads are counted as ``payloads_undecodable``, never raised.
+    """
+
+    def deliver(payload: Payload, info: MessageInfo) -> None:
+        try:
+            msg = msg_class.FromString(payload)
+        except (DecodeError, ValueError, TypeError) as error:
+            count("payloads_undecodable")
+            _LOG.debug("undecodable %s payload on %s: %s", info.msg_type, info.topic, error)
+            return
+        try:
+            callback(msg, info)
+        except Exception:
+            count("callback_errors")
+            _LOG.exception("subscription callback for %s raised", info.topic)
+
+    return deliver
 
 
 class DeliveryQueue(Generic[T]):

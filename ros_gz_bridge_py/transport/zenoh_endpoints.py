@@ -12,11 +12,10 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import zenoh
-from google.protobuf.message import DecodeError
 
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
-from ros_gz_bridge_py.transport.delivery import DeliveryQueue
+from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zenoh_node import ZenohNode
@@ -26,7 +25,6 @@ _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 #: One received message: the payload and what the callback learns about it.
 Delivery = tuple[bytes, MessageInfo]
 #: Hands one message to the user, guarding against (and counting) its errors.
-Deliver = Callable[[bytes, MessageInfo], None]
 
 
 def undeclare(*entities: Any) -> None:
@@ -163,37 +161,3 @@ class ZenohServiceOffer(ServiceOffer):
             self._closed = True
             self._node.forget_offer(self)
             undeclare(*reversed(self.entities))
-
-
-def raw_deliverer(node: ZenohNode, callback: Callable[[bytes, MessageInfo], None]) -> Deliver:
-    """A deliver function that hands the payload to ``callback``, counting its errors."""
-
-    def deliver(payload: bytes, info: MessageInfo) -> None:
-        try:
-            callback(payload, info)
-        except Exception:
-            node.count("callback_errors")
-            _LOG.exception("subscription callback for %s raised", info.topic)
-
-    return deliver
-
-
-def typed_deliverer(
-    node: ZenohNode, msg_class: type[Any], callback: Callable[[Any, MessageInfo], None]
-) -> Deliver:
-    """A deliver function that decodes with ``msg_class`` first; garbage is counted, not raised."""
-
-    def deliver(payload: bytes, info: MessageInfo) -> None:
-        try:
-            msg = msg_class.FromString(payload)
-        except (DecodeError, ValueError, TypeError) as error:
-            node.count("payloads_undecodable")
-            _LOG.debug("undecodable %s payload on %s: %s", info.msg_type, info.topic, error)
-            return
-        try:
-            callback(msg, info)
-        except Exception:
-            node.count("callback_errors")
-            _LOG.exception("subscription callback for %s raised", info.topic)
-
-    return deliver

@@ -47,7 +47,7 @@ from typing import Any
 
 import zenoh
 
-from ros_gz_bridge_py.errors import LocalProtocolError, TransportError, TransportTimeoutError
+from ros_gz_bridge_py.errors import LocalProtocolError, TransportError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import (
     MessageInfo,
@@ -59,16 +59,14 @@ from ros_gz_bridge_py.transport.api import (
     TransportStats,
     TypedCallback,
 )
+from ros_gz_bridge_py.transport.delivery import Deliver, raw_deliverer, typed_deliverer
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zenoh_config import Overrides, session_config
 from ros_gz_bridge_py.transport.zenoh_endpoints import (
-    Deliver,
     ZenohPublisher,
     ZenohServiceOffer,
     ZenohSubscription,
-    raw_deliverer,
-    typed_deliverer,
     undeclare,
 )
 from ros_gz_bridge_py.transport.zenoh_keys import (
@@ -281,7 +279,7 @@ class ZenohNode(Node):
         queue_size: int | None = None,
     ) -> ZenohSubscription:
         """Receive raw payloads of ``msg_type`` on ``topic`` (see :class:`Node`)."""
-        deliver = raw_deliverer(self, callback)
+        deliver = raw_deliverer(self.count, callback)
         return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
 
     def subscribe_typed(
@@ -295,7 +293,7 @@ class ZenohNode(Node):
         queue_size: int | None = None,
     ) -> ZenohSubscription:
         """Receive decoded messages; ``msg_type`` defaults to the class's full name."""
-        deliver = typed_deliverer(self, msg_class, callback)
+        deliver = typed_deliverer(self.count, msg_class, callback)
         wanted = msg_type or msg_class.DESCRIPTOR.full_name
         return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size)
 
@@ -422,27 +420,8 @@ class ZenohNode(Node):
             with contextlib.suppress(zenoh.ZError):
                 query.drop()  # type: ignore[no-untyped-call]
 
-    def request(
-        self, service: str, request: bytes, request_type: str, response_type: str, timeout: float
-    ) -> tuple[bool, bytes]:
-        """Call ``service`` and wait; one-way calls return (True, b"") once sent."""
-        if threading.current_thread() is self._thread:
-            msg = "request() would block the node thread; use request_async() in callbacks"
-            raise TransportError(msg)
-        done = threading.Event()
-        result: list[tuple[bool | None, bytes]] = []
-
-        def on_reply(ok: bool | None, payload: bytes) -> None:
-            result.append((ok, payload))
-            done.set()
-
-        self.request_async(service, request, request_type, response_type, timeout, on_reply)
-        done.wait()
-        ok, payload = result[0]
-        if ok is None:
-            msg = f"service {service!r} did not answer within {timeout} s"
-            raise TransportTimeoutError(msg)
-        return ok, payload
+    def _on_node_thread(self) -> bool:
+        return threading.current_thread() is self._thread
 
     def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
         self,

@@ -11,8 +11,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from google.protobuf.message import DecodeError
-
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.delivery import DeliveryQueue
@@ -116,42 +114,6 @@ class ZmqSubscription(Subscription):
         self._node.unsubscribe(self)
         if self._queue is not None:
             self._queue.close()
-
-
-def raw_deliverer(
-    node: ZmqNode, callback: Callable[[bytes, MessageInfo], None]
-) -> Callable[[Frame, MessageInfo], None]:
-    """A deliver function that hands ``bytes`` to ``callback``, guarding against its errors."""
-
-    def deliver(payload: Frame, info: MessageInfo) -> None:
-        try:
-            callback(payload if isinstance(payload, bytes) else bytes(payload), info)
-        except Exception:
-            node.count("callback_errors")
-            _LOG.exception("subscription callback for %s raised", info.topic)
-
-    return deliver
-
-
-def typed_deliverer(
-    node: ZmqNode, msg_class: type[Any], callback: Callable[[Any, MessageInfo], None]
-) -> Callable[[Frame, MessageInfo], None]:
-    """A deliver function that decodes with ``msg_class`` first (no copy of the payload)."""
-
-    def deliver(payload: Frame, info: MessageInfo) -> None:
-        try:
-            msg = msg_class.FromString(payload)
-        except (DecodeError, ValueError, TypeError) as error:
-            node.count("payloads_undecodable")
-            _LOG.debug("undecodable %s payload on %s: %s", info.msg_type, info.topic, error)
-            return
-        try:
-            callback(msg, info)
-        except Exception:
-            node.count("callback_errors")
-            _LOG.exception("subscription callback for %s raised", info.topic)
-
-    return deliver
 
 
 @dataclass(eq=False)

@@ -41,7 +41,7 @@ from typing import Any, TypeVar
 
 import zmq
 
-from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError, TransportTimeoutError
+from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import (
     MessageInfo,
@@ -54,6 +54,7 @@ from ros_gz_bridge_py.transport.api import (
     TransportStats,
     TypedCallback,
 )
+from ros_gz_bridge_py.transport.delivery import raw_deliverer, typed_deliverer
 from ros_gz_bridge_py.transport.discovery import (
     INIT_DELAY,
     DiscoveryEngine,
@@ -80,13 +81,7 @@ from ros_gz_bridge_py.transport.wire import (
     encode_request,
     encode_response,
 )
-from ros_gz_bridge_py.transport.zmq_endpoints import (
-    ZmqPublisher,
-    ZmqServiceOffer,
-    ZmqSubscription,
-    raw_deliverer,
-    typed_deliverer,
-)
+from ros_gz_bridge_py.transport.zmq_endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 T = TypeVar("T")
@@ -380,7 +375,7 @@ class ZmqNode(Node):
         queue_size: int | None = None,
     ) -> ZmqSubscription:
         """Receive raw payloads of ``msg_type`` on ``topic`` (see :class:`Node`)."""
-        deliver = raw_deliverer(self, callback)
+        deliver = raw_deliverer(self.count, callback)
         return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
 
     def subscribe_typed(
@@ -396,7 +391,7 @@ class ZmqNode(Node):
         """Receive decoded messages. To match a Fortress publisher pass
         ``msg_type="ignition.msgs.X"``: the class's own name is ``gz.msgs.X``.
         """
-        deliver = typed_deliverer(self, msg_class, callback)
+        deliver = typed_deliverer(self.count, msg_class, callback)
         wanted = msg_type or msg_class.DESCRIPTOR.full_name
         return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size)
 
@@ -501,27 +496,8 @@ class ZmqNode(Node):
         with contextlib.suppress(TransportError):
             self._call(command)
 
-    def request(
-        self, service: str, request: bytes, request_type: str, response_type: str, timeout: float
-    ) -> tuple[bool, bytes]:
-        """Call ``service`` and wait; one-way calls return (True, b"") once sent."""
-        if threading.current_thread() is self._io_thread:
-            msg = "request() would block the I/O thread; use request_async() in callbacks"
-            raise TransportError(msg)
-        done = threading.Event()
-        result: list[tuple[bool | None, bytes]] = []
-
-        def on_reply(ok: bool | None, payload: bytes) -> None:
-            result.append((ok, payload))
-            done.set()
-
-        self.request_async(service, request, request_type, response_type, timeout, on_reply)
-        done.wait()
-        ok, payload = result[0]
-        if ok is None:
-            msg = f"service {service!r} did not answer within {timeout} s"
-            raise TransportTimeoutError(msg)
-        return ok, payload
+    def _on_node_thread(self) -> bool:
+        return threading.current_thread() is self._io_thread
 
     def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
         self,
