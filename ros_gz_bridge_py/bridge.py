@@ -43,7 +43,8 @@ from ros_gz_bridge_py.config import (
 )
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
-from ros_gz_bridge_py.services import DEFAULT_TIMEOUT, ServiceBridge, ServiceHost
+from ros_gz_bridge_py.services import DEFAULT_TIMEOUT, ServiceBridge
+from ros_gz_bridge_py.side_node import SideNode, side_node_name
 from ros_gz_bridge_py.transport import Node as GzNode
 from ros_gz_bridge_py.transport import NodeOptions, create_node
 
@@ -85,9 +86,17 @@ class Bridge:
         self.registry = registry or default_registry()
         self._owns_gz_node = gz_node is None
         self.gz_node = gz_node if gz_node is not None else create_node(gz_options)
+        self._side: SideNode | None = None
         self._ctx = ChannelContext(
             ros_node=ros_node,
             gz_node=self.gz_node,
+            side_node=lambda: self._side_node().node,
+            own_nodes=frozenset(
+                {
+                    (ros_node.get_name(), ros_node.get_namespace()),
+                    (side_node_name(ros_node), ros_node.get_namespace()),
+                }
+            ),
             wall_time_stamps=self.options.override_timestamps_with_wall_time,
             override_frame_id=self.options.override_frame_id,
         )
@@ -95,7 +104,6 @@ class Bridge:
         self._lock = threading.RLock()
         self._handles: list[BridgeHandle] = []
         self._closed = False
-        self._service_host: ServiceHost | None = None
         self._timer = ros_node.create_timer(
             self.options.heartbeat, self.heartbeat, clock=Clock(clock_type=ClockType.STEADY_TIME)
         )
@@ -170,8 +178,8 @@ class Bridge:
         self.ros_node.destroy_timer(self._timer)
         for handle in reversed(handles):
             _close_handle(handle)
-        if self._service_host is not None:
-            self._service_host.close()
+        if self._side is not None:
+            self._side.close()
         if self._owns_gz_node:
             self.gz_node.close()
 
@@ -200,11 +208,26 @@ class Bridge:
                 channel = kind(self._ctx, spec, pair, lazy)
                 self._logger.info(f"Creating {channel.describe()} (Lazy {int(lazy)})")
                 handle.channels.append(channel)
+                self._guard_loops(channel, handle.channels)
                 channel.start()
         except Exception as err:
             _close_handle(handle)
             raise ConfigError(_failed_text(spec, str(err)), spec.source or None) from err
         return handle
+
+    def _side_node(self) -> SideNode:
+        with self._lock:
+            if self._side is None:
+                self._side = SideNode(self.ros_node)
+            return self._side
+
+    def _guard_loops(self, new: Channel, siblings: list[Channel]) -> None:
+        """Turn the loop guard on wherever this bridge both publishes and reads a ROS topic."""
+        same_topic = [c for c in self.channels + siblings if c.ros_topic == new.ros_topic]
+        if any(isinstance(c, GzToRosChannel) for c in same_topic):
+            for channel in same_topic:
+                if isinstance(channel, RosToGzChannel):
+                    channel.enable_loop_guard()
 
     def _add_service(self, spec: ServiceBridgeSpec) -> BridgeHandle:
         try:
@@ -212,11 +235,9 @@ class Bridge:
         except UnsupportedTypeError as err:
             msg = f"Failed to create a bridge for service [{spec.service}]: {err.message}"
             raise UnsupportedTypeError(msg, spec.source or None) from None
-        if self._service_host is None:
-            self._service_host = ServiceHost(self.ros_node)
         try:
             service = ServiceBridge(
-                self._service_host, self.gz_node, spec, pair, self.options.service_timeout
+                self._side_node(), self.gz_node, spec, pair, self.options.service_timeout
             )
         except ConfigError:
             raise

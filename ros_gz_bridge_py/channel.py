@@ -79,10 +79,14 @@ def _own_publications_table() -> Callable[[str], OwnPublications]:
 
 @dataclass
 class ChannelContext:
-    """What channels share: the two nodes and the node-wide options."""
+    """What channels share: the nodes and the node-wide options."""
 
     ros_node: Any
     gz_node: Node
+    #: The bridge's side node (created on first use), for subscriptions that need message info.
+    side_node: Callable[[], Any]
+    #: (name, namespace) of the bridge's own ROS nodes, left out when counting readers.
+    own_nodes: frozenset[tuple[str, str]] = frozenset()
     wall_time_stamps: bool = False
     override_frame_id: str = ""
     #: OwnPublications per resolved ROS topic, shared by the two halves of a bidirectional bridge.
@@ -256,11 +260,9 @@ class GzToRosChannel(Channel):
             self._subscription = None
 
     def _output_has_subscribers(self) -> bool:
-        node = self.ctx.ros_node
-        own = (node.get_name(), node.get_namespace())
         return any(
-            (info.node_name, info.node_namespace) != own
-            for info in node.get_subscriptions_info_by_topic(self.ros_topic)
+            (info.node_name, info.node_namespace) not in self.ctx.own_nodes
+            for info in self.ctx.ros_node.get_subscriptions_info_by_topic(self.ros_topic)
         )
 
     def _on_gz_message(self, gz_msg: Any, _info: MessageInfo) -> None:
@@ -277,7 +279,12 @@ class GzToRosChannel(Channel):
 
 
 class RosToGzChannel(Channel):
-    """ROS subscription -> converter -> Gazebo publisher."""
+    """ROS subscription -> converter -> Gazebo publisher.
+
+    With the loop guard on (the bridge also publishes this ROS topic from Gazebo), the
+    subscription takes rclpy's message info to skip the bridge's own publications; such
+    callbacks run on the side node, because the EventsExecutor cannot call them.
+    """
 
     direction = Direction.ROS_TO_GZ
 
@@ -287,7 +294,18 @@ class RosToGzChannel(Channel):
         self._own = ctx.own_publications(self.ros_topic)
         self._gz_publisher: Publisher | None = None
         self._subscription: Any = None
+        self._subscription_node: Any = None
         self._announced = False
+        self.loop_guard = False
+
+    def enable_loop_guard(self) -> None:
+        """Start skipping the bridge's own publications (re-subscribing if open)."""
+        if self.loop_guard:
+            return
+        self.loop_guard = True
+        if self.state is ChannelState.ACTIVE:
+            self._close_input()
+            self._open_input()
 
     def describe(self) -> str:
         return (
@@ -304,26 +322,35 @@ class RosToGzChannel(Channel):
             self._gz_publisher = None
 
     def _open_input(self) -> None:
-        self._subscription = self.ctx.ros_node.create_subscription(
+        callback: Callable[..., None]
+        if self.loop_guard:
+            node, callback = self.ctx.side_node(), self._on_ros_message_guarded
+        else:
+            node, callback = self.ctx.ros_node, self._on_ros_message
+        self._subscription = node.create_subscription(
             self.pair.ros_class,
             self.spec.ros_topic,
-            self._on_ros_message,
+            callback,
             self._qos,
             qos_overriding_options=SUBSCRIPTION_OVERRIDES,
         )
+        self._subscription_node = node
 
     def _close_input(self) -> None:
         if self._subscription is not None:
-            self.ctx.ros_node.destroy_subscription(self._subscription)
+            self._subscription_node.destroy_subscription(self._subscription)
             self._subscription = None
 
     def _output_has_subscribers(self) -> bool:
         return self._gz_publisher is not None and self._gz_publisher.has_connections()
 
-    def _on_ros_message(self, ros_msg: Any, info: Any) -> None:
+    def _on_ros_message_guarded(self, ros_msg: Any, info: Any) -> None:
         if self._own.is_own(info):
             self.stats.own_skipped += 1
             return
+        self._on_ros_message(ros_msg)
+
+    def _on_ros_message(self, ros_msg: Any) -> None:
         self.stats.received += 1
         publisher = self._gz_publisher
         if publisher is None:

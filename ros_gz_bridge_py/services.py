@@ -1,8 +1,8 @@
 """Service bridges: a ROS service whose requests are forwarded to a Gazebo service.
 
-Service bridges live on a small node of their own (:class:`ServiceHost`) spun by a
-multi-threaded executor in its own thread: each call converts the request, waits (blocking that
-executor thread only) for the Gazebo reply or the timeout, and returns exactly one response —
+Service bridges live on the bridge's side node (``side_node.py``), spun by a multi-threaded
+executor in its own thread: each call converts the request, waits (blocking that executor thread
+only) for the Gazebo reply or the timeout, and returns exactly one response —
 the converted reply, or ``success=False`` when Gazebo reports failure, does not answer in time,
 or the request cannot be converted. The C++ bridge can answer twice, and never answers when
 Gazebo is absent. Keeping calls off the main executor means a slow or absent Gazebo service never
@@ -11,18 +11,13 @@ delays topic traffic (the EventsExecutor also cannot run coroutine service callb
 
 from __future__ import annotations
 
-import contextlib
-import threading
 from typing import Any
-
-from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
-from rclpy.node import Node as RosNode
 
 from ros_gz_bridge_py.config import ServiceBridgeSpec
 from ros_gz_bridge_py.converters.registry import ServicePair, canonical_gz_type
 from ros_gz_bridge_py.errors import ConfigError, ConversionError, TransportError
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.side_node import SideNode
 from ros_gz_bridge_py.transport import Node
 
 DEFAULT_TIMEOUT = 5.0
@@ -56,40 +51,12 @@ def resolve_gz_types(spec: ServiceBridgeSpec, pair: ServicePair) -> tuple[str, s
     return chosen[0], chosen[1]
 
 
-class ServiceHost:
-    """The node and executor thread that serve a bridge's ROS services."""
-
-    THREADS = 4
-
-    def __init__(self, owner: Any) -> None:
-        self.node = RosNode(
-            f"{owner.get_name()}_services",
-            namespace=owner.get_namespace(),
-            context=owner.context,
-            start_parameter_services=False,
-        )
-        self.group = ReentrantCallbackGroup()
-        self._executor = MultiThreadedExecutor(num_threads=self.THREADS, context=owner.context)
-        self._executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, name="ros-gz-services", daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        with contextlib.suppress(ExternalShutdownException):
-            self._executor.spin()
-
-    def close(self) -> None:
-        self._executor.shutdown(timeout_sec=1.0)
-        self._thread.join(timeout=2.0)
-        self.node.destroy_node()
-
-
 class ServiceBridge:
     """One ROS service forwarded to one Gazebo service."""
 
     def __init__(
         self,
-        host: ServiceHost,
+        host: SideNode,
         gz_node: Node,
         spec: ServiceBridgeSpec,
         pair: ServicePair,
@@ -106,7 +73,7 @@ class ServiceBridge:
         self.calls = 0
         self.failures = 0
         self._service = host.node.create_service(
-            pair.ros_class, spec.service, self._on_request, callback_group=host.group
+            pair.ros_class, spec.service, self._on_request, callback_group=host.reentrant
         )
         self.service_name: str = self._service.srv_name
 

@@ -1,0 +1,57 @@
+"""A second rclpy node for the callbacks the main executor must not (or cannot) run.
+
+The bridge's main node is spun by the EventsExecutor, which is fast but runs neither coroutine
+callbacks nor subscription callbacks that take rclpy's message info. The side node lives in the
+same context and namespace, is spun by a small multi-threaded executor on its own thread, and
+hosts:
+
+* service bridges, whose calls block on a Gazebo reply (up to the service timeout) without
+  delaying any topic, in a reentrant group so calls run concurrently;
+* ROS -> Gazebo subscriptions that need message info to recognise the bridge's own publications
+  (bidirectional topics, see ``loop_guard.py``), in the node's default mutually exclusive group
+  so each topic keeps its order.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+from typing import Any
+
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node as RosNode
+
+SUFFIX = "_side"
+
+
+def side_node_name(owner: Any) -> str:
+    return f"{owner.get_name()}{SUFFIX}"
+
+
+class SideNode:
+    """The side node of one bridge and the thread that spins it."""
+
+    THREADS = 4
+
+    def __init__(self, owner: Any) -> None:
+        self.node = RosNode(
+            side_node_name(owner),
+            namespace=owner.get_namespace(),
+            context=owner.context,
+            start_parameter_services=False,
+        )
+        self.reentrant = ReentrantCallbackGroup()
+        self._executor = MultiThreadedExecutor(num_threads=self.THREADS, context=owner.context)
+        self._executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, name="ros-gz-side", daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        with contextlib.suppress(ExternalShutdownException):
+            self._executor.spin()
+
+    def close(self) -> None:
+        self._executor.shutdown(timeout_sec=1.0)
+        self._thread.join(timeout=2.0)
+        self.node.destroy_node()
