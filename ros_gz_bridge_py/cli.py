@@ -1,4 +1,4 @@
-"""Console entry points: ``parameter_bridge``, ``bridge_types`` (and ``image_bridge``)."""
+"""Console entry points: ``parameter_bridge``, ``image_bridge`` and ``bridge_types``."""
 
 from __future__ import annotations
 
@@ -15,3 +15,9 @@ def bridge_types_main() -> None:
     from ros_gz_bridge_py import bridge_types  # noqa: PLC0415
 
     sys.exit(bridge_types.main())
+
+
+def image_bridge_main() -> None:
+    from ros_gz_bridge_py import image_bridge  # noqa: PLC0415 - only this command needs rclpy
+
+    sys.exit(image_bridge.main())

@@ -35,6 +35,7 @@ from ros_gz_bridge_py.config import (
 )
 from ros_gz_bridge_py.runtime import make_executor, spin_until_stopped, tune_allocator
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.status import DiagnosticsPublisher, start_diagnostics, table_on_signal
 from ros_gz_bridge_py.transport import NodeOptions
 
 NODE_NAME = "ros_gz_bridge"
@@ -74,6 +75,9 @@ def declare_parameters(node: Node) -> dict[str, Any]:
     values = {name: node.declare_parameter(name, value).value for name, value in defaults.items()}
     names = node.declare_parameter("bridge_names", Parameter.Type.STRING_ARRAY).value
     values["bridge_names"] = list(names or [])
+    # Ours: seconds between two /diagnostics status messages (0 = none); int or float.
+    any_number = ParameterDescriptor(dynamic_typing=True)
+    values["status_period"] = node.declare_parameter("status_period", 0.0, any_number).value
     return values
 
 
@@ -134,6 +138,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = Node(NODE_NAME)
     bridge: Bridge | None = None
+    diagnostics: DiagnosticsPublisher | None = None
     try:
         params = declare_parameters(node)
         sources = [cli]
@@ -163,10 +168,14 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "No bridges are running: give topic arguments, or -p config_file:=<yaml>, "
                 "or bridge_names parameters (parameter_bridge -h shows the syntax)"
             )
+        diagnostics = start_diagnostics(node, bridge, params["status_period"])
         executor = make_executor()
         executor.add_node(node)
-        spin_until_stopped(executor)
+        with table_on_signal(bridge):
+            spin_until_stopped(executor)
     finally:
+        if diagnostics is not None:
+            diagnostics.close()
         if bridge is not None:
             bridge.close()
         node.destroy_node()
@@ -176,3 +185,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def expand_if(result: ParseResult, node: Node, params: dict[str, Any]) -> ParseResult:
     return expand_gz_names(result, node) if params["expand_gz_topic_names"] else result
+
+
+if __name__ == "__main__":
+    sys.exit(main())
