@@ -93,10 +93,7 @@ def bridge_commands() -> list[BridgeCommand]:
     parameter_bridge = [str(executable), "--ros-args", "-p", f"config_file:={topics.CONFIG_FILE}"]
     image_bridge = [sys.executable, "-m", "ros_gz_bridge_py.image_bridge", topics.CAMERA_IMAGE]
     return [
-        # The Jazzy EventsExecutor fails ("SystemError: null argument to internal routine")
-        # on subscription callbacks that take message info, as the ROS -> Gazebo channel's
-        # does; cmd_vel goes that way, so this bridge spins the single-threaded executor.
-        BridgeCommand("bridge", parameter_bridge, {"ROS_GZ_BRIDGE_EXECUTOR": "single"}),
+        BridgeCommand("bridge", parameter_bridge, {}),
         BridgeCommand("image bridge", image_bridge, {}),
     ]
 
