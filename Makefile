@@ -28,7 +28,7 @@ lint: setup
 	$(VENV)/bin/ruff format --check .
 
 typecheck: setup
-	$(VENV)/bin/mypy ros_gz_bridge_py tests benchmarks tools
+	$(VENV)/bin/mypy ros_gz_bridge_py tests benchmarks tools examples
 
 unit: setup
 	$(WITH_LOOPBACK) $(PY) -m pytest -q tests

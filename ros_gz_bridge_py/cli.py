@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import sys
 
+from ros_gz_bridge_py.stop_signal import StopSignal
+
 
 def parameter_bridge_main() -> None:
-    from ros_gz_bridge_py import parameter_bridge  # noqa: PLC0415 - only this command needs rclpy
+    with StopSignal() as stop:
+        from ros_gz_bridge_py import parameter_bridge  # noqa: PLC0415 - imports rclpy
 
-    sys.exit(parameter_bridge.main())
+        sys.exit(parameter_bridge.main(stop=stop))
 
 
 def bridge_types_main() -> None:

@@ -9,6 +9,7 @@ with command-line bridges.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import sys
 from collections.abc import Sequence
@@ -36,6 +37,7 @@ from ros_gz_bridge_py.config import (
 from ros_gz_bridge_py.runtime import make_executor, spin_until_stopped, tune_allocator
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.status import DiagnosticsPublisher, start_diagnostics, table_on_signal
+from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import NodeOptions
 
 NODE_NAME = "ros_gz_bridge"
@@ -117,7 +119,7 @@ def report(node: Node, result: ParseResult) -> None:
         logger.error(str(error))
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> int:
     argv = list(sys.argv if argv is None else argv)
     args = argv[1:]
     positional = remove_ros_args(argv)[1:]
@@ -134,53 +136,65 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"parameter_bridge: {err}", file=sys.stderr)
         return USAGE_EXIT
 
+    if stop is not None and stop.requested:
+        return 0
     tune_allocator()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    node = Node(NODE_NAME)
-    bridge: Bridge | None = None
-    diagnostics: DiagnosticsPublisher | None = None
-    try:
-        params = declare_parameters(node)
-        sources = [cli]
-        if params["config_file"]:
-            sources.append(expand_if(read_yaml_file(params["config_file"]), node, params))
-        if params["bridge_names"]:
-            sources.append(
-                expand_if(parameter_bridge_specs(node, params["bridge_names"]), node, params)
-            )
-        for source in sources:
-            report(node, source)
-        bridge = Bridge(
-            node,
-            options=BridgeOptions(
-                lazy=params["lazy"],
-                heartbeat=max(params["subscription_heartbeat"], 1) / 1000.0,
-                override_timestamps_with_wall_time=params["override_timestamps_with_wall_time"],
-                override_frame_id=params["override_frame_id"],
-                service_timeout=params["service_timeout"],
-            ),
-            gz_options=NodeOptions(implementation=params["gz_transport_implementation"] or None),
-        )
-        specs = [spec for source in sources for spec in source.specs]
-        bridge.add_all(specs)
-        if not bridge.handles:
-            node.get_logger().warning(
-                "No bridges are running: give topic arguments, or -p config_file:=<yaml>, "
-                "or bridge_names parameters (parameter_bridge -h shows the syntax)"
-            )
-        diagnostics = start_diagnostics(node, bridge, params["status_period"])
-        executor = make_executor()
-        executor.add_node(node)
-        with table_on_signal(bridge):
-            spin_until_stopped(executor)
-    finally:
-        if diagnostics is not None:
-            diagnostics.close()
-        if bridge is not None:
-            bridge.close()
-        node.destroy_node()
-        rclpy.try_shutdown()
+    with contextlib.ExitStack() as scope:
+        if stop is None:
+            stop = scope.enter_context(StopSignal())
+        node = Node(NODE_NAME)
+        bridge: Bridge | None = None
+        diagnostics: DiagnosticsPublisher | None = None
+        try:
+            params = declare_parameters(node)
+            if stop.requested:
+                return 0
+            bridge = build_bridge(node, cli, params)
+            diagnostics = start_diagnostics(node, bridge, params["status_period"])
+            executor = make_executor()
+            executor.add_node(node)
+            with table_on_signal(bridge):
+                spin_until_stopped(executor, stop)
+        finally:
+            if diagnostics is not None:
+                diagnostics.close()
+            if bridge is not None:
+                bridge.close()
+            node.destroy_node()
+            rclpy.try_shutdown()
     return 0
+
+
+def build_bridge(node: Node, cli: ParseResult, params: dict[str, Any]) -> Bridge:
+    """Collect every configuration source, report its problems, and create the bridges."""
+    sources = [cli]
+    if params["config_file"]:
+        sources.append(expand_if(read_yaml_file(params["config_file"]), node, params))
+    if params["bridge_names"]:
+        sources.append(
+            expand_if(parameter_bridge_specs(node, params["bridge_names"]), node, params)
+        )
+    for source in sources:
+        report(node, source)
+    bridge = Bridge(
+        node,
+        options=BridgeOptions(
+            lazy=params["lazy"],
+            heartbeat=max(params["subscription_heartbeat"], 1) / 1000.0,
+            override_timestamps_with_wall_time=params["override_timestamps_with_wall_time"],
+            override_frame_id=params["override_frame_id"],
+            service_timeout=params["service_timeout"],
+        ),
+        gz_options=NodeOptions(implementation=params["gz_transport_implementation"] or None),
+    )
+    bridge.add_all(spec for source in sources for spec in source.specs)
+    if not bridge.handles:
+        node.get_logger().warning(
+            "No bridges are running: give topic arguments, or -p config_file:=<yaml>, "
+            "or bridge_names parameters (parameter_bridge -h shows the syntax)"
+        )
+    return bridge
 
 
 def expand_if(result: ParseResult, node: Node, params: dict[str, Any]) -> ParseResult:

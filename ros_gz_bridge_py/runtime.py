@@ -8,9 +8,12 @@ Speed settings (``../shared/spec/environment.md`` §5, measured on the project m
   unless the user set either variable.
 * The executor: rclpy's ``SingleThreadedExecutor`` costs ~250 µs per callback;
   ``rclpy.experimental.EventsExecutor`` is about four times faster and is the default
-  (``ROS_GZ_BRIDGE_EXECUTOR=single`` switches back). Its plain ``spin()`` busy-waits while
-  holding the GIL in the Jazzy wheels, so we always drive it with
-  ``spin_until_future_complete``.
+  (``ROS_GZ_BRIDGE_EXECUTOR=single`` switches back). In the Jazzy wheels its plain ``spin()``
+  busy-waits holding the GIL, ``spin_until_future_complete`` ignores its timeout, and
+  subscription callbacks that take message info fail (``spin_once`` with a timeout works
+  and idles at ~0% CPU, ``spin_until_future_complete`` busy-waits at 60% of a core); so we
+  spin it step by step with ``spin_once`` and keep message-info callbacks on the side node
+  (``side_node.py``).
 """
 
 from __future__ import annotations
@@ -18,14 +21,12 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import os
-import signal
-from collections.abc import Callable
-from types import FrameType
 from typing import Any
 
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from rclpy.task import Future
+
+from ros_gz_bridge_py.stop_signal import StopSignal
 
 M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3
@@ -59,27 +60,23 @@ def make_executor() -> Any:
     return EventsExecutor()
 
 
-def spin_until_stopped(executor: Any, on_stop: Callable[[], None] | None = None) -> None:
-    """Spin ``executor`` until SIGINT/SIGTERM or rclpy shutdown; return without a traceback.
+#: Longest time one spin step blocks; bounds how long a stop request waits.
+SPIN_STEP = 0.1
 
-    The signal handlers only complete a future; the executor wakes up for it and returns, and
-    the caller cleans up on the main thread.
+
+def spin_until_stopped(executor: Any, stop: StopSignal | None = None) -> None:
+    """Spin ``executor`` until a stop signal or rclpy shutdown; return without a traceback.
+
+    Spinning is a loop of ``spin_once`` steps on the calling (main) thread, so the Python
+    signal handlers run between steps, at most :data:`SPIN_STEP` after the signal. With
+    ``stop`` None, handlers are installed for the duration of the call.
     """
-    stop: Future = Future(executor=executor)
-    stop.add_done_callback(lambda _f: None)
-
-    def request_stop(_signum: int, _frame: FrameType | None) -> None:
-        if not stop.done():
-            stop.set_result(True)
-
-    previous = {sig: signal.signal(sig, request_stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    if stop is None:
+        with StopSignal() as own:
+            spin_until_stopped(executor, own)
+        return
     try:
-        while rclpy.ok() and not stop.done():
-            executor.spin_until_future_complete(stop, timeout_sec=0.5)
+        while rclpy.ok() and not stop.requested:
+            executor.spin_once(timeout_sec=SPIN_STEP)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-        if on_stop is not None:
-            on_stop()
