@@ -11,9 +11,9 @@ Args::Args(int argc, char **argv, const std::set<std::string> &switches) {
     }
     const std::string name = arg.substr(2);
     if (switches.count(name)) {
-      options_[name] = "";
+      options_[name].push_back("");
     } else if (i + 1 < argc) {
-      options_[name] = argv[++i];
+      options_[name].push_back(argv[++i]);
     } else {
       throw UsageError("option --" + name + " needs a value");
     }
@@ -27,12 +27,17 @@ const std::string &Args::Word(std::size_t index, const char *what) const {
 
 std::string Args::Text(const std::string &name, const std::string &fallback) const {
   const auto it = options_.find(name);
-  return it == options_.end() ? fallback : it->second;
+  return it == options_.end() ? fallback : it->second.back();
+}
+
+std::vector<std::string> Args::All(const std::string &name) const {
+  const auto it = options_.find(name);
+  return it == options_.end() ? std::vector<std::string>{} : it->second;
 }
 
 double Args::Number(const std::string &name, double fallback) const {
   const auto it = options_.find(name);
-  return it == options_.end() ? fallback : ToNumber(it->second, name.c_str());
+  return it == options_.end() ? fallback : ToNumber(it->second.back(), name.c_str());
 }
 
 double ToNumber(const std::string &text, const char *what) {

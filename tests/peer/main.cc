@@ -16,7 +16,8 @@ namespace {
 constexpr char kUsage[] =
     "usage: ign_peer MODE ...\n"
     "  pub TOPIC TYPE HZ COUNT [TEXTPROTO] [--bytes N] [--wait S] [--settle S] [--linger S]\n"
-    "  echo TOPIC TYPE SECONDS [--count N] [--sha | --hex]\n"
+    "      [--wire-type WIRETYPE] [--field 'NUMBER TYPE TEXTPROTO']...\n"
+    "  echo TOPIC TYPE SECONDS [--count N] [--sha | --hex] [--wire-type WIRETYPE]\n"
     "  relay IN OUT TYPE SECONDS\n"
     "  reply SERVICE REQTYPE REPTYPE SECONDS [--fail] [--response TEXTPROTO] [--sha]\n"
     "  call SERVICE REQTYPE REPTYPE TIMEOUT_MS [TEXTPROTO]\n"

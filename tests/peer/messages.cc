@@ -26,6 +26,33 @@ std::unique_ptr<google::protobuf::Message> MakeMessage(const std::string &type,
   return msg;
 }
 
+namespace {
+void AppendVarint(std::string &out, std::uint64_t value) {
+  while (value >= 0x80) {
+    out.push_back(static_cast<char>((value & 0x7f) | 0x80));
+    value >>= 7;
+  }
+  out.push_back(static_cast<char>(value));
+}
+}  // namespace
+
+void AppendField(std::string &payload, const std::string &spec) {
+  const auto typeStart = spec.find(' ');
+  const auto textStart = typeStart == std::string::npos ? typeStart : spec.find(' ', typeStart + 1);
+  if (textStart == std::string::npos) throw UsageError("--field needs NUMBER TYPE TEXT: " + spec);
+  const double number = ToNumber(spec.substr(0, typeStart), "--field NUMBER");
+  if (number < 1 || number != static_cast<std::uint32_t>(number)) {
+    throw UsageError("--field NUMBER must be a positive integer: " + spec);
+  }
+  auto msg = MakeMessage(spec.substr(typeStart + 1, textStart - typeStart - 1), spec.substr(textStart + 1));
+  std::string body;
+  msg->SerializeToString(&body);
+  constexpr std::uint64_t kLengthDelimited = 2;
+  AppendVarint(payload, (static_cast<std::uint64_t>(number) << 3) | kLengthDelimited);
+  AppendVarint(payload, body.size());
+  payload += body;
+}
+
 std::string PatternBytes(std::size_t size) {
   std::string out(size, '\0');
   std::uint32_t state = 0x9e3779b9u ^ static_cast<std::uint32_t>(size);

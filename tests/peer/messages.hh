@@ -14,6 +14,12 @@ namespace peer {
 std::unique_ptr<google::protobuf::Message> MakeMessage(const std::string &type,
                                                        const std::string &text);
 
+// Appends a length-delimited field to a serialized message: `spec` is `NUMBER TYPE TEXTPROTO`,
+// the field number and a message of an ignition-msgs8 type built from text. This is how the peer
+// writes fields its own (Fortress) definitions lack, e.g. the covariances of a Harmonic
+// `gz.msgs.IMU`, whose numbers differ from `ignition.msgs.IMU`.
+void AppendField(std::string &payload, const std::string &spec);
+
 // `size` pseudo-random bytes (xorshift), so a corrupted or truncated copy cannot pass a digest
 // check by accident the way a constant fill could.
 std::string PatternBytes(std::size_t size);

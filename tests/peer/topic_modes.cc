@@ -26,7 +26,10 @@ bool WaitForConnections(const ignition::transport::Node::Publisher &pub, double 
 }  // namespace
 
 // pub TOPIC TYPE HZ COUNT [TEXTPROTO] [--bytes N] [--wait S] [--settle S] [--linger S]
-// COUNT <= 0 publishes until stopped; HZ <= 0 publishes back to back.
+//     [--wire-type WIRETYPE] [--field "NUMBER TYPE TEXTPROTO"]...
+// COUNT <= 0 publishes until stopped; HZ <= 0 publishes back to back. The message is built as
+// TYPE (plus each --field, see AppendField) and advertised and sent as WIRETYPE (default TYPE):
+// `--wire-type gz.msgs.Clock` puts on the wire what a Harmonic publisher of that type sends.
 int RunPub(const Args &args) {
   const std::string topic = args.Word(1, "TOPIC");
   const std::string type = args.Word(2, "TYPE");
@@ -43,9 +46,11 @@ int RunPub(const Args &args) {
   }
   std::string payload;
   msg->SerializeToString(&payload);
+  for (const auto &spec : args.All("field")) AppendField(payload, spec);
+  const std::string wireType = args.Text("wire-type", type);
 
   ignition::transport::Node node;
-  auto pub = node.Advertise(topic, type);
+  auto pub = node.Advertise(topic, wireType);
   if (!pub) {
     Line("ERROR advertise failed for " + topic);
     return 1;
@@ -57,7 +62,7 @@ int RunPub(const Args &args) {
 
   long sent = 0;
   for (; (count <= 0 || sent < count) && !StopRequested(); ++sent) {
-    pub.PublishRaw(payload, type);
+    pub.PublishRaw(payload, wireType);
     if (hz > 0) SleepFor(1.0 / hz);
   }
   Line("SENT " + std::to_string(sent));
@@ -65,8 +70,9 @@ int RunPub(const Args &args) {
   return 0;
 }
 
-// echo TOPIC TYPE SECONDS [--count N] [--sha | --hex]
-// Prints `MSG <type> <text|hex|sha256=.. len=..>` per message, then `COUNT n BYTES b`.
+// echo TOPIC TYPE SECONDS [--count N] [--sha | --hex] [--wire-type WIRETYPE]
+// Prints `MSG <type> <text|hex|sha256=.. len=..>` per message, then `COUNT n BYTES b`. With
+// --wire-type it subscribes to WIRETYPE (e.g. gz.msgs.Twist) and decodes the payload as TYPE.
 int RunEcho(const Args &args) {
   const std::string topic = args.Word(1, "TOPIC");
   const std::string type = args.Word(2, "TYPE");
@@ -74,6 +80,8 @@ int RunEcho(const Args &args) {
   const long wanted = static_cast<long>(args.Number("count", 0));
   const bool sha = args.Has("sha");
   const bool hex = args.Has("hex");
+  const std::string wireType = args.Text("wire-type", type);
+  const bool decodeAsType = args.Has("wire-type");
   std::atomic<long> received{0};
   std::atomic<long> bytes{0};
   std::mutex printing;
@@ -89,7 +97,7 @@ int RunEcho(const Args &args) {
     } else if (hex) {
       body = Hex(data, size);
     } else {
-      auto msg = ignition::msgs::Factory::New(info.Type());
+      auto msg = ignition::msgs::Factory::New(decodeAsType ? type : info.Type());
       body = msg && msg->ParseFromArray(data, static_cast<int>(size)) ? OneLine(*msg)
                                                                       : "UNDECODABLE " + Hex(data, size);
     }
@@ -97,7 +105,7 @@ int RunEcho(const Args &args) {
     bytes += static_cast<long>(size);
     ++received;
   };
-  if (!node.SubscribeRaw(topic, callback, type)) {
+  if (!node.SubscribeRaw(topic, callback, wireType)) {
     Line("ERROR subscribe failed for " + topic);
     return 1;
   }

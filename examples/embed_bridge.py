@@ -1,0 +1,105 @@
+"""Embed the bridge in your own rclpy program and change its bridges at run time.
+
+The program owns the rclpy node and the executor; ``Bridge`` only adds channels to that node
+(and opens one Gazebo Transport node of its own). It:
+
+1. bridges ``--first`` (Gazebo -> ROS, ``std_msgs/msg/String``) and prints the first message,
+2. removes that bridge (the Gazebo subscription and the ROS publisher go away),
+3. bridges ``--second`` the same way and prints its first message,
+4. closes the bridge and shuts rclpy down.
+
+Run it next to any Gazebo publisher, for example::
+
+    gz topic -t /first -m gz.msgs.StringMsg -p 'data: "hello"'   # in another shell
+    python examples/embed_bridge.py --first /first --second /second
+
+It prints one line per step (``RECEIVED <topic> <data>``, ``REMOVED <topic>``, ``DONE``) and
+exits with status 1 if a message does not arrive within ``--timeout`` seconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+from typing import Any
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from std_msgs.msg import String
+
+from ros_gz_bridge_py import Bridge
+from ros_gz_bridge_py.bridge import BridgeOptions
+from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+
+
+def first_message(node: Any, topic: str, timeout: float) -> str | None:
+    """Subscribe to ``topic`` on our own node and wait for one message's text."""
+    arrived = threading.Event()
+    texts: list[str] = []
+
+    def on_message(msg: Any) -> None:
+        texts.append(msg.data)
+        arrived.set()
+
+    subscription = node.create_subscription(String, topic, on_message, 10)
+    try:
+        arrived.wait(timeout)
+        return texts[0] if texts else None
+    finally:
+        node.destroy_subscription(subscription)
+
+
+def gz_to_ros(topic: str, gz_type: str) -> TopicBridgeSpec:
+    return TopicBridgeSpec(
+        ros_topic=topic,
+        gz_topic=topic,
+        ros_type="std_msgs/msg/String",
+        gz_type=gz_type,
+        direction=Direction.GZ_TO_ROS,
+    )
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--first", default="/first", help="Gazebo topic bridged first")
+    parser.add_argument("--second", default="/second", help="Gazebo topic bridged after it")
+    parser.add_argument("--gz-type", default="gz.msgs.StringMsg",
+                        help="Gazebo type name (ignition.msgs.StringMsg for Fortress)")  # fmt: skip
+    parser.add_argument("--timeout", type=float, default=20.0, help="seconds per message")
+    args = parser.parse_args()
+
+    rclpy.init()
+    node = rclpy.create_node("embed_bridge_example")
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    status = 0
+    # The bridge adds its channels and its lazy-check timer to *our* node.
+    bridge = Bridge(node, options=BridgeOptions(heartbeat=0.5))
+    try:
+        for step, topic in enumerate((args.first, args.second)):
+            handle = bridge.add(gz_to_ros(topic, args.gz_type))
+            print(f"ADDED {topic}", flush=True)
+            text = first_message(node, topic, args.timeout)
+            if text is None:
+                print(f"TIMEOUT {topic}", flush=True)
+                status = 1
+                break
+            print(f"RECEIVED {topic} {text}", flush=True)
+            if step == 0:
+                bridge.remove(handle)  # the other bridges (none here) keep running
+                print(f"REMOVED {topic}", flush=True)
+    finally:
+        bridge.close()
+        executor.shutdown(timeout_sec=1.0)
+        node.destroy_node()
+        rclpy.try_shutdown()
+        spinner.join(timeout=2.0)
+    print("DONE", flush=True)
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())

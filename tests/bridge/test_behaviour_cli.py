@@ -1,0 +1,107 @@
+"""``parameter_bridge`` on the command line: help, usage errors, and entries it cannot bridge.
+
+Usage errors end the process before ROS starts, like the C++ bridge (usage on stdout, status
+255), and add one line on stderr naming the argument and what is wrong with it.
+"""
+
+from __future__ import annotations
+
+import subprocess
+
+import pytest
+
+from ros_gz_bridge_py.config import USAGE
+from ros_gz_bridge_py.transport import Node as GzNode
+from tests.bridge.behaviour_harness import (
+    STRING,
+    WAIT,
+    bridge_command,
+    gz_node,
+    start_bridge,
+    started,
+)
+from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
+
+__all__ = ["gz_node", "started"]
+
+USAGE_EXIT = 255
+
+
+def run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        bridge_command(*args), capture_output=True, text=True, timeout=30, check=False
+    )
+
+
+@pytest.mark.parametrize("flag", ["-h", "--help"])
+def test_help_prints_usage_and_succeeds(flag: str) -> None:
+    done = run(flag)
+    assert done.returncode == 0
+    assert done.stdout.strip() == USAGE.strip()
+    assert "topic@ROS2_type@Gz_type" in done.stdout
+
+
+def test_no_arguments_prints_usage_and_fails() -> None:
+    done = run()
+    assert done.returncode == USAGE_EXIT
+    assert done.stdout.strip() == USAGE.strip()
+
+
+@pytest.mark.parametrize(
+    ("args", "position", "problem"),
+    [
+        (["chatter"], 1, "no '@'"),
+        (["@a@b"], 1, "no topic or service name"),
+        (
+            ["/w/control@ros_gz_interfaces/srv/ControlWorld@gz.msgs.WorldControl"],
+            1,
+            "both Gazebo types or neither",
+        ),
+        (
+            ["/w/control@ros_gz_interfaces/srv/ControlWorld[gz.msgs.WorldControl"],
+            1,
+            "no direction symbol",
+        ),
+        (["t@A@B@C"], 1, "more than one '@'"),
+        (["t@A@"], 1, "no Gazebo type after the direction symbol"),
+        (["t@A["], 1, "no Gazebo type after the direction symbol"),
+        # C++ bridges nothing here, silently.
+        (["/t@std_msgs/msg/String"], 1, "no Gazebo type"),
+        (["/ok@std_msgs/msg/String@gz.msgs.StringMsg", "/t@std_msgs/msg/String["], 2, "no "),
+    ],
+)
+def test_bad_argument_prints_usage_and_names_it(
+    args: list[str], position: int, problem: str
+) -> None:
+    done = run(*args)
+    assert done.returncode == USAGE_EXIT
+    assert done.stdout.strip() == USAGE.strip()
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert f"argument {position} '{args[position - 1]}'" in lines[0]
+    assert problem in lines[0]
+
+
+@pytest.mark.ros
+@pytest.mark.peer
+def test_unsupported_pair_is_reported_and_the_other_bridges_run(
+    gz_node: GzNode, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    wrong = unique_name("cli_wrong")
+    good = unique_name("cli_good")
+    bridge = start_bridge(
+        f"{wrong}@std_msgs/String@gz.msgs.StringMsg", f"{good}@std_msgs/msg/String[{STRING}"
+    )
+    started.append(bridge)
+    error = wait_for_line(bridge, r"\[ERROR\].*Failed to create a bridge", timeout=30).string
+    assert "argument 1" in error
+    assert f"topic [{wrong}] with ROS2 type [std_msgs/String]" in error
+    assert "did you mean [std_msgs/msg/String]" in error
+
+    publisher = gz_node.advertise(good, STRING)
+    try:
+        wait_until(publisher.has_connections, WAIT, "the valid bridge's Gazebo subscription")
+    finally:
+        publisher.close()
+    assert bridge.poll() is None

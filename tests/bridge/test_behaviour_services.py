@@ -1,0 +1,230 @@
+"""Service bridges: ROS clients calling real ign-transport 11 services through the bridge.
+
+One bridge process serves every case: ControlWorld in the explicit CLI form (Fortress type
+names, as a Fortress Gazebo needs), DeleteEntity/SetEntityPose/SpawnEntity, and one entry
+from a YAML file. The peer's ``reply`` mode prints each request it gets, so the converted
+request values are checked where Gazebo sees them.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import rclpy
+from ros_gz_interfaces.msg import Entity
+from ros_gz_interfaces.srv import ControlWorld, DeleteEntity, SetEntityPose, SpawnEntity
+
+from tests.bridge.behaviour_harness import (
+    WAIT,
+    RosSide,
+    ros_side,
+    start_bridge,
+    started,
+)
+from tests.gzpeer import PeerProcess, require_peer, start_peer, unique_name, wait_for_line
+
+__all__ = ["ros_side", "started"]
+
+pytestmark = [pytest.mark.ros, pytest.mark.peer]
+
+WORLD_CONTROL = "ignition.msgs.WorldControl"
+BOOLEAN = "ignition.msgs.Boolean"
+SERVICE_TIMEOUT = 1.0
+#: (ROS service type, Gazebo request type) of the CLI service bridges, by key.
+CLI_SERVICES = {
+    "control": ("ControlWorld", WORLD_CONTROL),
+    "control_fail": ("ControlWorld", WORLD_CONTROL),
+    "control_absent": ("ControlWorld", WORLD_CONTROL),
+    "delete": ("DeleteEntity", "ignition.msgs.Entity"),
+    "set_pose": ("SetEntityPose", "ignition.msgs.Pose"),
+    "spawn": ("SpawnEntity", "ignition.msgs.EntityFactory"),
+}
+
+
+@pytest.fixture(scope="module")
+def services(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]]:
+    """Service names by key ("control", ..., "yaml") of one running bridge."""
+    require_peer()
+    names = {key: unique_name(f"svc_{key}") for key in (*CLI_SERVICES, "yaml")}
+    config = Path(tmp_path_factory.mktemp("services") / "services.yaml")
+    config.write_text(
+        f"- service_name: {names['yaml']}\n"
+        "  ros_type_name: ros_gz_interfaces/srv/ControlWorld\n"
+        f"  gz_req_type_name: {WORLD_CONTROL}\n"
+        f"  gz_rep_type_name: {BOOLEAN}\n"
+    )
+    args = [
+        f"{names[key]}@ros_gz_interfaces/srv/{ros_type}@{gz_request}@{BOOLEAN}"
+        for key, (ros_type, gz_request) in CLI_SERVICES.items()
+    ]
+    bridge = start_bridge(
+        *args,
+        ros_args=["-p", f"config_file:={config}", "-p", f"service_timeout:={SERVICE_TIMEOUT}"],
+        creating=len(names),
+    )
+    yield names
+    bridge.stop()
+
+
+def start_replier(
+    started: list[PeerProcess], service: str, request_type: str, *flags: str
+) -> PeerProcess:
+    peer = start_peer("reply", service, request_type, BOOLEAN, "60", *flags)
+    started.append(peer)
+    wait_for_line(peer, r"^READY$")
+    return peer
+
+
+def call(ros_side: RosSide, srv_type: Any, service: str, request: Any) -> Any:
+    """One call through a fresh client; fails the test if no response comes within WAIT."""
+    client = ros_side.run(lambda: ros_side.node.create_client(srv_type, service))
+    try:
+        deadline = time.monotonic() + WAIT
+        while not client.service_is_ready():
+            if time.monotonic() > deadline:
+                pytest.fail(f"service {service} never appeared")
+            time.sleep(0.05)
+        future = ros_side.run(lambda: client.call_async(request))
+        while not future.done():
+            if time.monotonic() > deadline + WAIT:
+                pytest.fail(f"no response from {service}")
+            time.sleep(0.02)
+        return future.result()
+    finally:
+        ros_side.destroy(client)
+
+
+def call_until_served(
+    ros_side: RosSide, peer: PeerProcess, srv_type: Any, service: str, request: Any
+) -> tuple[Any, str]:
+    """Call until the peer printed a request (the bridge may not have discovered it yet).
+
+    Returns the response of that call and the peer's ``REQUEST`` line.
+    """
+    deadline = time.monotonic() + WAIT
+    while time.monotonic() < deadline:
+        response = call(ros_side, srv_type, service, request)
+        if served := [line for line in peer.output().splitlines() if line.startswith("REQUEST")]:
+            return response, served[-1]
+    pytest.fail(f"the Gazebo service {service} never got a request; output:\n{peer.output()}")
+
+
+def control_request() -> Any:
+    request = ControlWorld.Request()
+    request.world_control.pause = True
+    request.world_control.multi_step = 7
+    request.world_control.reset.model_only = True
+    return request
+
+
+def test_control_world_reaches_gazebo_and_succeeds(
+    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    peer = start_replier(started, services["control"], WORLD_CONTROL)
+    response, request = call_until_served(
+        ros_side, peer, ControlWorld, services["control"], control_request()
+    )
+    assert response.success is True
+    assert request.startswith(f"REQUEST {WORLD_CONTROL} ")
+    assert "pause: true" in request
+    assert "multi_step: 7" in request
+    assert "model_only: true" in request
+
+
+def test_control_world_failure_in_gazebo_is_success_false(
+    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    peer = start_replier(started, services["control_fail"], WORLD_CONTROL, "--fail")
+    response, request = call_until_served(
+        ros_side, peer, ControlWorld, services["control_fail"], control_request()
+    )
+    assert response.success is False
+    assert "multi_step: 7" in request
+
+
+def test_no_gazebo_service_gives_exactly_one_failure_response(
+    services: dict[str, str], ros_side: RosSide
+) -> None:
+    # A node outside the spinning executor, so this test takes the responses itself.
+    node = rclpy.create_node(
+        f"svc_counter_{int(time.time() * 1000) % 100000}", context=ros_side.context
+    )
+    try:
+        client = node.create_client(ControlWorld, services["control_absent"])
+        assert client.wait_for_service(timeout_sec=WAIT)
+        client.call_async(control_request())
+        responses = []
+        listen_until = time.monotonic() + SERVICE_TIMEOUT + 2.0
+        while time.monotonic() < listen_until:
+            with client.handle:
+                header, response = client.handle.take_response(ControlWorld.Response)
+            if header is not None:
+                responses.append(response)
+            time.sleep(0.02)
+        assert [response.success for response in responses] == [False]
+    finally:
+        node.destroy_node()
+
+
+def test_yaml_service_entry_is_bridged(
+    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    peer = start_replier(started, services["yaml"], WORLD_CONTROL)
+    response, request = call_until_served(
+        ros_side, peer, ControlWorld, services["yaml"], control_request()
+    )
+    assert response.success is True
+    assert "pause: true" in request
+
+
+def test_delete_entity_request_as_gazebo_sees_it(
+    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    peer = start_replier(started, services["delete"], "ignition.msgs.Entity")
+    request = DeleteEntity.Request()
+    request.entity.name = "doomed_box"
+    request.entity.type = Entity.MODEL
+    response, seen = call_until_served(ros_side, peer, DeleteEntity, services["delete"], request)
+    assert response.success is True
+    assert seen.startswith("REQUEST ignition.msgs.Entity ")
+    assert 'name: "doomed_box"' in seen
+    assert "type: MODEL" in seen
+
+
+def test_set_entity_pose_request_as_gazebo_sees_it(
+    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    peer = start_replier(started, services["set_pose"], "ignition.msgs.Pose")
+    request = SetEntityPose.Request()
+    request.entity.name = "moved_box"
+    request.pose.position.x = 1.5
+    request.pose.position.z = -2.25
+    request.pose.orientation.w = 1.0
+    response, seen = call_until_served(ros_side, peer, SetEntityPose, services["set_pose"], request)
+    assert response.success is True
+    assert seen.startswith("REQUEST ignition.msgs.Pose ")
+    assert 'name: "moved_box"' in seen
+    assert "x: 1.5" in seen
+    assert "z: -2.25" in seen
+
+
+def test_spawn_entity_request_as_gazebo_sees_it(
+    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    peer = start_replier(started, services["spawn"], "ignition.msgs.EntityFactory")
+    request = SpawnEntity.Request()
+    request.entity_factory.name = "new_box"
+    request.entity_factory.sdf_filename = "model://box"
+    request.entity_factory.allow_renaming = True
+    request.entity_factory.pose.position.y = 3.0
+    response, seen = call_until_served(ros_side, peer, SpawnEntity, services["spawn"], request)
+    assert response.success is True
+    assert seen.startswith("REQUEST ignition.msgs.EntityFactory ")
+    assert 'name: "new_box"' in seen
+    assert 'sdf_filename: "model://box"' in seen
+    assert "allow_renaming: true" in seen
+    assert "y: 3" in seen

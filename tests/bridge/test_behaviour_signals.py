@@ -1,0 +1,97 @@
+"""SIGINT and SIGTERM stop ``parameter_bridge`` cleanly.
+
+Clean means: exit status 0 promptly, no traceback, nothing of the process left (its whole
+process group is gone), and the Gazebo side told that the bridge's topic is gone (an
+unadvertisement, not a peer that went silent and expired).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+import uuid
+
+import pytest
+from rcl_interfaces.srv import ListParameters
+
+from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport.discovery import SILENCE_INTERVAL
+from tests.bridge.behaviour_harness import (
+    STRING,
+    WAIT,
+    RosSide,
+    gz_advertised,
+    gz_node,
+    ros_side,
+    start_bridge,
+    started,
+    wait_gz_advertised,
+)
+from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_until
+
+__all__ = ["gz_node", "ros_side", "started"]
+
+pytestmark = [pytest.mark.ros, pytest.mark.peer]
+
+#: The brief's bound for a clean exit after the signal.
+EXIT_WITHIN = 2.0
+
+
+def wait_until_spinning(ros_side: RosSide, node_name: str) -> None:
+    """Wait until the bridge's executor answers its parameter service.
+
+    The bridge installs its signal handlers just before it starts spinning; a signal during
+    start-up is another case (see the report).
+    """
+    client = ros_side.run(
+        lambda: ros_side.node.create_client(ListParameters, f"/{node_name}/list_parameters")
+    )
+    try:
+        deadline = time.monotonic() + WAIT
+        future = None
+        while future is None or not future.done():
+            if time.monotonic() > deadline:
+                pytest.fail(f"{node_name} never answered list_parameters")
+            if future is None and client.service_is_ready():
+                future = ros_side.run(lambda: client.call_async(ListParameters.Request()))
+            time.sleep(0.02)
+    finally:
+        ros_side.destroy(client)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_signal_stops_the_bridge_cleanly(
+    signum: signal.Signals, gz_node: GzNode, ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    topic = unique_name("signal")
+    node_name = f"signal_bridge_{uuid.uuid4().hex[:8]}"
+    bridge = start_bridge(
+        f"{topic}@std_msgs/msg/String]{STRING}",
+        f"{unique_name('signal_in')}@std_msgs/msg/String[{STRING}",
+        f"{unique_name('signal_svc')}@ros_gz_interfaces/srv/ControlWorld",
+        ros_args=["-r", f"__node:={node_name}"],
+        creating=3,
+    )
+    started.append(bridge)
+    wait_gz_advertised(gz_node, topic)
+    wait_until_spinning(ros_side, node_name)
+
+    bridge.send_signal(signum)
+    try:
+        status = bridge.wait(EXIT_WITHIN)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"still running {EXIT_WITHIN} s after {signum.name}:\n{bridge.output()}")
+
+    assert status == 0, bridge.output()
+    assert "Traceback" not in bridge.output()
+    with pytest.raises(ProcessLookupError):
+        os.killpg(bridge.pid, 0)  # the session the bridge led has no process left
+    # A peer that just went silent is forgotten only SILENCE_INTERVAL after its last heartbeat
+    # (heartbeats come every second until the exit), so disappearing sooner than
+    # SILENCE_INTERVAL - 1 s after the exit means the bridge unadvertised.
+    wait_until(
+        lambda: not gz_advertised(gz_node, topic), SILENCE_INTERVAL - 1.5, f"{topic} unadvertised"
+    )

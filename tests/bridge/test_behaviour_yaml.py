@@ -1,0 +1,92 @@
+"""YAML configuration errors as the running bridge reports them.
+
+An invalid entry is skipped with its index, its line and the C++ error text, and the valid
+entries of the same file bridge; a value C++ cannot convert (``lazy: maybe``) is one more
+invalid entry here, where it kills the C++ process. A missing file is one error, once.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import pytest
+
+from ros_gz_bridge_py.transport import Node as GzNode
+from tests.bridge.behaviour_harness import (
+    STRING,
+    WAIT,
+    gz_node,
+    start_bridge,
+    started,
+)
+from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
+
+__all__ = ["gz_node", "started"]
+
+pytestmark = [pytest.mark.ros, pytest.mark.peer]
+
+HEARTBEAT_MS = 200
+
+
+def test_invalid_entries_are_reported_and_valid_ones_bridge(
+    tmp_path: Path, gz_node: GzNode, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    first, last = unique_name("yaml_first"), unique_name("yaml_last")
+    config = tmp_path / "mixed.yaml"
+    config.write_text(
+        f"- topic_name: {first}\n"  # entry 1, line 1
+        "  ros_type_name: std_msgs/msg/String\n"
+        f"  gz_type_name: {STRING}\n"
+        "  direction: GZ_TO_ROS\n"
+        "\n"
+        "- topic_name: /both\n"  # entry 2, line 6
+        "  ros_topic_name: /both_ros\n"
+        "  ros_type_name: std_msgs/msg/String\n"
+        f"  gz_type_name: {STRING}\n"
+        "- topic_name: /maybe\n"  # entry 3, line 10
+        "  ros_type_name: std_msgs/msg/String\n"
+        f"  gz_type_name: {STRING}\n"
+        "  lazy: maybe\n"  # line 13
+        f"- topic_name: {last}\n"  # entry 4, line 14
+        "  ros_type_name: std_msgs/msg/String\n"
+        f"  gz_type_name: {STRING}\n"
+        "  direction: GZ_TO_ROS\n"
+    )
+    bridge = start_bridge(ros_args=["-p", f"config_file:={config}"])
+    started.append(bridge)
+
+    exclusive = wait_for_line(bridge, r"\[ERROR\].*entry 2", timeout=30).string
+    assert f"{config} entry 2 (line 6): " in exclusive
+    assert exclusive.endswith(
+        "Could not parse entry: topic_name and ros_topic_name are mutually exclusive"
+    )
+    unconvertible = wait_for_line(bridge, r"\[ERROR\].*entry 3", timeout=WAIT).string
+    assert f"{config} entry 3 (line 13): Could not parse entry: lazy " in unconvertible
+    assert "'maybe'" in unconvertible
+
+    for topic in (first, last):
+        publisher = gz_node.advertise(topic, STRING)
+        try:
+            wait_until(publisher.has_connections, WAIT, f"the bridge of {topic}")
+        finally:
+            publisher.close()
+    assert "Traceback" not in bridge.output()
+
+
+def test_missing_file_is_one_clear_error(tmp_path: Path, started: list[PeerProcess]) -> None:
+    missing = tmp_path / "no_such_bridge.yaml"
+    bridge = start_bridge(
+        ros_args=["-p", f"config_file:={missing}", "-p", f"subscription_heartbeat:={HEARTBEAT_MS}"]
+    )
+    started.append(bridge)
+    wait_for_line(bridge, r"No bridges are running", timeout=30)
+    time.sleep(5 * HEARTBEAT_MS / 1000)  # C++ would log the error again on every heartbeat
+
+    output = bridge.output()
+    errors = [line for line in output.splitlines() if "[ERROR]" in line]
+    assert errors == [line for line in errors if line.endswith(f"failed to open file [{missing}]")]
+    assert len(errors) == 1, output
+    assert "Could not parse config" in errors[0]
+    assert "Traceback" not in output
