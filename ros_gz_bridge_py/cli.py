@@ -21,6 +21,7 @@ def bridge_types_main() -> None:
 
 
 def image_bridge_main() -> None:
-    from ros_gz_bridge_py import image_bridge  # noqa: PLC0415 - only this command needs rclpy
+    with StopSignal() as stop:
+        from ros_gz_bridge_py import image_bridge  # noqa: PLC0415 - imports rclpy
 
-    sys.exit(image_bridge.main())
+        sys.exit(image_bridge.main(stop=stop))

@@ -8,7 +8,8 @@ Differences from ros_gz_bridge:
   image with format UNKNOWN_PIXEL_FORMAT and no data).
 - Image R→G with data shorter than height*step raises ConversionError (C++ over-reads).
 - Image G→R with an unsupported format raises ConversionError (C++ prints and publishes an
-  empty image); longer gz data is truncated to step*height, shorter data is zero-padded.
+  empty image); data shorter than step*height raises ConversionError (C++ publishes the
+  frame zero-padded); longer gz data is truncated to step*height (C++ overruns).
 - CameraInfo G→R truncates gz arrays longer than the ROS k (9), p (12), r (9) arrays
   (C++ writes out of bounds).
 """
@@ -90,11 +91,13 @@ def image_to_ros(gz: Any) -> Any:
     ros.step = gz.width * bytes_per_pixel
     size = ros.step * gz.height
     data: bytes = gz.data
-    if len(data) > size:
-        data = data[:size]
-    elif len(data) < size:
-        data += bytes(size - len(data))
-    ros.data = data
+    if len(data) < size:
+        msg = (
+            f"gz.msgs.Image data has {len(data)} bytes, fewer than height*step = {size} "
+            f"for {gz.width}x{gz.height} {encoding}"
+        )
+        raise ConversionError(msg)
+    ros.data = data if len(data) == size else data[:size]
     return ros
 
 

@@ -50,11 +50,12 @@ def test_unknown_encoding_and_short_data_are_rejected() -> None:
         image_to_ros(GzImage(width=1, height=1, pixel_format_type=7))
 
 
-def test_gz_data_is_truncated_or_zero_padded_to_the_image_size() -> None:
+def test_long_gz_data_is_truncated_and_short_data_rejected() -> None:
     long_gz = GzImage(width=2, height=1, pixel_format_type=1, data=b"abcdef")
     assert bytes(image_to_ros(long_gz).data) == b"ab"
     short_gz = GzImage(width=2, height=2, pixel_format_type=1, data=b"abc")
-    assert bytes(image_to_ros(short_gz).data) == b"abc\0"
+    with pytest.raises(ConversionError, match="3 bytes, fewer than height\\*step = 4"):
+        image_to_ros(short_gz)
 
 
 def test_camera_info_upstream_fixture_round_trips() -> None:

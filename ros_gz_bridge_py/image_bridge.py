@@ -1,0 +1,194 @@
+"""``image_bridge``: ros_gz_image's executable on the bridge core (Gazebo->ROS camera images).
+
+Each topic argument becomes a Gazebo->ROS ``sensor_msgs/msg/Image`` bridge of a
+:class:`~ros_gz_bridge_py.bridge.Bridge` on the node ``ros_gz_image``; channels, QoS, lazy
+switching and error counting are the bridge's. Run it as ``image_bridge`` or
+``python -m ros_gz_bridge_py.image_bridge``; ``-h`` prints the arguments and parameters.
+
+Beyond ros_gz_image (ros_gz issues #701, #778, #752): ``GZ_TOPIC:=ROS_TOPIC`` renames,
+``config_file`` takes a parameter_bridge YAML (its Image and CameraInfo entries), ``camera_info``
+bridges the camera's CameraInfo too, ``lazy`` subscribes to Gazebo only while ROS listens, and
+``gz_type`` lets Fortress users match ``ignition.msgs.Image``. A frame whose data is shorter than
+height x width x bytes per pixel, or whose pixel format has no ROS encoding, is counted, logged
+(throttled) and not published. There is no image_transport: only the raw topic is published.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import rclpy
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+
+from ros_gz_bridge_py.bridge import Bridge, BridgeOptions
+from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
+from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.image_bridge_args import (
+    USAGE,
+    ImageTopic,
+    check_gz_type,
+    parse_topic_args,
+    qos_profile_name,
+    select_config_entries,
+    split_ros_args,
+    topic_specs,
+    wants_help,
+    with_camera_info,
+    with_qos,
+)
+from ros_gz_bridge_py.runtime import make_executor, spin_until_stopped, tune_allocator
+from ros_gz_bridge_py.stop_signal import StopSignal
+from ros_gz_bridge_py.transport import NodeOptions
+
+NODE_NAME = "ros_gz_image"
+#: Exit status for bad arguments, as ros_gz_image (``return -1``).
+USAGE_EXIT = 255
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The node parameters, read once at start."""
+
+    qos: str
+    camera_info: bool
+    config_file: str
+    lazy: bool
+    subscription_heartbeat: int
+    gz_type: str
+    override_frame_id: str
+    override_timestamps_with_wall_time: bool
+    gz_transport_implementation: str
+
+
+def declare_parameters(node: Node) -> Settings:
+    defaults = Settings(
+        qos="default",
+        camera_info=False,
+        config_file="",
+        lazy=False,
+        subscription_heartbeat=1000,
+        gz_type="gz.msgs.Image",
+        # parameter_bridge's: replace header.frame_id (e.g. by the camera's optical frame) and
+        # header.stamp (by wall time) of every bridged message.
+        override_frame_id="",
+        override_timestamps_with_wall_time=False,
+        # Ours, as in parameter_bridge: "zeromq" or "zenoh"; empty = GZ_TRANSPORT_IMPLEMENTATION.
+        gz_transport_implementation="",
+    )
+    values = {
+        name: node.declare_parameter(name, value).value for name, value in vars(defaults).items()
+    }
+    return Settings(**values)
+
+
+def bridge_specs(
+    node: Node, topics: Sequence[TopicBridgeSpec], settings: Settings
+) -> list[TopicBridgeSpec]:
+    """Every bridge to create: the topic arguments, the config file's entries, camera infos.
+
+    Problems with the ``qos`` value and the config file are logged here; what can be bridged is.
+    """
+    logger = node.get_logger()
+    specs = list(topics)
+    if settings.config_file:
+        config = select_config_entries(read_yaml_file(settings.config_file))
+        for warning in config.warnings:
+            logger.warning(warning)
+        for error in config.errors:
+            logger.error(str(error))
+        specs += [spec for spec in config.specs if isinstance(spec, TopicBridgeSpec)]
+    if settings.camera_info:
+        specs = list(with_camera_info(specs))
+    try:
+        profile = qos_profile_name(settings.qos)
+    except ConfigError as err:
+        logger.error(str(err))
+        profile = None
+    return list(with_qos(specs, profile))
+
+
+def build_bridge(node: Node, topics: Sequence[ImageTopic]) -> Bridge | None:
+    """The running bridge, or None (logged) when the parameters leave nothing to bridge."""
+    settings = declare_parameters(node)
+    try:
+        gz_type = check_gz_type(settings.gz_type)
+    except ConfigError as err:
+        node.get_logger().error(str(err))
+        return None
+    specs = bridge_specs(node, topic_specs(topics, gz_type), settings)
+    if not specs:
+        node.get_logger().error(
+            "No image topics to bridge: give topic arguments or -p config_file:=<yaml> "
+            "(image_bridge -h shows the syntax)"
+        )
+        return None
+    bridge = Bridge(
+        node,
+        options=BridgeOptions(
+            lazy=settings.lazy,
+            heartbeat=max(settings.subscription_heartbeat, 1) / 1000.0,
+            override_timestamps_with_wall_time=settings.override_timestamps_with_wall_time,
+            override_frame_id=settings.override_frame_id,
+        ),
+        gz_options=NodeOptions(implementation=settings.gz_transport_implementation or None),
+    )
+    bridge.add_all(specs)
+    return bridge
+
+
+def run(topics: Sequence[ImageTopic], stop: StopSignal) -> int:
+    """Bridge until ``stop`` or rclpy shutdown; the node and bridge are closed on the way out."""
+    node = Node(NODE_NAME)
+    bridge: Bridge | None = None
+    try:
+        bridge = build_bridge(node, topics)
+        if bridge is None:
+            return USAGE_EXIT
+        if stop.requested:
+            return 0
+        executor = make_executor()
+        executor.add_node(node)
+        spin_until_stopped(executor, stop)
+    finally:
+        if bridge is not None:
+            bridge.close()
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> int:
+    """Run the image bridge on ``argv`` (with the program name); return the exit status.
+
+    ``stop``: SIGINT/SIGTERM handlers the entry point installed before importing us; None
+    installs them here.
+    """
+    argv = list(sys.argv if argv is None else argv)
+    ros_args, positional = split_ros_args(argv[1:])
+    if wants_help(positional):
+        print(USAGE, end="")
+        return 0
+    if len(argv) < 2:
+        print(USAGE, end="", file=sys.stderr)
+        return USAGE_EXIT
+    try:
+        topics = parse_topic_args(positional)
+    except UsageError as err:
+        print(f"image_bridge: {err}\n\n{USAGE}", end="", file=sys.stderr)
+        return USAGE_EXIT
+
+    if stop is not None and stop.requested:
+        return 0
+    tune_allocator()
+    rclpy.init(args=[argv[0], *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    if stop is not None:
+        return run(topics, stop)
+    with StopSignal() as own:
+        return run(topics, own)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
