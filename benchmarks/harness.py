@@ -1,0 +1,238 @@
+"""Driving one benchmark flow: endpoint processes, the bridge, CPU and RSS from /proc.
+
+A flow is one publisher process and one subscriber process (``benchmarks.workers``), with or
+without a bridge process between them. The bridge's CPU is read from ``/proc/<pid>/stat``
+over the publishing window; its RSS from ``/proc/<pid>/status``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import sys
+import time
+import uuid
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+from benchmarks.payloads import KINDS
+from benchmarks.transport import STATS_LINE
+from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
+from tests.gzpeer import PeerProcess, start_process, stop_processes, wait_for_line
+
+ROOT = Path(__file__).resolve().parent.parent
+BIN = Path(sys.executable).parent
+#: ZeroMQ high-water mark for the Gazebo publisher of large kinds: bounds its own queue.
+LARGE_HWM = "20"
+#: Seconds between a subscriber seeing the bridge and the publisher starting (connections).
+SETTLE = 1.0
+LARGE_KINDS = frozenset({"image640", "image1080", "cloud1mb"})
+#: One Gazebo partition for the whole run, so every process of it meets the others.
+PARTITION = f"bench-{os.getpid()}-{uuid.uuid4().hex[:6]}"
+#: Errors a flow may end with; it is then reported as failed and the run goes on.
+FlowFailure = (Exception, pytest.fail.Exception)
+
+
+def bench_env(backend: str = "zeromq") -> dict[str, str]:
+    """The environment of every benchmark process: loopback only, our own partition/domain,
+    the bridge executables' Fast DDS profile (so the ceiling uses the same settings)."""
+    env = dict(os.environ)
+    partition = PARTITION
+    env.update(
+        {
+            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+            "ROS_LOCALHOST_ONLY": "1",
+            "GZ_IP": "127.0.0.1",
+            "IGN_IP": "127.0.0.1",
+            "GZ_PARTITION": partition,
+            "IGN_PARTITION": partition,
+            "RCUTILS_LOGGING_SEVERITY_THRESHOLD": "WARN",
+        }
+    )
+    env.setdefault("ROS_DOMAIN_ID", str(os.getpid() % 100 + 101))
+    for name in ("GZ_RELAY", "IGN_RELAY", "GZ_TRANSPORT_IMPLEMENTATION"):
+        env.pop(name, None)
+    apply_fastdds_profile(env)
+    if backend == "zenoh":
+        env["GZ_TRANSPORT_IMPLEMENTATION"] = "zenoh"
+    return env
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port: int = sock.getsockname()[1]
+        return port
+
+
+def zenoh_override(listen: Sequence[str] = (), connect: Sequence[str] = ()) -> str:
+    """``GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE`` for a peer on explicit loopback endpoints only."""
+    entries = {
+        "mode": '"peer"',
+        "scouting/multicast/enabled": "false",
+        "scouting/gossip/enabled": "false",
+        "listen/endpoints": json.dumps(list(listen)),
+        "connect/endpoints": json.dumps(list(connect)),
+    }
+    return ";".join(f"{key}={value}" for key, value in entries.items())
+
+
+def topic_name(stem: str) -> str:
+    return f"/bench_{stem}_{os.getpid()}_{uuid.uuid4().hex[:6]}"
+
+
+# --- /proc ------------------------------------------------------------------------------------
+
+_TICK = os.sysconf("SC_CLK_TCK")
+
+
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU time of process ``pid`` (all its threads)."""
+    with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+        fields = stat.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / _TICK
+
+
+def rss_mb(pid: int) -> float:
+    with open(f"/proc/{pid}/status", encoding="ascii") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    return 0.0
+
+
+class CpuWindow:
+    """CPU share (percent of one core) of ``pid`` between :meth:`begin` and :meth:`end`."""
+
+    def __init__(self, pid: int | None) -> None:
+        self.pid = pid
+        self._start = (0.0, 0.0)
+        self.percent: float | None = None
+
+    def begin(self) -> None:
+        if self.pid is not None:
+            self._start = (time.monotonic(), cpu_seconds(self.pid))
+
+    def end(self) -> None:
+        if self.pid is not None:
+            wall = time.monotonic() - self._start[0]
+            self.percent = 100 * (cpu_seconds(self.pid) - self._start[1]) / max(wall, 1e-9)
+
+
+# --- processes --------------------------------------------------------------------------------
+
+
+def worker(
+    role: str, topic: str, kind: str, seconds: float, env: Mapping[str, str], *extra: str
+) -> PeerProcess:
+    command = [sys.executable, "-m", "benchmarks.workers", role, topic, kind, str(seconds)]
+    return start_process([*command, *extra], env)
+
+
+def bridge_argument(ros_topic: str, kind: str, direction: str) -> str:
+    """``topic@ros_type[gz_type`` (``direction`` "gz2ros") or ``]`` ("ros2gz")."""
+    spec = KINDS[kind]
+    mark = "[" if direction == "gz2ros" else "]"
+    return f"{ros_topic}@{spec.ros_type}{mark}{spec.gz_type}"
+
+
+def start_bridge(
+    arguments: Sequence[str], env: Mapping[str, str], executable: str = "parameter_bridge"
+) -> PeerProcess:
+    """Start a bridge executable and wait until it created all its channels."""
+    bridge = start_process([str(BIN / executable), *arguments], env)
+    if executable == "parameter_bridge":
+        for _ in arguments:
+            wait_for_line(bridge, r"Creating (GZ->ROS|ROS->GZ)", 30)
+    else:
+        time.sleep(3)
+    return bridge
+
+
+@dataclass(frozen=True)
+class FlowResult:
+    """What the subscriber of one flow measured, plus the bridge's CPU."""
+
+    sent: int
+    received: int
+    rate: float
+    median_us: float
+    p99_us: float
+    cpu: float | None
+    error: str = ""
+
+    @property
+    def share(self) -> float:
+        return self.received / self.sent if self.sent else 0.0
+
+
+def failed(error: BaseException) -> FlowResult:
+    first = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+    return FlowResult(0, 0, 0.0, 0.0, 0.0, None, first[:160])
+
+
+@dataclass(frozen=True)
+class Flow:
+    """One publisher -> (bridge) -> subscriber run."""
+
+    publisher: str  # ros-pub | gz-pub
+    subscriber: str  # ros-sub | gz-sub
+    kind: str
+    seconds: float
+    hz: float = 0.0
+    slow_ms: float = 0.0
+
+
+def run_flow(
+    flow: Flow,
+    topic: str,
+    env: Mapping[str, str],
+    *,
+    pub_env: Mapping[str, str] | None = None,
+    bridge_pid: int | None = None,
+    during: Callable[[], None] | None = None,
+) -> FlowResult:
+    """Run ``flow`` on ``topic`` (``env``: the subscriber's, and the publisher's unless
+    ``pub_env`` is given). With a bridge in between (``bridge_pid``) the subscriber first waits
+    to see the bridge's publisher. ``during`` runs once publishing started (RSS sampling)."""
+    pub_env = dict(pub_env or env)
+    if flow.publisher == "gz-pub" and flow.kind in LARGE_KINDS:
+        for prefix in ("GZ_", "IGN_"):
+            pub_env[f"{prefix}TRANSPORT_SNDHWM"] = LARGE_HWM
+    cpu = CpuWindow(bridge_pid)
+    extra = ("--slow-ms", str(flow.slow_ms)) if flow.slow_ms else ()
+    sub = worker(flow.subscriber, topic, flow.kind, flow.seconds + 60, env, *extra)
+    pub: PeerProcess | None = None
+    try:
+        wait_for_line(sub, r"^READY$", 30)
+        if bridge_pid is not None:
+            wait_for_line(sub, r"^MATCHED$", 20)
+            time.sleep(SETTLE)
+        pub = worker(flow.publisher, topic, flow.kind, flow.seconds, pub_env, "--hz", str(flow.hz))
+        wait_for_line(pub, r"^CONNECTED$", 40)
+        wait_for_line(pub, r"^START$", 10)
+        cpu.begin()
+        if during is not None:
+            during()
+        sent = int(wait_for_line(pub, r"^SENT (\d+)", flow.seconds + 30)[1])
+        cpu.end()
+        time.sleep(1.0)  # the last messages drain
+        sub.stop(grace=15)
+        stats = wait_for_line(sub, STATS_LINE.pattern, 5)
+    except FlowFailure as error:
+        return failed(error)
+    finally:
+        sub.stop()
+        if pub is not None:
+            pub.stop()
+    return FlowResult(
+        sent, int(stats[1]), float(stats[4]), float(stats[5]), float(stats[6]), cpu.percent
+    )
+
+
+def stop_all() -> None:
+    stop_processes(grace=3)

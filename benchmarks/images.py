@@ -1,0 +1,118 @@
+"""Large messages through the bridge (issues 5 and 6), side by side with the rclpy ceiling.
+
+Usage: ``.venv/bin/python -m benchmarks.images [--seconds S] [--no-zenoh]``; writes the
+``images`` section of BENCHMARKS.md. The ceiling is an rclpy publisher -> rclpy subscriber with
+the same settings as the bridge (Fast DDS SHM profile, EventsExecutor, allocator tuning). The
+Gazebo ends are Python ``benchmarks.workers`` on the bridge's backend (ZeroMQ, or Zenoh on
+explicit loopback endpoints).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import sys
+
+from benchmarks.bridged import (
+    Ceilings,
+    backend,
+    bridge_process,
+    ceilings,
+    flow_through,
+    through_bridge,
+)
+from benchmarks.harness import Flow, topic_name
+from benchmarks.report import write_section
+from benchmarks.tables import Row, latency_goal, rate_goal, table
+
+#: (kind, publishing rate) of every case; 0 = flat out.
+CASES = (
+    ("image640", 0.0),
+    ("image640", 30.0),
+    ("image1080", 0.0),
+    ("image1080", 30.0),
+    ("cloud1mb", 0.0),
+)
+ROS_TO_GZ_CASES = (("image640", 0.0), ("image1080", 0.0), ("image1080", 30.0), ("cloud1mb", 0.0))
+ZENOH_CASES = (("image1080", 0.0), ("image1080", 30.0), ("cloud1mb", 0.0))
+
+
+def through_image_bridge(seconds: float, ceiling: Ceilings) -> list[Row]:
+    if importlib.util.find_spec("ros_gz_bridge_py.image_bridge") is None:
+        return []
+    which = backend("zeromq")
+    topics = {kind: topic_name(f"ib_{kind}") for kind in ("image640", "image1080")}
+    rows = []
+    with bridge_process(list(topics.values()), which.bridge_env, "image_bridge") as bridge:
+        for kind, hz in CASES:
+            if kind in topics:
+                result = flow_through(
+                    Flow("gz-pub", "ros-sub", kind, seconds, hz), topics[kind], which, bridge
+                )
+                rows.append(
+                    Row("GZ->ROS image_bridge (ZeroMQ)", kind, hz, result, ceiling[kind, hz])
+                )
+    return rows
+
+
+def goals(rows: list[Row]) -> list[str]:
+    lines = []
+    for row in rows:
+        if not row.path.startswith("GZ->ROS"):
+            continue
+        if row.kind in {"image640", "image1080"} and row.hz == 0:
+            lines.append(rate_goal(row, 0.9))
+        if row.kind == "image1080" and row.hz == 30:
+            lines.append(latency_goal(row, 2.0))
+    return lines
+
+
+def markdown(rows: list[Row], ceiling_rows: list[Row], seconds: float, command: str) -> str:
+    return f"""## Images and point clouds through the bridge (issues 5, 6)
+
+Command: `{command}`
+
+Each row: one publisher process, the bridge process (one per backend, every channel of the
+table configured at once) and one subscriber process, {seconds:g} s of publishing. Latency is
+publish time (CLOCK_MONOTONIC in the header stamp) to the subscriber's callback. The
+**ceiling** is rclpy publisher -> rclpy subscriber, no bridge, with the bridge's own speed
+settings (Fast DDS 64 MB SHM profile, EventsExecutor, allocator tuning); "vs ceiling" is
+msg/s against the ceiling row of the same message and rate, measured in the same run. Bridge
+CPU is % of one core from /proc/<pid>/stat over the publishing window. With 2 cores the
+bridge path runs three busy processes where the ceiling runs two, so flat-out rows are bound
+by the machine as much as by the bridge. ROS QoS: reliable, keep-last 10 (the bridge's
+default) on both ends; the Gazebo publisher's ZeroMQ high-water mark is 20 messages.
+
+{table(ceiling_rows + rows)}
+
+Goals (issue 5: 1080p GZ->ROS >= 90% of the ceiling's msg/s, 1080p@30 Hz median within 2 ms
+of the ceiling's, 640x480 >= 90%):
+{chr(10).join(goals(rows))}
+"""
+
+
+def run(seconds: float, zenoh: bool) -> str:
+    all_cases = tuple(dict.fromkeys(CASES + ROS_TO_GZ_CASES))
+    ceiling = ceilings(seconds, all_cases)
+    ceiling_rows = [Row("ceiling: rclpy -> rclpy", k, hz, ceiling[k, hz]) for k, hz in all_cases]
+    rows = through_bridge(seconds, backend("zeromq"), ceiling, CASES, ROS_TO_GZ_CASES)
+    rows += through_image_bridge(seconds, ceiling)
+    if zenoh:
+        rows += through_bridge(seconds, backend("zenoh"), ceiling, ZENOH_CASES, ZENOH_CASES)
+    flags = f" --seconds {seconds:g}" + ("" if zenoh else " --no-zenoh")
+    return markdown(rows, ceiling_rows, seconds, f".venv/bin/python -m benchmarks.images{flags}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seconds", type=float, default=3.0, help="publishing time per flow")
+    parser.add_argument("--no-zenoh", action="store_true", help="skip the Zenoh backend")
+    args = parser.parse_args(argv)
+    os.environ.setdefault("PYTHONUNBUFFERED", "1")
+    write_section("images", run(args.seconds, not args.no_zenoh))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

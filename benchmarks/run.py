@@ -1,0 +1,77 @@
+"""``make bench``: every benchmark in one go, each bounded, rewriting BENCHMARKS.md.
+
+Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
+about 12 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
+Each module writes its own section; a module that fails is reported and the others still run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+import traceback
+from collections.abc import Callable
+
+from benchmarks import conversion, images, memory, small_messages, starvation, transport
+from benchmarks.harness import stop_all
+from benchmarks.report import write_section
+from ros_gz_bridge_py.ros_speed import PROFILE
+
+
+def steps(quick: bool) -> dict[str, Callable[[], int]]:
+    """Each benchmark with the phase lengths of a full (or quick) run."""
+    flow = 1.5 if quick else 2.5
+    return {
+        "conversion": lambda: conversion.main(["--seconds", "0.2" if quick else "0.5"]),
+        "transport": lambda: transport.main(["--seconds", "1" if quick else "2"]),
+        "images": lambda: images.main(["--seconds", str(flow)]),
+        "small_messages": lambda: small_messages.main(["--seconds", str(flow)]),
+        "starvation": lambda: starvation.main(["--seconds", "3" if quick else "5"]),
+        "memory": lambda: memory.main(
+            ["--flood-seconds", "15" if quick else "60", "--slow-seconds", "8" if quick else "15"]
+        ),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="short phases (smoke run)")
+    parser.add_argument("--only", nargs="+", choices=list(steps(False)), help="run only these")
+    args = parser.parse_args(argv)
+    chosen = steps(args.quick)
+    names = args.only or list(chosen)
+    load, start, lines = os.getloadavg()[0], time.monotonic(), []
+    for name in names:
+        began = time.monotonic()
+        print(f"== {name}", file=sys.stderr, flush=True)
+        try:
+            chosen[name]()
+            outcome = "done"
+        except Exception:
+            traceback.print_exc()
+            outcome = "**failed** (see the console output); its section is from an earlier run"
+        finally:
+            stop_all()
+        lines.append(f"- `{name}`: {outcome} in {time.monotonic() - began:.0f} s")
+    flags = (" --quick" if args.quick else "") + (f" --only {' '.join(names)}" if args.only else "")
+    write_section(
+        "run",
+        f"""## This run
+
+Command: `make bench` (= `.venv/bin/python -m benchmarks.run{flags}` with the loopback
+environment). Total {time.monotonic() - start:.0f} s; 1-minute load average before the run
+{load:.2f}, after {os.getloadavg()[0]:.2f} (other work on the machine skews every number).
+Every ROS process (bridge, ceiling, workers) uses the bridge's speed settings: the Fast DDS
+profile `{PROFILE.name}` (64 MB shared-memory segment), the EventsExecutor and the glibc
+allocator tuning.
+
+{chr(10).join(lines)}
+""",
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

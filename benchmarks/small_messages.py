@@ -1,0 +1,67 @@
+"""Small messages at full rate through one channel each, both directions, beside the ceiling.
+
+Usage: ``.venv/bin/python -m benchmarks.small_messages [--seconds S] [--no-zenoh]``; writes
+the ``small_messages`` section of BENCHMARKS.md. Goal: >= 5,000 msg/s through one channel.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from benchmarks.bridged import backend, ceilings, through_bridge
+from benchmarks.report import write_section
+from benchmarks.tables import Row, table, verdict
+
+CASES = (("twist", 0.0), ("odometry", 0.0), ("tf20", 0.0))
+GOAL_RATE = 5000.0
+
+
+def goal(row: Row) -> str:
+    result = row.result
+    what = f"{row.path}, {row.kind}"
+    if result.error:
+        return f"- {what} >= {GOAL_RATE:,.0f} msg/s: not measured ({result.error})"
+    met = result.rate >= GOAL_RATE
+    ceiling = f"; ceiling {row.ceiling.rate:,.0f} msg/s" if row.ceiling else ""
+    return (
+        f"- {what} >= {GOAL_RATE:,.0f} msg/s: {result.rate:,.0f}{ceiling} — "
+        f"{verdict(met, f'{GOAL_RATE - result.rate:,.0f} msg/s')}"
+    )
+
+
+def run(seconds: float, zenoh: bool) -> str:
+    ceiling = ceilings(seconds, CASES)
+    ceiling_rows = [Row("ceiling: rclpy -> rclpy", k, hz, ceiling[k, hz]) for k, hz in CASES]
+    rows = through_bridge(seconds, backend("zeromq"), ceiling, CASES, CASES)
+    if zenoh:
+        rows += through_bridge(seconds, backend("zenoh"), ceiling, CASES, CASES)
+    flags = f" --seconds {seconds:g}" + ("" if zenoh else " --no-zenoh")
+    return f"""## Small messages at full rate (Twist, Odometry, 20-transform TFMessage)
+
+Command: `.venv/bin/python -m benchmarks.small_messages{flags}`
+
+The publisher sends back to back for {seconds:g} s; one bridge process per backend with one
+channel per message and direction. Latency is publish to callback (header stamp; Twist
+carries it in `linear.x`). Reliable keep-last 10 on the ROS ends: a subscriber that falls
+behind loses the oldest messages, so msg/s is what the subscriber received. Ceiling: rclpy
+publisher -> rclpy subscriber with the bridge's settings, same run. Bridge CPU: % of one core.
+
+{table(ceiling_rows + rows)}
+
+Goal (>= {GOAL_RATE:,.0f} msg/s through one channel, both directions):
+{chr(10).join(goal(row) for row in rows)}
+"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seconds", type=float, default=3.0, help="publishing time per flow")
+    parser.add_argument("--no-zenoh", action="store_true", help="skip the Zenoh backend")
+    args = parser.parse_args(argv)
+    write_section("small_messages", run(args.seconds, not args.no_zenoh))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

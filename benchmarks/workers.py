@@ -1,0 +1,237 @@
+"""Benchmark endpoint processes: a ROS or Gazebo publisher or subscriber of one message kind.
+
+``python -m benchmarks.workers ROLE TOPIC KIND SECONDS [--hz HZ] [--slow-ms MS]`` with ROLE one
+of ``ros-pub``, ``ros-sub``, ``gz-pub``, ``gz-sub``. Lines printed, in order: ``READY`` (the
+endpoint exists), ``CONNECTED`` (publishers: a subscriber is matched), ``START``, then
+``SENT n SECONDS s``; subscribers print ``MATCHED`` when they see a publisher and, on SIGTERM
+or after SECONDS, the same ``STATS`` line as ``benchmarks.transport``. ROS ends use the speed
+settings of the bridge executables (Fast DDS SHM profile, EventsExecutor, allocator tuning);
+Gazebo ends use the backend ``GZ_TRANSPORT_IMPLEMENTATION`` names.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from benchmarks.payloads import KINDS, GzPayloads, Kind, gz_stamp, now_ns, ros_stamp, stamp_ros
+from benchmarks.transport import stats_line
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
+from ros_gz_bridge_py.transport import MessageInfo, create_node
+
+#: How long a publisher waits for its first subscriber.
+MATCH_WAIT = 15.0
+#: Pause between the match and the first measured message (late discovery on the far side).
+SETTLE = 0.5
+NS_PER_S = 1_000_000_000
+
+
+def say(line: str) -> None:
+    print(line, flush=True)
+
+
+class Recorder:
+    """Latencies and arrival times of one subscriber, printed as a STATS line."""
+
+    def __init__(self, slow_s: float) -> None:
+        self.latencies: list[int] = []
+        self.arrivals: list[int] = []
+        self.total = 0
+        self.slow_s = slow_s
+
+    def record(self, stamp_ns: int, size: int) -> None:
+        now = now_ns()
+        self.latencies.append(now - stamp_ns)
+        self.arrivals.append(now)
+        self.total += size
+        if self.slow_s:
+            time.sleep(self.slow_s)
+
+    def report(self) -> None:
+        say(stats_line(list(self.latencies), list(self.arrivals), self.total))
+
+
+def _pace(hz: float) -> Callable[[], None]:
+    """A function that sleeps until the next send time (no-op when ``hz`` is 0)."""
+    if hz <= 0:
+        return lambda: None
+    period = int(NS_PER_S / hz)
+    next_send = [now_ns()]
+
+    def wait() -> None:
+        delay = next_send[0] - now_ns()
+        if delay > 0:
+            time.sleep(delay / NS_PER_S)
+        next_send[0] += period
+
+    return wait
+
+
+def _publish_loop(seconds: float, hz: float, send: Callable[[], None]) -> None:
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    pace = _pace(hz)
+    say("START")
+    start = now_ns()
+    end = start + int(seconds * NS_PER_S)
+    sent = 0
+    while not stop.is_set() and now_ns() < end:
+        pace()
+        send()
+        sent += 1
+    say(f"SENT {sent} SECONDS {(now_ns() - start) / NS_PER_S:.3f}")
+
+
+def _ros_start() -> Any:
+    from ros_gz_bridge_py.runtime import tune_allocator  # noqa: PLC0415 - loads rclpy
+
+    tune_allocator()
+    apply_fastdds_profile()
+    import rclpy  # noqa: PLC0415
+    from rclpy.signals import SignalHandlerOptions  # noqa: PLC0415
+
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    return rclpy
+
+
+def _ros_qos() -> Any:
+    from ros_gz_bridge_py.qos import endpoint_qos  # noqa: PLC0415
+
+    return endpoint_qos(None, None)
+
+
+def ros_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
+    rclpy = _ros_start()
+    node = rclpy.create_node(f"bench_pub_{os.getpid()}")
+    publisher = node.create_publisher(kind.pair.ros_class, topic, _ros_qos())
+    msg = kind.make_ros()
+    say("READY")
+    deadline = time.monotonic() + MATCH_WAIT
+    while publisher.get_subscription_count() == 0 and time.monotonic() < deadline:
+        time.sleep(0.02)
+    if publisher.get_subscription_count() == 0:
+        say("NO_CONNECTIONS")
+        return
+    say("CONNECTED")
+    time.sleep(SETTLE)
+
+    def send() -> None:
+        stamp_ros(kind, msg, now_ns())
+        publisher.publish(msg)
+
+    _publish_loop(seconds, hz, send)
+    time.sleep(0.5)
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float) -> None:
+    """Spin on a daemon thread; the main thread waits for SIGTERM or ``seconds`` and reports,
+    so the STATS line never depends on the executor shutting down cleanly under load."""
+    rclpy = _ros_start()
+    from rclpy.task import Future  # noqa: PLC0415
+
+    from ros_gz_bridge_py.runtime import make_executor  # noqa: PLC0415
+
+    node = rclpy.create_node(f"bench_sub_{os.getpid()}")
+    recorder = Recorder(slow_s)
+
+    def on_message(msg: Any) -> None:
+        recorder.record(ros_stamp(kind, msg), 0)
+
+    node.create_subscription(kind.pair.ros_class, topic, on_message, _ros_qos())
+    say("READY")
+    _announce_match(lambda: node.count_publishers(topic) > 0)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    executor = make_executor()
+    executor.add_node(node)
+    never: Future = Future(executor=executor)
+
+    def spin() -> None:
+        while not stop.is_set():
+            executor.spin_until_future_complete(never, timeout_sec=0.5)
+
+    threading.Thread(target=spin, daemon=True).start()
+    stop.wait(seconds)
+    recorder.report()
+    os._exit(0)  # rclpy's threads need no orderly goodbye
+
+
+def _announce_match(matched: Callable[[], bool]) -> None:
+    def watch() -> None:
+        deadline = time.monotonic() + MATCH_WAIT
+        while time.monotonic() < deadline:
+            if matched():
+                say("MATCHED")
+                return
+            time.sleep(0.05)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def gz_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
+    payloads = GzPayloads(kind)
+    with create_node() as node:
+        publisher = node.advertise(topic, kind.gz_type)
+        say("READY")
+        deadline = time.monotonic() + MATCH_WAIT
+        while not publisher.has_connections() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        if not publisher.has_connections():
+            say("NO_CONNECTIONS")
+            return
+        say("CONNECTED")
+        time.sleep(SETTLE)
+        _publish_loop(seconds, hz, lambda: publisher.publish_raw(payloads.payload(now_ns())))
+        time.sleep(0.5)
+
+
+def gz_sub(topic: str, kind: Kind, seconds: float, slow_s: float) -> None:
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    parse = message_class(kind.gz_type).FromString
+    recorder = Recorder(slow_s)
+
+    def on_message(payload: bytes, _info: MessageInfo) -> None:
+        recorder.record(gz_stamp(kind, parse(payload)), len(payload))
+
+    with create_node() as node:
+        subscription = node.subscribe(topic, on_message, kind.gz_type)
+        say("READY")
+        _announce_match(lambda: bool(node.topic_info(topic)))
+        stop.wait(seconds)
+        subscription.close()
+    recorder.report()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("role", choices=("ros-pub", "ros-sub", "gz-pub", "gz-sub"))
+    parser.add_argument("topic")
+    parser.add_argument("kind", choices=sorted(KINDS))
+    parser.add_argument("seconds", type=float)
+    parser.add_argument("--hz", type=float, default=0.0, help="publishers: rate (0: flat out)")
+    parser.add_argument("--slow-ms", type=float, default=0.0, help="subscribers: work per message")
+    args = parser.parse_args(argv)
+    kind = KINDS[args.kind]
+    if args.role == "ros-pub":
+        ros_pub(args.topic, kind, args.seconds, args.hz)
+    elif args.role == "ros-sub":
+        ros_sub(args.topic, kind, args.seconds, args.slow_ms / 1000)
+    elif args.role == "gz-pub":
+        gz_pub(args.topic, kind, args.seconds, args.hz)
+    else:
+        gz_sub(args.topic, kind, args.seconds, args.slow_ms / 1000)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
