@@ -16,6 +16,7 @@ from typing import Any, Self
 
 from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.transport.delivery import Deliver, raw_deliverer, typed_deliverer
 
 
 class Scope(enum.IntEnum):
@@ -164,7 +165,6 @@ class Node(abc.ABC):
     def advertise(self, topic: str, msg_type: str) -> Publisher:
         """Advertise ``topic`` with the exact type string ``msg_type``."""
 
-    @abc.abstractmethod
     def subscribe(
         self,
         topic: str,
@@ -179,8 +179,9 @@ class Node(abc.ABC):
         ``queue_size`` None runs ``callback`` on the node's I/O thread; N gives the
         subscription its own delivery thread behind a drop-oldest queue of N messages.
         """
+        deliver = raw_deliverer(self.count, callback)
+        return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
 
-    @abc.abstractmethod
     def subscribe_typed(
         self,
         topic: str,
@@ -191,11 +192,30 @@ class Node(abc.ABC):
         ignore_local: bool = False,
         queue_size: int | None = None,
     ) -> Subscription:
-        """Like :meth:`subscribe`, decoding with ``msg_class.FromString``.
+        """Like :meth:`subscribe`, decoding with ``msg_class.FromString`` (no payload copy).
 
-        ``msg_type`` defaults to the class's full protobuf name. Undecodable payloads are
-        counted in ``stats.payloads_undecodable``.
+        ``msg_type`` defaults to the class's full protobuf name, which is always ``gz.msgs.X``:
+        to match a Fortress publisher pass ``msg_type="ignition.msgs.X"``. Undecodable
+        payloads are counted in ``stats.payloads_undecodable``.
         """
+        deliver = typed_deliverer(self.count, msg_class, callback)
+        wanted = msg_type or msg_class.DESCRIPTOR.full_name
+        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size)
+
+    @abc.abstractmethod
+    def count(self, name: str, amount: int = 1) -> None:
+        """Add to one of the ``stats`` counters (thread-safe)."""
+
+    @abc.abstractmethod
+    def _add_subscription(
+        self,
+        topic: str,
+        msg_type: str,
+        deliver: Deliver,
+        ignore_local: bool,
+        queue_size: int | None,
+    ) -> Subscription:
+        """Register a subscription that hands each matching payload to ``deliver``."""
 
     @abc.abstractmethod
     def advertise_service(

@@ -11,11 +11,12 @@ import collections
 import logging
 import threading
 from collections.abc import Callable
-from typing import Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from google.protobuf.message import DecodeError
 
-from ros_gz_bridge_py.transport.api import MessageInfo
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.transport.api import MessageInfo
 
 T = TypeVar("T")
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
@@ -24,7 +25,7 @@ _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 Payload = bytes | bytearray | memoryview
 #: A node's counter increment, e.g. ``node.count("callback_errors")``.
 Count = Callable[[str], None]
-Deliver = Callable[[Payload, MessageInfo], None]
+Deliver = Callable[[Payload, "MessageInfo"], None]
 
 
 def raw_deliverer(count: Count, callback: Callable[[bytes, MessageInfo], None]) -> Deliver:

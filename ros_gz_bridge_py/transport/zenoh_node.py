@@ -52,14 +52,12 @@ from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import (
     MessageInfo,
     Node,
-    RawCallback,
     ReplyCallback,
     ServiceHandler,
     TopicInfo,
     TransportStats,
-    TypedCallback,
 )
-from ros_gz_bridge_py.transport.delivery import Deliver, raw_deliverer, typed_deliverer
+from ros_gz_bridge_py.transport.delivery import Deliver
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zenoh_config import Overrides, session_config
@@ -268,34 +266,6 @@ class ZenohNode(Node):
             not sub.ignore_local and sub.accepts(publisher.msg_type)
             for sub in self._subscriptions.get(publisher.fqn, ())
         )
-
-    def subscribe(
-        self,
-        topic: str,
-        callback: RawCallback,
-        msg_type: str = GENERIC_TYPE,
-        *,
-        ignore_local: bool = False,
-        queue_size: int | None = None,
-    ) -> ZenohSubscription:
-        """Receive raw payloads of ``msg_type`` on ``topic`` (see :class:`Node`)."""
-        deliver = raw_deliverer(self.count, callback)
-        return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
-
-    def subscribe_typed(
-        self,
-        topic: str,
-        msg_class: type[Any],
-        callback: TypedCallback,
-        *,
-        msg_type: str | None = None,
-        ignore_local: bool = False,
-        queue_size: int | None = None,
-    ) -> ZenohSubscription:
-        """Receive decoded messages; ``msg_type`` defaults to the class's full name."""
-        deliver = typed_deliverer(self.count, msg_class, callback)
-        wanted = msg_type or msg_class.DESCRIPTOR.full_name
-        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size)
 
     def _add_subscription(
         self,

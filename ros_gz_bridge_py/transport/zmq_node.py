@@ -46,15 +46,12 @@ from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import (
     MessageInfo,
     Node,
-    RawCallback,
     ReplyCallback,
     Scope,
     ServiceHandler,
     TopicInfo,
     TransportStats,
-    TypedCallback,
 )
-from ros_gz_bridge_py.transport.delivery import raw_deliverer, typed_deliverer
 from ros_gz_bridge_py.transport.discovery import (
     INIT_DELAY,
     DiscoveryEngine,
@@ -364,36 +361,6 @@ class ZmqNode(Node):
             not sub.ignore_local and sub.accepts(publisher.msg_type)
             for sub in self._subscriptions.get(publisher.fqn, ())
         )
-
-    def subscribe(
-        self,
-        topic: str,
-        callback: RawCallback,
-        msg_type: str = GENERIC_TYPE,
-        *,
-        ignore_local: bool = False,
-        queue_size: int | None = None,
-    ) -> ZmqSubscription:
-        """Receive raw payloads of ``msg_type`` on ``topic`` (see :class:`Node`)."""
-        deliver = raw_deliverer(self.count, callback)
-        return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
-
-    def subscribe_typed(
-        self,
-        topic: str,
-        msg_class: type[Any],
-        callback: TypedCallback,
-        *,
-        msg_type: str | None = None,
-        ignore_local: bool = False,
-        queue_size: int | None = None,
-    ) -> ZmqSubscription:
-        """Receive decoded messages. To match a Fortress publisher pass
-        ``msg_type="ignition.msgs.X"``: the class's own name is ``gz.msgs.X``.
-        """
-        deliver = typed_deliverer(self.count, msg_class, callback)
-        wanted = msg_type or msg_class.DESCRIPTOR.full_name
-        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size)
 
     def _add_subscription(
         self,
