@@ -29,7 +29,7 @@ pytestmark = pytest.mark.peer
 
 STRING = "ignition.msgs.StringMsg"
 LOOPBACK_ADDRESS = r"tcp://127\.0\.0\.1:\d+"
-ONE_SHOT_ATTEMPTS = 3
+ONE_SHOT_ATTEMPTS = 6
 
 
 def publish_until(publisher: Any, done: Any, what: str, timeout: float = 10.0) -> list[str]:
