@@ -144,17 +144,30 @@ def now_ns() -> int:
     return time.monotonic_ns()
 
 
+def _ros_time(kind: Kind, msg: Any) -> Any:
+    """The builtin_interfaces/Time of a ROS message of ``kind`` that carries the stamp."""
+    if kind.stamp_at == "clock":
+        return msg.clock
+    if kind.stamp_at == "transform":
+        return msg.transforms[0].header.stamp
+    return msg.header.stamp
+
+
+def _gz_time(kind: Kind, msg: Any) -> Any:
+    """The gz.msgs.Time of a Gazebo message of ``kind`` that carries the stamp."""
+    if kind.stamp_at == "clock":
+        return msg.sim
+    if kind.stamp_at == "transform":
+        return msg.pose[0].header.stamp
+    return msg.header.stamp
+
+
 def stamp_ros(kind: Kind, msg: Any, stamp_ns: int) -> None:
-    """Write ``stamp_ns`` into a ROS message of ``kind``."""
+    """Write ``stamp_ns`` into a ROS message of ``kind`` (Twist has no stamp: linear.x)."""
     if kind.stamp_at == "twist":
         msg.linear.x = stamp_ns / NS
         return
-    if kind.stamp_at == "clock":
-        time_msg = msg.clock
-    elif kind.stamp_at == "transform":
-        time_msg = msg.transforms[0].header.stamp
-    else:
-        time_msg = msg.header.stamp
+    time_msg = _ros_time(kind, msg)
     time_msg.sec, time_msg.nanosec = divmod(stamp_ns, NS)
 
 
@@ -163,12 +176,7 @@ def ros_stamp(kind: Kind, msg: Any) -> int:
     if kind.stamp_at == "twist":
         seconds: float = msg.linear.x
         return round(seconds * NS)
-    if kind.stamp_at == "clock":
-        time_msg = msg.clock
-    elif kind.stamp_at == "transform":
-        time_msg = msg.transforms[0].header.stamp
-    else:
-        time_msg = msg.header.stamp
+    time_msg = _ros_time(kind, msg)
     return int(time_msg.sec) * NS + int(time_msg.nanosec)
 
 
@@ -177,12 +185,7 @@ def stamp_gz(kind: Kind, msg: Any, stamp_ns: int) -> None:
     if kind.stamp_at == "twist":
         msg.linear.x = stamp_ns / NS
         return
-    if kind.stamp_at == "clock":
-        time_msg = msg.sim
-    elif kind.stamp_at == "transform":
-        time_msg = msg.pose[0].header.stamp
-    else:
-        time_msg = msg.header.stamp
+    time_msg = _gz_time(kind, msg)
     time_msg.sec, time_msg.nsec = divmod(stamp_ns, NS)
 
 
@@ -191,12 +194,7 @@ def gz_stamp(kind: Kind, msg: Any) -> int:
     if kind.stamp_at == "twist":
         seconds: float = msg.linear.x
         return round(seconds * NS)
-    if kind.stamp_at == "clock":
-        time_msg = msg.sim
-    elif kind.stamp_at == "transform":
-        time_msg = msg.pose[0].header.stamp
-    else:
-        time_msg = msg.header.stamp
+    time_msg = _gz_time(kind, msg)
     return int(time_msg.sec) * NS + int(time_msg.nsec)
 
 
