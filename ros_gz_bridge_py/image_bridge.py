@@ -39,13 +39,7 @@ from ros_gz_bridge_py.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
-from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
-from ros_gz_bridge_py.runtime import (
-    make_executor,
-    spin_until_stopped,
-    tune_allocator,
-    tune_threads,
-)
+from ros_gz_bridge_py.runtime import apply_speed_settings, make_executor, spin_until_stopped
 from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import NodeOptions
 
@@ -188,9 +182,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
 
     if stop is not None and stop.requested:
         return 0
-    tune_allocator()
-    tune_threads()
-    apply_fastdds_profile()
+    apply_speed_settings()
     rclpy.init(args=[argv[0], *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     if stop is not None:
         return run(topics, stop)

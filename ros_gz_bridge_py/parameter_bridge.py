@@ -34,13 +34,7 @@ from ros_gz_bridge_py.config import (
     parse_parameter_bridges,
     read_yaml_file,
 )
-from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
-from ros_gz_bridge_py.runtime import (
-    make_executor,
-    spin_until_stopped,
-    tune_allocator,
-    tune_threads,
-)
+from ros_gz_bridge_py.runtime import apply_speed_settings, make_executor, spin_until_stopped
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.status import DiagnosticsPublisher, start_diagnostics, table_on_signal
 from ros_gz_bridge_py.stop_signal import StopSignal
@@ -144,9 +138,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
 
     if stop is not None and stop.requested:
         return 0
-    tune_allocator()
-    tune_threads()
-    apply_fastdds_profile()
+    apply_speed_settings()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     with contextlib.ExitStack() as scope:
         if stop is None:

@@ -27,6 +27,7 @@ from typing import Any
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
+from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
 from ros_gz_bridge_py.stop_signal import StopSignal
 
 M_TRIM_THRESHOLD = -1
@@ -44,6 +45,13 @@ SWITCH_INTERVAL = 0.0005
 def tune_threads() -> None:
     """Shorten the GIL switch interval so a heavy channel cannot delay light ones for long."""
     sys.setswitchinterval(SWITCH_INTERVAL)
+
+
+def apply_speed_settings() -> None:
+    """Everything the executables set before ``rclpy.init``: allocator, GIL, Fast DDS profile."""
+    tune_allocator()
+    tune_threads()
+    apply_fastdds_profile()
 
 
 def tune_allocator() -> bool:
