@@ -22,6 +22,7 @@ The bridge creates a wall-clock (steady) timer on the node that re-evaluates laz
 
 from __future__ import annotations
 
+import os
 import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -48,6 +49,9 @@ from ros_gz_bridge_py.side_node import SideNode, side_node_name
 from ros_gz_bridge_py.transport import Node as GzNode
 from ros_gz_bridge_py.transport import NodeOptions, create_node
 
+#: Environment switch: ``off`` sends images and point clouds through the object path.
+BULK_PATH_ENV = "ROS_GZ_BRIDGE_BULK_PATH"
+
 
 @dataclass
 class BridgeHandle:
@@ -67,6 +71,8 @@ class BridgeOptions:
     override_timestamps_with_wall_time: bool = False
     override_frame_id: str = ""
     service_timeout: float = DEFAULT_TIMEOUT
+    #: Images and point clouds on the bulk path (``ROS_GZ_BRIDGE_BULK_PATH=off`` also disables).
+    bulk_path: bool = True
 
 
 class Bridge:
@@ -99,6 +105,7 @@ class Bridge:
             ),
             wall_time_stamps=self.options.override_timestamps_with_wall_time,
             override_frame_id=self.options.override_frame_id,
+            bulk_path=self.options.bulk_path and os.environ.get(BULK_PATH_ENV, "").lower() != "off",
         )
         self._logger = ros_node.get_logger()
         self._lock = threading.RLock()

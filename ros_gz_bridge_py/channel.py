@@ -10,6 +10,10 @@ closes exactly those (never "everything on this topic").
 Threads: Gazebo->ROS messages are decoded, converted and published on the channel's own
 delivery thread (a bounded, drop-oldest queue in the transport), so a heavy topic never delays
 a light one and never touches the ROS executor. ROS->Gazebo messages arrive on the executor.
+
+Pairs with a bulk path (Image, PointCloud2) take it unless ``ChannelContext.bulk_path`` is off:
+serialized messages on the ROS side, the bulk bytes copied once, and the DDS write made with
+the GIL released (see :mod:`ros_gz_bridge_py.bulk`).
 """
 
 from __future__ import annotations
@@ -22,6 +26,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from rclpy.serialization import deserialize_message
+
+from ros_gz_bridge_py.bulk.path import BulkPath, gz_to_ros_cdr, ros_cdr_to_gz
+from ros_gz_bridge_py.bulk.serialized_publisher import SerializedPublisher
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.loop_guard import OwnPublications
@@ -89,6 +97,8 @@ class ChannelContext:
     own_nodes: frozenset[tuple[str, str]] = frozenset()
     wall_time_stamps: bool = False
     override_frame_id: str = ""
+    #: Take the bulk path for pairs that have one (off: always the object path).
+    bulk_path: bool = True
     #: OwnPublications per resolved ROS topic, shared by the two halves of a bidirectional bridge.
     own_publications: Callable[[str], OwnPublications] = field(
         default_factory=_own_publications_table
@@ -113,6 +123,7 @@ class Channel(abc.ABC):
         self.ros_topic = ctx.resolve(spec.ros_topic)
         self._logger = ctx.ros_node.get_logger()
         self._last_error_log = 0.0
+        self.bulk: BulkPath | None = pair.bulk if ctx.bulk_path else None
 
     def start(self) -> None:
         """Open the output side, and the input side unless the channel is lazy."""
@@ -236,7 +247,8 @@ class GzToRosChannel(Channel):
             self._qos,
             qos_overriding_options=PUBLISHER_OVERRIDES,
         )
-        self._publish = self.ctx.own_publications(self.ros_topic).wrap(self._publisher)
+        publisher = self._publisher if self.bulk is None else SerializedPublisher(self._publisher)
+        self._publish = self.ctx.own_publications(self.ros_topic).wrap(publisher)
 
     def _close_output(self) -> None:
         self._publish = _closed_publish
@@ -245,13 +257,24 @@ class GzToRosChannel(Channel):
             self._publisher = None
 
     def _open_input(self) -> None:
+        depth = self._qos.depth or 1
+        if self.bulk is not None:
+            self._subscription = self.ctx.gz_node.subscribe(
+                self.spec.gz_topic,
+                self._on_gz_payload,
+                self.spec.gz_type,
+                ignore_local=True,
+                queue_size=depth,
+                copy=False,
+            )
+            return
         self._subscription = self.ctx.gz_node.subscribe_typed(
             self.spec.gz_topic,
             self._gz_class,
             self._on_gz_message,
             msg_type=self.spec.gz_type,
             ignore_local=True,
-            queue_size=self._qos.depth or 1,
+            queue_size=depth,
         )
 
     def _close_input(self) -> None:
@@ -275,6 +298,18 @@ class GzToRosChannel(Channel):
             self._conversion_failed(err)
             return
         self._publish(ros_msg)
+        self.stats.published += 1
+
+    def _on_gz_payload(self, payload: Any, _info: MessageInfo) -> None:
+        """The bulk path: Gazebo payload straight to a serialized ROS message."""
+        self.stats.received += 1
+        assert self.bulk is not None  # subscribed this way only with a bulk path
+        try:
+            cdr = gz_to_ros_cdr(self.bulk, self._gz_class, memoryview(payload), self._finish)
+        except Exception as err:
+            self._conversion_failed(err)
+            return
+        self._publish(cdr)
         self.stats.published += 1
 
 
@@ -333,6 +368,7 @@ class RosToGzChannel(Channel):
             callback,
             self._qos,
             qos_overriding_options=SUBSCRIPTION_OVERRIDES,
+            raw=self.bulk is not None,
         )
         self._subscription_node = node
 
@@ -351,12 +387,16 @@ class RosToGzChannel(Channel):
         self._on_ros_message(ros_msg)
 
     def _on_ros_message(self, ros_msg: Any) -> None:
+        """``ros_msg`` is a message object, or its CDR bytes on the bulk path."""
         self.stats.received += 1
         publisher = self._gz_publisher
         if publisher is None:
             return
         try:
-            publisher.publish(self.pair.to_gz(ros_msg))
+            if self.bulk is None:
+                publisher.publish(self.pair.to_gz(ros_msg))
+            else:
+                self._publish_serialized(publisher, ros_msg)
         except Exception as err:
             self._conversion_failed(err)
             return
@@ -367,6 +407,14 @@ class RosToGzChannel(Channel):
                 f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
                 "(showing msg only once per type)"
             )
+
+    def _publish_serialized(self, publisher: Publisher, cdr: bytes) -> None:
+        assert self.bulk is not None  # subscribed raw only with a bulk path
+        payload = ros_cdr_to_gz(self.bulk, self.pair.ros_class, cdr)
+        if payload is None:  # not plain CDR: let rclpy read it and take the object path
+            publisher.publish(self.pair.to_gz(deserialize_message(cdr, self.pair.ros_class)))
+        else:
+            publisher.publish_raw(payload)
 
 
 def _closed_publish(_msg: Any) -> None:

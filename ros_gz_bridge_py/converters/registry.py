@@ -23,9 +23,12 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from importlib.metadata import entry_points
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.errors import BridgeError, UnsupportedTypeError
+
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.bulk.path import BulkPath
 
 ENTRY_POINT_GROUP = "ros_gz_bridge_py.converters"
 
@@ -73,6 +76,8 @@ class Pair:
     ros_class: type[Any]
     #: Where it came from (module name), for listings and error messages.
     origin: str = field(default="", compare=False)
+    #: For large messages: how channels convert them without copying the bulk bytes around.
+    bulk: BulkPath | None = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)

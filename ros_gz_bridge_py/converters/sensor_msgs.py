@@ -32,6 +32,7 @@ from sensor_msgs.msg import (
     Range,
 )
 
+from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters.geometry_msgs import (
     covariance_to_ros,
     fill_gz_covariance,
@@ -42,12 +43,14 @@ from ros_gz_bridge_py.converters.geometry_msgs import (
 )
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.converters.sensor_msgs_image import (
+    IMAGE_BULK,
     camera_info_to_gz,
     camera_info_to_ros,
     image_to_gz,
     image_to_ros,
 )
 from ros_gz_bridge_py.converters.sensor_msgs_scan import (
+    POINT_CLOUD2_BULK,
     laser_scan_to_gz,
     laser_scan_to_ros,
     point_cloud2_to_gz,
@@ -244,15 +247,18 @@ def nav_sat_fix_to_ros(gz: Any) -> Any:
     return ros
 
 
-def _pair(ros_class: type[Any], gz_type: str, to_gz: Any, to_ros: Any) -> Pair:
-    return Pair(f"sensor_msgs/msg/{ros_class.__name__}", gz_type, to_gz, to_ros, ros_class)
+def _pair(
+    ros_class: type[Any], gz_type: str, to_gz: Any, to_ros: Any, bulk: BulkPath | None = None
+) -> Pair:
+    name = f"sensor_msgs/msg/{ros_class.__name__}"
+    return Pair(name, gz_type, to_gz, to_ros, ros_class, bulk=bulk)
 
 
 PAIRS = (
     _pair(BatteryState, "gz.msgs.BatteryState", battery_state_to_gz, battery_state_to_ros),
     _pair(CameraInfo, "gz.msgs.CameraInfo", camera_info_to_gz, camera_info_to_ros),
     _pair(FluidPressure, "gz.msgs.FluidPressure", fluid_pressure_to_gz, fluid_pressure_to_ros),
-    _pair(Image, "gz.msgs.Image", image_to_gz, image_to_ros),
+    _pair(Image, "gz.msgs.Image", image_to_gz, image_to_ros, IMAGE_BULK),
     _pair(Imu, "gz.msgs.IMU", imu_to_gz, imu_to_ros),
     _pair(Imu, "ignition.msgs.IMU", imu_to_gz_fortress, imu_to_ros_fortress),
     _pair(JointState, "gz.msgs.Model", joint_state_to_gz, joint_state_to_ros),
@@ -260,6 +266,12 @@ PAIRS = (
     _pair(LaserScan, "gz.msgs.LaserScan", laser_scan_to_gz, laser_scan_to_ros),
     _pair(MagneticField, "gz.msgs.Magnetometer", magnetic_field_to_gz, magnetic_field_to_ros),
     _pair(NavSatFix, "gz.msgs.NavSat", nav_sat_fix_to_gz, nav_sat_fix_to_ros),
-    _pair(PointCloud2, "gz.msgs.PointCloudPacked", point_cloud2_to_gz, point_cloud2_to_ros),
+    _pair(
+        PointCloud2,
+        "gz.msgs.PointCloudPacked",
+        point_cloud2_to_gz,
+        point_cloud2_to_ros,
+        POINT_CLOUD2_BULK,
+    ),
     _pair(Range, "gz.msgs.LaserScan", range_to_gz, range_to_ros),
 )

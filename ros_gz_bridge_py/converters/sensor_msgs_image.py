@@ -1,7 +1,9 @@
 """sensor_msgs Image and CameraInfo converters (conversions.md §3.5); paired in sensor_msgs.py.
 
-Image data is copied once, as ``bytes``. The ROS ``step`` (row padding) and ``is_bigendian``
-are ignored, as in the reference: ``step`` is recomputed from width and encoding.
+Image data is copied once, as ``bytes``; on the bulk path (``IMAGE_BULK``) the channel converts
+only the other fields with the ``*_meta_*`` halves and copies the data once into the output.
+The ROS ``step`` (row padding) and ``is_bigendian`` are ignored, as in the reference: ``step``
+is recomputed from width and encoding.
 
 Differences from ros_gz_bridge:
 - Image R→G with an unknown encoding raises ConversionError (C++ prints and publishes an
@@ -20,6 +22,8 @@ from typing import Any
 
 from sensor_msgs.msg import CameraInfo, Image
 
+from ros_gz_bridge_py.bulk.cdr import HEADER
+from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
@@ -49,7 +53,8 @@ DISTORTION_MODELS: dict[str, int] = {"plumb_bob": 0, "rational_polynomial": 1, "
 _DISTORTION_NAMES = {value: name for name, value in DISTORTION_MODELS.items()}
 
 
-def image_to_gz(ros: Any) -> Any:
+def image_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
+    """Every field but ``data``; returns the gz Image and how many data bytes it takes."""
     entry = ENCODINGS.get(ros.encoding)
     if entry is None:
         msg = (
@@ -65,18 +70,24 @@ def image_to_gz(ros: Any) -> Any:
     gz.pixel_format_type = pixel_format
     gz.step = ros.width * channels * depth
     size = gz.step * ros.height
-    data = ros.data
-    if len(data) < size:
+    if data_size < size:
         msg = (
-            f"sensor_msgs/msg/Image data has {len(data)} bytes, fewer than "
+            f"sensor_msgs/msg/Image data has {data_size} bytes, fewer than "
             f"height*width*bytes_per_pixel = {size} for {ros.width}x{ros.height} {ros.encoding}"
         )
         raise ConversionError(msg)
+    return gz, size
+
+
+def image_to_gz(ros: Any) -> Any:
+    data = ros.data
+    gz, size = image_meta_to_gz(ros, len(data))
     gz.data = bytes(memoryview(data)[:size])
     return gz
 
 
-def image_to_ros(gz: Any) -> Any:
+def image_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
+    """Every field but ``data``; returns the ROS Image and how many data bytes it takes."""
     entry = PIXEL_FORMATS.get(gz.pixel_format_type)
     if entry is None:
         msg = f"gz.msgs.Image pixel_format_type {gz.pixel_format_type} has no ROS encoding"
@@ -90,15 +101,29 @@ def image_to_ros(gz: Any) -> Any:
     ros.is_bigendian = 0
     ros.step = gz.width * bytes_per_pixel
     size = ros.step * gz.height
-    data: bytes = gz.data
-    if len(data) < size:
+    if data_size < size:
         msg = (
-            f"gz.msgs.Image data has {len(data)} bytes, fewer than height*step = {size} "
+            f"gz.msgs.Image data has {data_size} bytes, fewer than height*step = {size} "
             f"for {gz.width}x{gz.height} {encoding}"
         )
         raise ConversionError(msg)
+    return ros, size
+
+
+def image_to_ros(gz: Any) -> Any:
+    data: bytes = gz.data
+    ros, size = image_meta_to_ros(gz, len(data))
     ros.data = data if len(data) == size else data[:size]
     return ros
+
+
+#: Image on the bulk path: gz ``data`` is field 5; ROS ``data`` is the last field.
+IMAGE_BULK = BulkPath(
+    gz_field=5,
+    ros_layout=(*HEADER, "u32", "u32", "str", "u8", "u32", "bulk"),
+    gz_meta_to_ros=image_meta_to_ros,
+    ros_meta_to_gz=image_meta_to_gz,
+)
 
 
 def camera_info_to_gz(ros: Any) -> Any:

@@ -28,6 +28,8 @@ from typing import Any
 import numpy as np
 from sensor_msgs.msg import LaserScan, PointCloud2, PointField, Range
 
+from ros_gz_bridge_py.bulk.cdr import HEADER, Sequence
+from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header, gz_to_ros_frame
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
@@ -130,8 +132,9 @@ def range_to_ros(gz: Any) -> Any:
     return ros
 
 
-def point_cloud2_to_gz(ros: Any) -> Any:
-    """An unknown ROS datatype becomes gz INT8, silently, as in C++."""
+def point_cloud2_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
+    """Every field but ``data`` (all of which is taken). An unknown ROS datatype becomes gz
+    INT8, silently, as in C++."""
     gz = GzPointCloudPacked()
     fill_gz_header(ros.header, gz.header)
     gz.height = ros.height
@@ -140,7 +143,6 @@ def point_cloud2_to_gz(ros: Any) -> Any:
     gz.point_step = ros.point_step
     gz.row_step = ros.row_step
     gz.is_dense = ros.is_dense
-    gz.data = bytes(ros.data)
     for field in ros.fields:
         datatype = field.datatype
         gz.field.add(
@@ -149,11 +151,18 @@ def point_cloud2_to_gz(ros: Any) -> Any:
             count=field.count,
             datatype=datatype - _DATATYPE_OFFSET if datatype in _ROS_DATATYPES else _GZ_INT8,
         )
+    return gz, data_size
+
+
+def point_cloud2_to_gz(ros: Any) -> Any:
+    gz, _ = point_cloud2_meta_to_gz(ros, 0)
+    gz.data = bytes(ros.data)
     return gz
 
 
-def point_cloud2_to_ros(gz: Any) -> Any:
-    """An unknown gz datatype becomes ROS INT8, silently, as in C++."""
+def point_cloud2_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
+    """Every field but ``data`` (all of which is taken). An unknown gz datatype becomes ROS
+    INT8, silently, as in C++."""
     ros = PointCloud2()
     fill_ros_header(gz.header, ros.header)
     ros.height = gz.height
@@ -162,7 +171,6 @@ def point_cloud2_to_ros(gz: Any) -> Any:
     ros.point_step = gz.point_step
     ros.row_step = gz.row_step
     ros.is_dense = gz.is_dense
-    ros.data = gz.data
     fields = []
     for field in gz.field:
         datatype = field.datatype + _DATATYPE_OFFSET
@@ -175,4 +183,28 @@ def point_cloud2_to_ros(gz: Any) -> Any:
             )
         )
     ros.fields = fields
+    return ros, data_size
+
+
+def point_cloud2_to_ros(gz: Any) -> Any:
+    ros, _ = point_cloud2_meta_to_ros(gz, 0)
+    ros.data = gz.data
     return ros
+
+
+#: PointCloud2 on the bulk path: gz ``data`` is field 8; in ROS only ``is_dense`` follows it.
+POINT_CLOUD2_BULK = BulkPath(
+    gz_field=8,
+    ros_layout=(
+        *HEADER,
+        "u32",
+        "u32",
+        Sequence(("str", "u32", "u8", "u32")),
+        "u8",
+        "u32",
+        "u32",
+        "bulk",
+    ),
+    gz_meta_to_ros=point_cloud2_meta_to_ros,
+    ros_meta_to_gz=point_cloud2_meta_to_gz,
+)

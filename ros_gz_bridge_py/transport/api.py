@@ -97,7 +97,7 @@ class TransportStats:
 
 
 #: Raw subscription callback: ``callback(payload, info)``.
-RawCallback = Callable[[bytes, MessageInfo], None]
+RawCallback = Callable[[Any, MessageInfo], None]
 #: Typed subscription callback: ``callback(message, info)``.
 TypedCallback = Callable[[Any, MessageInfo], None]
 #: Service handler: ``handler(request bytes) -> (success, response bytes)``.
@@ -173,13 +173,16 @@ class Node(abc.ABC):
         *,
         ignore_local: bool = False,
         queue_size: int | None = None,
+        copy: bool = True,
     ) -> Subscription:
         """Receive raw payloads of ``msg_type`` (exact string; GENERIC_TYPE = any).
 
         ``queue_size`` None runs ``callback`` on the node's I/O thread; N gives the
         subscription its own delivery thread behind a drop-oldest queue of N messages.
+        ``copy=False`` hands over the backend's buffer (``bytes`` or a read-only
+        ``memoryview``) instead of copying it into ``bytes``.
         """
-        deliver = raw_deliverer(self.count, callback)
+        deliver = raw_deliverer(self.count, callback, copy=copy)
         return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
 
     def subscribe_typed(

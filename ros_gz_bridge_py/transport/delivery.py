@@ -28,12 +28,17 @@ Count = Callable[[str], None]
 Deliver = Callable[[Payload, "MessageInfo"], None]
 
 
-def raw_deliverer(count: Count, callback: Callable[[bytes, MessageInfo], None]) -> Deliver:
-    """A deliver function that hands ``bytes`` to ``callback``, counting its errors."""
+def raw_deliverer(
+    count: Count, callback: Callable[[Any, MessageInfo], None], *, copy: bool = True
+) -> Deliver:
+    """A deliver function that hands the payload to ``callback``, counting its errors.
+
+    With ``copy`` the payload arrives as ``bytes``; without, as the backend's buffer.
+    """
 
     def deliver(payload: Payload, info: MessageInfo) -> None:
         try:
-            callback(payload if isinstance(payload, bytes) else bytes(payload), info)
+            callback(payload if not copy or isinstance(payload, bytes) else bytes(payload), info)
         except Exception:
             count("callback_errors")
             _LOG.exception("subscription callback for %s raised", info.topic)

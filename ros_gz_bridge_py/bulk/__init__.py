@@ -1,0 +1,16 @@
+"""The bulk path: large messages converted without touching their bulk bytes.
+
+An Image or a PointCloud2 is a few hundred bytes of metadata around megabytes of ``data``.
+The object path (protobuf message -> converter -> rclpy message -> rclpy publish) copies those
+megabytes about six times and holds the GIL through the DDS write. The bulk path instead:
+
+- splits the Gazebo payload into its small fields and a view of the bulk field
+  (:mod:`.protowire`), converts only the small fields with the pair's own converter, lets rclpy
+  serialize that small message, and splices the bulk view into the CDR (:mod:`.cdr`): one copy;
+- publishes the CDR bytes through ``rcl_publish_serialized_message`` with the GIL released
+  (:mod:`.serialized_publisher`), so other topics keep flowing during the DDS write;
+- the other way, walks the serialized ROS message to the bulk field, converts the small rest,
+  and appends the bulk bytes to the small protobuf payload: one copy.
+
+:class:`BulkPath` (in :mod:`.path`) holds what one pair needs; the pair's module declares it.
+"""

@@ -1,0 +1,84 @@
+"""What a pair needs for the bulk path, and the two conversions built on it."""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from google.protobuf.message import DecodeError
+from rclpy.serialization import deserialize_message, serialize_message
+
+from ros_gz_bridge_py.bulk.cdr import Layout, locate_bulk
+from ros_gz_bridge_py.bulk.protowire import bytes_field_prefix, split_bytes_field
+from ros_gz_bridge_py.errors import ConversionError
+
+#: Converts a message without its bulk field, given the bulk field's length; returns the other
+#: side's message without its bulk field and how many bulk bytes it takes (a prefix).
+#: Raises ConversionError when the bulk field is too short for the metadata.
+MetaConverter = Callable[[Any, int], tuple[Any, int]]
+_EMPTY_SEQUENCE = b"\0\0\0\0"
+
+
+@dataclass(frozen=True)
+class BulkPath:
+    """How one pair's bulk field maps between the gz protobuf and the ROS CDR.
+
+    The ROS fields after the bulk field must all be 1-byte aligned (bool, uint8), so that
+    splicing bytes in does not move their alignment; true of Image (none) and PointCloud2
+    (``is_dense``).
+    """
+
+    #: Field number of the bulk ``bytes`` field in the gz message.
+    gz_field: int
+    #: The ROS message's CDR layout up to and including its ``uint8[]`` bulk field.
+    ros_layout: Layout
+    gz_meta_to_ros: MetaConverter
+    ros_meta_to_gz: MetaConverter
+
+
+def gz_to_ros_cdr(
+    path: BulkPath,
+    gz_class: type[Any],
+    payload: memoryview,
+    finish: Callable[[Any], None] | None = None,
+) -> bytes:
+    """Gazebo payload -> serialized ROS message; the bulk bytes are copied once.
+
+    ``finish`` may edit the ROS message (header overrides) before it is serialized.
+    """
+    rest, bulk = split_bytes_field(payload, path.gz_field)
+    try:
+        small = gz_class.FromString(rest)
+    except DecodeError as err:
+        msg = f"{gz_class.DESCRIPTOR.full_name} payload is not a valid message: {err}"
+        raise ConversionError(msg) from err
+    ros, used = path.gz_meta_to_ros(small, len(bulk))
+    if finish is not None:
+        finish(ros)
+    cdr = memoryview(serialize_message(ros))
+    where = locate_bulk(cdr, path.ros_layout)
+    if where is None:  # rclpy always writes plain CDR; kept total for the type checker
+        msg = "rclpy produced a serialized message that is not plain CDR"
+        raise ConversionError(msg)
+    length = struct.pack("<I" if where.little_endian else ">I", used)
+    return b"".join((cdr[: where.length_at], length, bulk[:used], cdr[where.end :]))
+
+
+def ros_cdr_to_gz(path: BulkPath, ros_class: type[Any], cdr: bytes) -> bytes | None:
+    """Serialized ROS message -> Gazebo payload; the bulk bytes are copied once.
+
+    Returns None when ``cdr`` is not plain CDR (another encapsulation); the caller then
+    deserializes it whole and takes the object path.
+    """
+    view = memoryview(cdr)
+    where = locate_bulk(view, path.ros_layout)
+    if where is None:
+        return None
+    ros = deserialize_message(
+        b"".join((view[: where.length_at], _EMPTY_SEQUENCE, view[where.end :])), ros_class
+    )
+    gz, used = path.ros_meta_to_gz(ros, where.end - where.start)
+    prefix = bytes_field_prefix(path.gz_field, used)
+    return b"".join((gz.SerializeToString(), prefix, view[where.start : where.start + used]))
