@@ -25,9 +25,10 @@ GOAL_SHARE = 0.95
 MARGIN = 3.0
 
 
-#: A paced flood: above what the bridge converts per second (about 60 1080p frames), so the
-#: bridge is saturated, without the publisher process taking a whole core of its own.
-PACED_FLOOD_HZ = 100.0
+#: A paced flood: above what the bridge converts per second (about 150 1080p frames on the
+#: bulk path), so the bridge is saturated and drops frames, without the publisher process
+#: taking a whole core of its own.
+PACED_FLOOD_HZ = 200.0
 
 
 def clock_under_flood(

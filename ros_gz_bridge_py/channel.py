@@ -10,6 +10,11 @@ closes exactly those (never "everything on this topic").
 Threads: Gazebo->ROS messages are decoded, converted and published on the channel's own
 delivery thread (a bounded, drop-oldest queue in the transport), so a heavy topic never delays
 a light one and never touches the ROS executor. ROS->Gazebo messages arrive on the executor.
+The queue holds at least :data:`MIN_DELIVERY_QUEUE` messages (more if the publisher depth is
+larger) within the transport's byte budget (64 MiB): a burst or a scheduling hiccup of a few
+milliseconds at kilohertz rates is absorbed instead of dropped, and a flood of images still
+keeps only the newest ~10 frames. (The C++ bridge blocks its receive thread instead, so ZeroMQ
+buffers up to 1000 messages of every topic behind a slow one.)
 
 Pairs with a bulk path (Image, PointCloud2) take it unless ``ChannelContext.bulk_path`` is off:
 serialized messages on the ROS side, the bulk bytes copied once, and the DDS write made with
@@ -44,6 +49,8 @@ from ros_gz_bridge_py.transport import MessageInfo, Node, Publisher, Subscriptio
 
 #: Minimum seconds between two log lines about conversion errors of one channel.
 ERROR_LOG_PERIOD = 5.0
+#: Fewest messages a Gazebo->ROS delivery queue holds.
+MIN_DELIVERY_QUEUE = 100
 
 
 class ChannelState(enum.Enum):
@@ -257,7 +264,7 @@ class GzToRosChannel(Channel):
             self._publisher = None
 
     def _open_input(self) -> None:
-        depth = self._qos.depth or 1
+        depth = max(self._qos.depth, MIN_DELIVERY_QUEUE)
         if self.bulk is not None:
             self._subscription = self.ctx.gz_node.subscribe(
                 self.spec.gz_topic,

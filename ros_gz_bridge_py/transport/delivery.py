@@ -7,11 +7,11 @@ the oldest message is dropped and counted, the same policy as ROS "keep last N".
 
 from __future__ import annotations
 
-import collections
 import logging
+import queue
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast
 
 from google.protobuf.message import DecodeError
 
@@ -70,46 +70,91 @@ def typed_deliverer(
     return deliver
 
 
-class DeliveryQueue(Generic[T]):
-    """Hands items to ``handler`` on a dedicated daemon thread, keeping the newest ``size``."""
+def payload_size(item: tuple[Payload, MessageInfo]) -> int:
+    """The weight of a queued (payload, info) delivery: its payload's size."""
+    return len(item[0])
 
-    def __init__(self, size: int, handler: Callable[[T], None], name: str) -> None:
+
+#: Bytes a delivery queue may hold (at least one item is always kept): ten 1080p frames.
+MAX_QUEUED_BYTES = 64 * 1024 * 1024
+
+
+class DeliveryQueue(Generic[T]):
+    """Hands items to ``handler`` on a dedicated daemon thread, keeping the newest ``size``
+    items and, when ``weigh`` gives their sizes, no more than ``max_bytes`` (but always one).
+
+    Built on :class:`queue.SimpleQueue`, whose put and get are single C calls: at tens of
+    thousands of small messages per second a Condition-based queue costs the producer (the
+    node's I/O thread) more than the message itself. The bound is kept by the producer, which
+    takes the oldest item out when the queue is over ``size``; a get racing with that can make
+    the queue briefly hold one more or one fewer item, never an unbounded number.
+    """
+
+    def __init__(
+        self,
+        size: int,
+        handler: Callable[[T], None],
+        name: str,
+        *,
+        weigh: Callable[[T], int] | None = None,
+        max_bytes: int = MAX_QUEUED_BYTES,
+    ) -> None:
         if size < 1:
             msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
             raise ValueError(msg)
-        self._items: collections.deque[T] = collections.deque(maxlen=size)
+        self._size = size
+        self._weigh = weigh
+        self._max_bytes = max_bytes
+        # Queued bytes = put - dropped (written by the producer) - handled (by the consumer);
+        # one writer per counter, so no lock on the hot path.
+        self._bytes_put = self._bytes_dropped = self._bytes_handled = 0
+        self._items: queue.SimpleQueue[T | object] = queue.SimpleQueue()
         self._handler = handler
-        self._ready = threading.Condition()
         self._closed = False
         self.dropped = 0
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
 
     def put(self, item: T) -> bool:
-        """Queue ``item``; False if that pushed out the oldest one."""
-        with self._ready:
-            full = len(self._items) == self._items.maxlen
-            if full:
-                self.dropped += 1
-            self._items.append(item)
-            self._ready.notify()
-        return not full
+        """Queue ``item``; False if that pushed out older ones."""
+        items = self._items
+        weigh = self._weigh
+        if weigh is not None:
+            self._bytes_put += weigh(item)
+        items.put(item)
+        kept = True
+        while items.qsize() > self._size or (weigh is not None and self._over_budget()):
+            try:
+                oldest = items.get_nowait()
+            except queue.Empty:  # the delivery thread took it first
+                break
+            if weigh is not None:
+                self._bytes_dropped += weigh(cast(T, oldest))
+            self.dropped += 1
+            kept = False
+        return kept
+
+    def _over_budget(self) -> bool:
+        queued = self._bytes_put - self._bytes_dropped - self._bytes_handled
+        return queued > self._max_bytes and self._items.qsize() > 1
 
     def close(self) -> None:
         """Stop after the item being handled; pending items are discarded. Idempotent."""
-        with self._ready:
-            self._closed = True
-            self._items.clear()
-            self._ready.notify()
+        self._closed = True
+        self._items.put(_STOP)
         if self._thread is not threading.current_thread():
             self._thread.join()
 
     def _run(self) -> None:
+        get = self._items.get
         while True:
-            with self._ready:
-                while not self._items and not self._closed:
-                    self._ready.wait()
-                if self._closed:
-                    return
-                item = self._items.popleft()
+            item = cast(T, get())  # only _STOP is not a T, and it comes after close
+            if self._closed:
+                return
+            if self._weigh is not None:
+                self._bytes_handled += self._weigh(item)
             self._handler(item)
+
+
+#: Wakes the delivery thread for :meth:`DeliveryQueue.close`.
+_STOP = object()

@@ -15,7 +15,7 @@ import zenoh
 
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
-from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue
+from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue, payload_size
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zenoh_node import ZenohNode
@@ -103,7 +103,9 @@ class ZenohSubscription(Subscription):
         self._closed = False
         self._queue: DeliveryQueue[Delivery] | None = None
         if queue_size is not None:
-            self._queue = DeliveryQueue(queue_size, self._run, f"gz-sub {topic}")
+            self._queue = DeliveryQueue(
+                queue_size, self._run, f"gz-sub {topic}", weigh=payload_size
+            )
 
     @property
     def dropped(self) -> int:

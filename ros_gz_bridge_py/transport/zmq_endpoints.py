@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
-from ros_gz_bridge_py.transport.delivery import DeliveryQueue
+from ros_gz_bridge_py.transport.delivery import DeliveryQueue, payload_size
 from ros_gz_bridge_py.transport.wire import Frame, PublisherRecord
 
 if TYPE_CHECKING:
@@ -84,7 +84,9 @@ class ZmqSubscription(Subscription):
         self._closed = False
         self._queue: DeliveryQueue[Delivery] | None = None
         if queue_size is not None:
-            self._queue = DeliveryQueue(queue_size, self._run, f"gz-sub {topic}")
+            self._queue = DeliveryQueue(
+                queue_size, self._run, f"gz-sub {topic}", weigh=payload_size
+            )
 
     @property
     def dropped(self) -> int:

@@ -135,7 +135,7 @@ def test_queue_size_drops_oldest() -> None:
         sub = node.subscribe_typed(topic, StringMsg, slow, queue_size=2)
         pub = node.advertise(topic, "gz.msgs.StringMsg")
         pub.publish(StringMsg(data="0"))
-        assert wait_until(lambda: sub._queue is not None and not sub._queue._items)  # type: ignore[attr-defined]
+        assert wait_until(lambda: sub._queue is not None and sub._queue._items.empty())  # type: ignore[attr-defined]
         for i in range(1, 6):
             pub.publish(StringMsg(data=str(i)))
         release.set()

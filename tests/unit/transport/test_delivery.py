@@ -1,0 +1,76 @@
+"""The drop-oldest delivery queue: bounded by count and by bytes, never losing the newest."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from ros_gz_bridge_py.transport.delivery import DeliveryQueue
+
+
+def _blocked_queue(
+    size: int, max_bytes: int
+) -> tuple[DeliveryQueue[bytes], list[bytes], threading.Event]:
+    """A queue whose handler blocks on its first item until the event is set."""
+    handled: list[bytes] = []
+    release = threading.Event()
+    first = threading.Event()
+
+    def handle(item: bytes) -> None:
+        first.set()
+        release.wait(10)
+        handled.append(item)
+
+    queue = DeliveryQueue(size, handle, "test", weigh=len, max_bytes=max_bytes)
+    queue.put(b"first")
+    assert first.wait(5)
+    return queue, handled, release
+
+
+def _drain(handled: list[bytes], count: int) -> None:
+    deadline = time.monotonic() + 5
+    while len(handled) < count and time.monotonic() < deadline:
+        time.sleep(0.005)
+
+
+def test_count_bound_drops_the_oldest() -> None:
+    queue, handled, release = _blocked_queue(size=3, max_bytes=1 << 20)
+    results = [queue.put(bytes([i])) for i in range(6)]
+    assert results == [True, True, True, False, False, False]
+    release.set()
+    _drain(handled, 4)
+    queue.close()
+    assert handled == [b"first", b"\x03", b"\x04", b"\x05"]
+    assert queue.dropped == 3
+
+
+def test_byte_bound_keeps_the_newest_within_budget() -> None:
+    queue, handled, release = _blocked_queue(size=100, max_bytes=25)
+    for i in range(5):
+        queue.put(bytes([i]) * 10)  # 10 bytes each: only two fit in 25
+    release.set()
+    _drain(handled, 3)
+    queue.close()
+    assert handled == [b"first", b"\x03" * 10, b"\x04" * 10]
+    assert queue.dropped == 3
+
+
+def test_one_item_larger_than_the_budget_is_still_delivered() -> None:
+    queue, handled, release = _blocked_queue(size=10, max_bytes=4)
+    queue.put(b"x" * 100)
+    release.set()
+    _drain(handled, 2)
+    queue.close()
+    assert handled == [b"first", b"x" * 100]
+    assert queue.dropped == 0
+
+
+def test_close_discards_pending_items_and_stops_the_thread() -> None:
+    queue, handled, release = _blocked_queue(size=10, max_bytes=1 << 20)
+    queue.put(b"pending")
+    closer = threading.Thread(target=queue.close)
+    closer.start()
+    release.set()
+    closer.join(5)
+    assert not closer.is_alive()
+    assert handled == [b"first"]
