@@ -24,8 +24,8 @@ import os
 import sys
 from typing import Any
 
-import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.utilities import get_default_context
 
 from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
 from ros_gz_bridge_py.stop_signal import StopSignal
@@ -95,8 +95,10 @@ def spin_until_stopped(executor: Any, stop: StopSignal | None = None) -> None:
         with StopSignal() as own:
             spin_until_stopped(executor, own)
         return
+    spin_once = executor.spin_once
+    context = get_default_context()
     try:
-        while rclpy.ok() and not stop.requested:
-            executor.spin_once(timeout_sec=SPIN_STEP)
+        while context.ok() and not stop.requested:
+            spin_once(timeout_sec=SPIN_STEP)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.delivery import DeliveryQueue, payload_size
-from ros_gz_bridge_py.transport.wire import Frame, PublisherRecord
+from ros_gz_bridge_py.transport.wire import Frame, PublisherRecord, encode_data
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zmq_node import ZmqNode
@@ -33,6 +33,8 @@ class ZmqPublisher(Publisher):
         self.msg_type = msg_type
         self.fqn = record.topic
         self.record = record
+        #: The data frames with an empty payload, encoded once (§2.8.1).
+        self.wire_frames = encode_data(record.topic, record.address, b"", msg_type)
         self._node = node
         self._closed = False
 
