@@ -185,6 +185,8 @@ class Flow:
     seconds: float
     hz: float = 0.0
     slow_ms: float = 0.0
+    #: History depth of a ros-sub subscriber (None: the bridge's default, 10).
+    depth: int | None = None
 
 
 def run_flow(
@@ -205,6 +207,8 @@ def run_flow(
             pub_env[f"{prefix}TRANSPORT_SNDHWM"] = LARGE_HWM
     cpu = CpuWindow(bridge_pid)
     extra = ("--slow-ms", str(flow.slow_ms)) if flow.slow_ms else ()
+    if flow.depth is not None:
+        extra = (*extra, "--depth", str(flow.depth))
     sub = worker(flow.subscriber, topic, flow.kind, flow.seconds + 60, env, *extra)
     pub: PeerProcess | None = None
     try:

@@ -101,10 +101,10 @@ def _ros_start() -> Any:
     return rclpy
 
 
-def _ros_qos() -> Any:
+def _ros_qos(depth: int | None = None) -> Any:
     from ros_gz_bridge_py.qos import endpoint_qos  # noqa: PLC0415
 
-    return endpoint_qos(None, None)
+    return endpoint_qos(None, depth)
 
 
 def ros_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
@@ -132,7 +132,7 @@ def ros_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
     rclpy.try_shutdown()
 
 
-def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float) -> None:
+def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | None) -> None:
     """Spin on a daemon thread; the main thread waits for SIGTERM or ``seconds`` and reports,
     so the STATS line never depends on the executor shutting down cleanly under load."""
     rclpy = _ros_start()
@@ -146,7 +146,7 @@ def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float) -> None:
     def on_message(msg: Any) -> None:
         recorder.record(ros_stamp(kind, msg), 0)
 
-    node.create_subscription(kind.pair.ros_class, topic, on_message, _ros_qos())
+    node.create_subscription(kind.pair.ros_class, topic, on_message, _ros_qos(depth))
     say("READY")
     _announce_match(lambda: node.count_publishers(topic) > 0)
     stop = threading.Event()
@@ -220,12 +220,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("seconds", type=float)
     parser.add_argument("--hz", type=float, default=0.0, help="publishers: rate (0: flat out)")
     parser.add_argument("--slow-ms", type=float, default=0.0, help="subscribers: work per message")
+    parser.add_argument("--depth", type=int, default=None, help="ros-sub: history depth")
     args = parser.parse_args(argv)
     kind = KINDS[args.kind]
     if args.role == "ros-pub":
         ros_pub(args.topic, kind, args.seconds, args.hz)
     elif args.role == "ros-sub":
-        ros_sub(args.topic, kind, args.seconds, args.slow_ms / 1000)
+        ros_sub(args.topic, kind, args.seconds, args.slow_ms / 1000, args.depth)
     elif args.role == "gz-pub":
         gz_pub(args.topic, kind, args.seconds, args.hz)
     else:

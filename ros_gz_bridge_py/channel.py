@@ -24,7 +24,9 @@ the GIL released (see :mod:`ros_gz_bridge_py.bulk`).
 from __future__ import annotations
 
 import abc
+import contextlib
 import enum
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -51,6 +53,9 @@ from ros_gz_bridge_py.transport import MessageInfo, Node, Publisher, Subscriptio
 ERROR_LOG_PERIOD = 5.0
 #: Fewest messages a Gazebo->ROS delivery queue holds.
 MIN_DELIVERY_QUEUE = 100
+#: How much lower the CPU priority (nice) of bulk-path delivery threads is; 0 keeps it.
+BULK_THREAD_NICE = 10
+BULK_THREAD_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
 
 
 class ChannelState(enum.Enum):
@@ -218,6 +223,8 @@ class GzToRosChannel(Channel):
         self._publish: Callable[[Any], None] = _closed_publish
         self._subscription: Subscription | None = None
         self._finish = self._make_finisher()
+        #: The delivery thread already made to yield (see yield_cpu_to_light_topics).
+        self._yielding_thread: int | None = None
 
     def describe(self) -> str:
         return (
@@ -311,6 +318,9 @@ class GzToRosChannel(Channel):
         """The bulk path: Gazebo payload straight to a serialized ROS message."""
         self.stats.received += 1
         assert self.bulk is not None  # subscribed this way only with a bulk path
+        if self._yielding_thread != threading.get_ident():
+            self._yielding_thread = threading.get_ident()
+            yield_cpu_to_light_topics()
         try:
             cdr = gz_to_ros_cdr(self.bulk, self._gz_class, memoryview(payload), self._finish)
         except Exception as err:
@@ -422,6 +432,22 @@ class RosToGzChannel(Channel):
             publisher.publish(self.pair.to_gz(deserialize_message(cdr, self.pair.ros_class)))
         else:
             publisher.publish_raw(payload)
+
+
+def yield_cpu_to_light_topics() -> None:
+    """Lower the calling thread's CPU priority by :data:`BULK_THREAD_NICE` (Linux, per thread).
+
+    The delivery thread of an image or point cloud channel spends milliseconds of CPU per
+    message (copies, the DDS write); on a busy machine that would delay ``/clock`` and the
+    other light topics, in this process and in the processes that receive them. Raising a
+    thread's own nice value needs no privilege; where it is not possible nothing changes.
+    """
+    nice = int(os.environ.get(BULK_THREAD_NICE_ENV, BULK_THREAD_NICE))
+    if nice <= 0:
+        return
+    with contextlib.suppress(OSError, AttributeError):
+        tid = threading.get_native_id()
+        os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + nice)
 
 
 def _closed_publish(_msg: Any) -> None:

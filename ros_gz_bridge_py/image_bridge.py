@@ -40,6 +40,7 @@ from ros_gz_bridge_py.image_bridge_args import (
     with_qos,
 )
 from ros_gz_bridge_py.runtime import apply_speed_settings, make_executor, spin_until_stopped
+from ros_gz_bridge_py.status import table_on_signal
 from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import NodeOptions
 
@@ -151,7 +152,8 @@ def run(topics: Sequence[ImageTopic], stop: StopSignal) -> int:
             return 0
         executor = make_executor()
         executor.add_node(node)
-        spin_until_stopped(executor, stop)
+        with table_on_signal(bridge):
+            spin_until_stopped(executor, stop)
     finally:
         if bridge is not None:
             bridge.close()

@@ -26,6 +26,10 @@ class StopSignal:
     def __enter__(self) -> StopSignal:
         for sig in SIGNALS:
             self._previous[sig] = signal.signal(sig, self._request)
+        # SIGUSR1 asks a running bridge for its status table; until the table handler is
+        # installed it must not terminate the process (its default action).
+        if signal.getsignal(signal.SIGUSR1) == signal.SIG_DFL:
+            self._previous[signal.SIGUSR1] = signal.signal(signal.SIGUSR1, signal.SIG_IGN)
         return self
 
     def __exit__(self, *_exc: object) -> None:

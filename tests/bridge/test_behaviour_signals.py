@@ -8,6 +8,7 @@ unadvertisement, not a peer that went silent and expired).
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import time
@@ -19,6 +20,7 @@ from rcl_interfaces.srv import ListParameters
 from ros_gz_bridge_py.transport import Node as GzNode
 from ros_gz_bridge_py.transport.discovery import SILENCE_INTERVAL
 from tests.bridge.behaviour_harness import (
+    PARAMETER_BRIDGE,
     STRING,
     WAIT,
     RosSide,
@@ -29,7 +31,7 @@ from tests.bridge.behaviour_harness import (
     started,
     wait_gz_advertised,
 )
-from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_until
+from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
 
 __all__ = ["gz_node", "ros_side", "started"]
 
@@ -95,3 +97,38 @@ def test_signal_stops_the_bridge_cleanly(
     wait_until(
         lambda: not gz_advertised(gz_node, topic), SILENCE_INTERVAL - 1.5, f"{topic} unadvertised"
     )
+
+
+@pytest.mark.parametrize("executable", ["parameter_bridge", "image_bridge"])
+def test_sigusr1_never_kills_and_prints_the_table(executable: str) -> None:
+    """SIGUSR1 during start-up is ignored (its default would kill); once running it prints
+    the status table, for both executables."""
+    topic = unique_name("usr1")
+    bridged = f"{topic}@std_msgs/msg/String[{STRING}"
+    argument = bridged if executable == "parameter_bridge" else topic
+    process = PeerProcess([str(PARAMETER_BRIDGE.parent / executable), argument])
+    try:
+        # Before the interpreter reaches the entry point nothing can catch the signal.
+        wait_until(lambda: _ignores_sigusr1(process.pid), WAIT, "SIGUSR1 ignored at start-up")
+        deadline = time.monotonic() + 30
+        while "Creating GZ->ROS" not in process.output():
+            assert process.poll() is None, process.output()
+            assert time.monotonic() < deadline, process.output()
+            process.send_signal(signal.SIGUSR1)
+            time.sleep(0.05)
+        time.sleep(1.0)  # spinning, with the table handler installed
+        process.send_signal(signal.SIGUSR1)
+        wait_for_line(process, rf"^\w+\s+GZ->ROS\s+{re.escape(topic)}\s", timeout=WAIT)
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(WAIT) == 0, process.output()
+    finally:
+        process.stop()
+
+
+def _ignores_sigusr1(pid: int) -> bool:
+    """Whether the process's ignored-signals mask (/proc/<pid>/status SigIgn) has SIGUSR1."""
+    with open(f"/proc/{pid}/status", encoding="ascii") as status:
+        for line in status:
+            if line.startswith("SigIgn:"):
+                return bool(int(line.split()[1], 16) >> (signal.SIGUSR1 - 1) & 1)
+    return False
