@@ -22,7 +22,7 @@ from benchmarks.bridged import (
     flow_through,
     through_bridge,
 )
-from benchmarks.harness import Flow, topic_name
+from benchmarks.harness import Flow, bridge_argument, topic_name
 from benchmarks.report import write_section
 from benchmarks.tables import Row, latency_goal, rate_goal, table
 
@@ -56,12 +56,41 @@ def through_image_bridge(seconds: float, ceiling: Ceilings) -> list[Row]:
     return rows
 
 
+#: Path label of the flows paced at the ceiling's own rate.
+AT_CEILING = "GZ->ROS parameter_bridge (ZeroMQ), paced at the ceiling's rate"
+
+
+def at_ceiling_rate(seconds: float, ceiling: Ceilings) -> list[Row]:
+    """Images from Gazebo paced at the rate rclpy itself reached flat out.
+
+    A Gazebo publisher, unlike an rclpy one, is never slowed down by its subscribers: flat out
+    it sends many times what any bridge converts, and the bridge spends CPU receiving frames
+    it then drops. Paced at the ceiling's rate, the question is only whether the bridge keeps up.
+    """
+    which = backend("zeromq")
+    kinds = ("image640", "image1080")
+    topics = {kind: topic_name(f"atc_{kind}") for kind in kinds}
+    rows = []
+    with bridge_process(
+        [bridge_argument(topics[k], k, "gz2ros") for k in kinds], which.bridge_env
+    ) as bridge:
+        for kind in kinds:
+            target = ceiling[kind, 0.0]
+            if target.error or not target.rate:
+                continue
+            hz = round(target.rate)
+            flow = Flow("gz-pub", "ros-sub", kind, seconds, hz)
+            result = flow_through(flow, topics[kind], which, bridge)
+            rows.append(Row(AT_CEILING, kind, hz, result, target))
+    return rows
+
+
 def goals(rows: list[Row]) -> list[str]:
     lines = []
     for row in rows:
         if not row.path.startswith("GZ->ROS"):
             continue
-        if row.kind in {"image640", "image1080"} and row.hz == 0:
+        if row.kind in {"image640", "image1080"} and (row.hz == 0 or row.path == AT_CEILING):
             lines.append(rate_goal(row, 0.9))
         if row.kind == "image1080" and row.hz == 30:
             lines.append(latency_goal(row, 2.0))
@@ -82,7 +111,11 @@ msg/s against the ceiling row of the same message and rate, measured in the same
 CPU is % of one core from /proc/<pid>/stat over the publishing window. With 2 cores the
 bridge path runs three busy processes where the ceiling runs two, so flat-out rows are bound
 by the machine as much as by the bridge. ROS QoS: reliable, keep-last 10 (the bridge's
-default) on both ends; the Gazebo publisher's ZeroMQ high-water mark is 20 messages.
+default) on both ends; the Gazebo publisher's ZeroMQ high-water mark is 20 messages. A
+Gazebo publisher is not slowed down by its subscribers as an rclpy one is (DDS reliability):
+flat out it sends several times what the bridge converts, and the bridge receives, then
+drops, the rest. The rows "paced at the ceiling's rate" publish from Gazebo at the msg/s the
+ceiling reached flat out, to show whether the bridge keeps up with what rclpy itself does.
 
 {table(ceiling_rows + rows)}
 
@@ -98,6 +131,7 @@ def run(seconds: float, zenoh: bool) -> str:
     ceiling_rows = [Row("ceiling: rclpy -> rclpy", k, hz, ceiling[k, hz]) for k, hz in all_cases]
     rows = through_bridge(seconds, backend("zeromq"), ceiling, CASES, ROS_TO_GZ_CASES)
     rows += through_image_bridge(seconds, ceiling)
+    rows += at_ceiling_rate(seconds, ceiling)
     if zenoh:
         rows += through_bridge(seconds, backend("zenoh"), ceiling, ZENOH_CASES, ZENOH_CASES)
     flags = f" --seconds {seconds:g}" + ("" if zenoh else " --no-zenoh")

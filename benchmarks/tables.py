@@ -86,9 +86,7 @@ def bound(row: Row) -> str:
     if cpu is None:
         return ""
     if cpu >= CPU_BOUND:
-        return (
-            f"; bound by the bridge's CPU ({cpu:.0f}% of a core: its Python threads share one GIL)"
-        )
+        return f"; bound by the bridge's CPU ({cpu:.0f}% of a core)"
     return (
         f"; the bridge was busy only {cpu:.0f}% of a core, so it waited on its ends: three busy "
         "processes (publisher, bridge, subscriber) share 2 cores where the ceiling has two"
@@ -111,6 +109,8 @@ def latency_goal(row: Row, within_ms: float) -> str:
 
 #: Why a paced flow through the bridge is slower than the ceiling.
 HOP = (
-    "; the bridge path is one more hop: a Gazebo Transport send and receive, the conversion, "
-    "and a second rclpy publish of the whole message, each a full copy"
+    "; the bridge path is one more hop: the Gazebo publisher's protobuf serialization, the "
+    "ZeroMQ TCP transfer of the whole frame (a kernel copy each way), and the bulk path's one "
+    "copy into the serialized ROS message; the DDS write and the subscriber are the ceiling's "
+    '(see "transport" and "conversion" for those costs alone)'
 )
