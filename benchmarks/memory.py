@@ -9,6 +9,7 @@ longer per image than the publisher makes nothing queue without bound (RSS flat,
 from __future__ import annotations
 
 import argparse
+import statistics
 import sys
 import threading
 import time
@@ -57,9 +58,12 @@ class RssSampler:
         return ", ".join(f"{at:.0f} s: {mb:.0f}" for at, mb in dict(picked).items())
 
     def summary(self) -> tuple[float, float, float]:
-        """(RSS after the warm-up, maximum after it, last) in MB."""
+        """(median RSS of the first third after the warm-up, the peak, median of the last
+        third) in MB. Single samples swing by ~100 MB as 6 MB buffers come and go; a leak
+        moves the medians, a swing does not."""
         warm = [mb for at, mb in self.samples if at >= WARM_UP] or [0.0]
-        return warm[0], max(warm), warm[-1]
+        third = max(1, len(warm) // 3)
+        return statistics.median(warm[:third]), max(warm), statistics.median(warm[-third:])
 
 
 @dataclass(frozen=True)
@@ -91,8 +95,9 @@ def goal(phase: Phase) -> str:
     met = phase.growth < GOAL_MB and not phase.result.error
     dropped = phase.result.sent - phase.result.received
     return (
-        f"- {phase.name}: RSS {start:.0f} MB after {WARM_UP:g} s, peak {peak:.0f} MB, last "
-        f"{last:.0f} MB: growth {phase.growth:+.1f} MB (< {GOAL_MB:g} MB) — "
+        f"- {phase.name}: RSS median {start:.0f} MB over the first third after {WARM_UP:g} s, "
+        f"peak {peak:.0f} MB, median {last:.0f} MB over the last third: "
+        f"growth {phase.growth:+.1f} MB (< {GOAL_MB:g} MB) — "
         f"{verdict(met, f'{phase.growth - GOAL_MB:.1f} MB')}; {dropped} of "
         f"{phase.result.sent} images not delivered (dropped). RSS MB over time: "
         f"{phase.trajectory}"
@@ -115,9 +120,11 @@ Command: `.venv/bin/python -m benchmarks.memory --flood-seconds {flood_seconds:g
 A Python Gazebo publisher sends 1920x1080 rgb8 images back to back through a fresh
 parameter_bridge (Gazebo -> ROS) to an rclpy subscriber: first for {flood_seconds:g} s, then
 for {slow_seconds:g} s to a subscriber that sleeps {SLOW_MS:g} ms in each callback. The
-bridge's RSS (/proc/<pid>/status VmRSS) is sampled every {SAMPLE_PERIOD:g} s; growth is the
-last sample minus the RSS after {WARM_UP:g} s of flooding (the peak is shown too: glibc keeps
-freed image buffers for reuse, so RSS rises to a plateau and may fall back). Images the bridge
+bridge's RSS (/proc/<pid>/status VmRSS) is sampled every {SAMPLE_PERIOD:g} s from {WARM_UP:g} s
+into the flood; growth is the median of the last third of the samples minus the median of the
+first third (single samples swing by ~100 MB as 6 MB frames are received, queued, copied and
+freed, so first-versus-last-sample differences measure the swing, not a leak; the peak and the
+trajectory are shown too). Images the bridge
 cannot pass on are dropped (its per-channel queue drops the oldest; the ROS publisher keeps the
 last 10).
 
