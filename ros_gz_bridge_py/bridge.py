@@ -51,6 +51,8 @@ from ros_gz_bridge_py.transport import NodeOptions, create_node
 
 #: Environment switch: ``off`` sends images and point clouds through the object path.
 BULK_PATH_ENV = "ROS_GZ_BRIDGE_BULK_PATH"
+#: Environment switch: ``off`` makes ROS->Gazebo channels take rclpy's message objects.
+LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
 
 
 @dataclass
@@ -73,6 +75,9 @@ class BridgeOptions:
     service_timeout: float = DEFAULT_TIMEOUT
     #: Images and point clouds on the bulk path (``ROS_GZ_BRIDGE_BULK_PATH=off`` also disables).
     bulk_path: bool = True
+    #: ROS->Gazebo channels read serialized messages with ros_cdr
+    #: (``ROS_GZ_BRIDGE_LIGHT_READ=off`` also disables).
+    light_read: bool = True
 
 
 class Bridge:
@@ -105,7 +110,8 @@ class Bridge:
             ),
             wall_time_stamps=self.options.override_timestamps_with_wall_time,
             override_frame_id=self.options.override_frame_id,
-            bulk_path=self.options.bulk_path and os.environ.get(BULK_PATH_ENV, "").lower() != "off",
+            bulk_path=self.options.bulk_path and _switched_on(BULK_PATH_ENV),
+            light_read=self.options.light_read and _switched_on(LIGHT_READ_ENV),
         )
         self._logger = ros_node.get_logger()
         self._lock = threading.RLock()
@@ -270,3 +276,8 @@ def _close_handle(handle: BridgeHandle) -> None:
         channel.close()
     if handle.service is not None:
         handle.service.close()
+
+
+def _switched_on(variable: str) -> bool:
+    """An environment switch is on unless set to ``off``."""
+    return os.environ.get(variable, "").lower() != "off"

@@ -1,9 +1,10 @@
-"""Images and point clouds both ways through ``parameter_bridge``, on every publishing path.
+"""Images and point clouds both ways, and Twist ROS->Gazebo, on every publishing path.
 
 The bridge runs three ways: the default bulk path (serialized messages, the DDS write through
-rcl with the GIL released), the bulk path publishing through rclpy's own serialized publish
-(``ROS_GZ_BRIDGE_SERIALIZED_PUBLISH=rclpy``), and the object path
-(``ROS_GZ_BRIDGE_BULK_PATH=off``). ROS->Gazebo messages land in the real C++ ign-transport
+rcl with the GIL released) with ROS->Gazebo messages read by ``ros_cdr``, the bulk path
+publishing through rclpy's own serialized publish (``ROS_GZ_BRIDGE_SERIALIZED_PUBLISH=rclpy``),
+and the object path with rclpy's message objects everywhere (``ROS_GZ_BRIDGE_BULK_PATH=off``,
+``ROS_GZ_BRIDGE_LIGHT_READ=off``). ROS->Gazebo messages land in the real C++ ign-transport
 echo, which parses them with the Debian gz-msgs; Gazebo->ROS messages come from the real C++
 peer and our node, and land in rclpy. Every field is checked on arrival.
 """
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import pytest
+from geometry_msgs.msg import Twist
 from sensor_msgs.msg import Image, PointCloud2, PointField
 
 from ros_gz_bridge_py.converters.registry import default_registry
@@ -51,7 +53,7 @@ WIDTH, HEIGHT = 6, 4
 VARIANTS = {
     "bulk": {},
     "bulk-rclpy-publish": {"ROS_GZ_BRIDGE_SERIALIZED_PUBLISH": "rclpy"},
-    "object": {"ROS_GZ_BRIDGE_BULK_PATH": "off"},
+    "object": {"ROS_GZ_BRIDGE_BULK_PATH": "off", "ROS_GZ_BRIDGE_LIGHT_READ": "off"},
 }
 
 
@@ -61,6 +63,7 @@ class Topics:
     cloud_to_gz: str
     image_to_ros: str
     cloud_to_ros: str
+    twist_to_gz: str
 
 
 @dataclass
@@ -77,16 +80,18 @@ def bridge(request: pytest.FixtureRequest) -> Iterator[RunningBridge]:
         unique_name("bulk_pc_r2g"),
         unique_name("bulk_img_g2r"),
         unique_name("bulk_pc_g2r"),
+        unique_name("bulk_twist_r2g"),
     )
     command = bridge_command(
         f"{topics.image_to_gz}@sensor_msgs/msg/Image]{GZ_IMAGE}",
         f"{topics.cloud_to_gz}@sensor_msgs/msg/PointCloud2]{GZ_CLOUD}",
         f"{topics.image_to_ros}@sensor_msgs/msg/Image[{GZ_IMAGE}",
         f"{topics.cloud_to_ros}@sensor_msgs/msg/PointCloud2[{GZ_CLOUD}",
+        f"{topics.twist_to_gz}@geometry_msgs/msg/Twist]gz.msgs.Twist",
     )
     process = start_process(command, {**os.environ, **VARIANTS[request.param]})
     try:
-        for _ in range(4):
+        for _ in range(5):
             wait_for_line(process, r"\]: Creating ", timeout=30)
         yield RunningBridge(process, topics)
     finally:
@@ -103,6 +108,13 @@ def ros_image(index: int) -> Image:
     msg.encoding = "bgr8"
     msg.step = WIDTH * 3 + 2  # row padding: gz recomputes the step and takes height*step bytes
     msg.data = bytes((7 * i + index) % 256 for i in range(HEIGHT * msg.step))
+    return msg
+
+
+def ros_twist(index: int) -> Twist:
+    msg = Twist()
+    msg.linear.x, msg.linear.y, msg.linear.z = 1.5 + index, -2.25, 3.125
+    msg.angular.x, msg.angular.y, msg.angular.z = -4.5, 5.75, -6.875
     return msg
 
 
@@ -140,6 +152,7 @@ def _first_message(echo: PeerProcess, type_name: str) -> Any:
     [
         ("image", ros_image, "sensor_msgs/msg/Image", GZ_IMAGE, "Image"),
         ("cloud", ros_cloud, "sensor_msgs/msg/PointCloud2", GZ_CLOUD, "PointCloudPacked"),
+        ("twist", ros_twist, "geometry_msgs/msg/Twist", "gz.msgs.Twist", "Twist"),
     ],
 )
 def test_ros_to_gazebo(  # noqa: PLR0917 - one parametrized case per message kind
@@ -152,7 +165,11 @@ def test_ros_to_gazebo(  # noqa: PLR0917 - one parametrized case per message kin
     gz_type: str,
     type_name: str,
 ) -> None:
-    topic = bridge.topics.image_to_gz if kind == "image" else bridge.topics.cloud_to_gz
+    topic = {
+        "image": bridge.topics.image_to_gz,
+        "cloud": bridge.topics.cloud_to_gz,
+        "twist": bridge.topics.twist_to_gz,
+    }[kind]
     echo = _echo(topic, type_name)
     started.append(echo)
     assert callable(make)
@@ -172,9 +189,11 @@ def test_ros_to_gazebo(  # noqa: PLR0917 - one parametrized case per message kin
         assert got.pixel_format_type == 8  # BGR_INT8
         assert got.step == WIDTH * 3
         assert len(got.data) == HEIGHT * WIDTH * 3
-    else:
+    elif kind == "cloud":
         assert [f.datatype for f in got.field] == [6, 3]
         assert got.is_dense
+    else:
+        assert (got.angular.x, got.angular.y, got.angular.z) == (-4.5, 5.75, -6.875)
 
 
 def test_gazebo_to_ros_image_from_the_real_peer(
