@@ -65,6 +65,7 @@ from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.udp import DiscoverySocket, determine_host
 from ros_gz_bridge_py.transport.wire import (
+    DATA_FRAMES,
     Frame,
     MessagePublisher,
     PublisherRecord,
@@ -93,10 +94,12 @@ READ_BATCH = 64
 #: Frames up to this size are copied into ``bytes`` on receipt (cheaper than a view for small
 #: ones); larger frames, such as images, are handed on as zero-copy views.
 COPY_BELOW = 64 * 1024
-#: Cached MessageInfo records (topic, sender, type); cleared when it grows beyond this.
-INFO_CACHE_SIZE = 1024
+#: Cached routes (topic, sender, type frames -> subscriptions, info); cleared beyond this size.
+ROUTE_CACHE_SIZE = 1024
 #: Response types that make a call one-way (§2.9.3).
 ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
+#: Where received data goes: the subscriptions that accept it, and what they are told.
+Route = tuple[tuple[ZmqSubscription, ...], MessageInfo]
 
 
 @dataclass(eq=False)
@@ -142,7 +145,7 @@ class ZmqNode(Node):
         self._counts: collections.Counter[str] = collections.Counter()
         # Touched by the I/O thread only: the per-message fast path takes no lock.
         self._received = 0
-        self._info_cache: dict[tuple[str, str, str], MessageInfo] = {}
+        self._routes: dict[tuple[Frame, Frame, Frame], Route] = {}
         self._count_lock = threading.Lock()
         self._closed = False
         self._commands: collections.deque[Callable[[], None]] = collections.deque()
@@ -399,6 +402,7 @@ class ZmqNode(Node):
         with self._sub_lock:
             known = self._subscriptions.get(fqn, ())
             self._subscriptions[fqn] = (*known, sub)
+            self._routes.clear()
         if not known:
             self._sub.setsockopt(zmq.SUBSCRIBE, fqn.encode())
         sub.record = PublisherRecord(
@@ -423,6 +427,7 @@ class ZmqNode(Node):
                 self._subscriptions[fqn] = remaining
             else:
                 self._subscriptions.pop(fqn, None)
+            self._routes.clear()
         if sub.record is not None:
             self._msg.remove_local_subscriber(sub.record)
         if remaining:
@@ -736,25 +741,40 @@ class ZmqNode(Node):
                 _LOG.debug("dropped ZMQ message: %s", error)
 
     def _on_data(self, frames: list[Frame]) -> None:
-        """§2.8.1 step 8: exact FQN, exact or generic type."""
+        """§2.8.1 step 8: exact FQN, exact or generic type.
+
+        A (topic, sender, type) seen before takes the cached route: no decoding, no matching.
+        The cache is emptied whenever a subscription starts or ends (both on this thread).
+        """
+        if len(frames) == DATA_FRAMES:
+            route = self._routes.get((frames[0], frames[1], frames[3]))
+            if route is not None:
+                self._received += 1
+                subs, info = route
+                payload = frames[2]
+                for sub in subs:
+                    sub.offer(payload, info)
+                return
+        self._route(frames)
+
+    def _route(self, frames: list[Frame]) -> None:
         message = decode_data(frames)
         subs = self._subscriptions.get(message.topic)
         if not subs:
             return
         self._received += 1
-        key = (message.topic, message.sender, message.msg_type)
-        info = self._info_cache.get(key)
-        if info is None:
-            if len(self._info_cache) >= INFO_CACHE_SIZE:
-                self._info_cache.clear()
-            name = (decompose(message.topic) or ("", message.topic))[1]
-            info = MessageInfo(
-                name, message.msg_type, self.partition, message.sender, intra_process=False
-            )
-            self._info_cache[key] = info
-        for sub in subs:
-            if sub.accepts(message.msg_type):
-                sub.offer(message.payload, info)
+        name = (decompose(message.topic) or ("", message.topic))[1]
+        info = MessageInfo(
+            name, message.msg_type, self.partition, message.sender, intra_process=False
+        )
+        accepting = tuple(sub for sub in subs if sub.accepts(message.msg_type))
+        key = (frames[0], frames[1], frames[3])
+        if all(isinstance(frame, bytes) for frame in key):
+            if len(self._routes) >= ROUTE_CACHE_SIZE:
+                self._routes.clear()
+            self._routes[key] = (accepting, info)
+        for sub in accepting:
+            sub.offer(message.payload, info)
 
     def _handle_events(self, engine: DiscoveryEngine, events: list[Event]) -> None:
         if not events:

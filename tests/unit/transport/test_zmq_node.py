@@ -86,6 +86,29 @@ def test_type_mismatch_is_not_delivered(nodes: tuple[ZmqNode, ZmqNode]) -> None:
     assert wrong == []
 
 
+def test_subscriptions_added_and_closed_while_messages_flow(
+    nodes: tuple[ZmqNode, ZmqNode],
+) -> None:
+    """Received messages take a cached route; a subscription that starts or ends while the
+    topic is flowing must be seen at once (the cache is emptied each time)."""
+    a, b = nodes
+    topic = unique("routes")
+    first: list[bytes] = []
+    second: list[bytes] = []
+    sub_first = b.subscribe(topic, lambda d, _: first.append(d))
+    pub = a.advertise(topic, "gz.msgs.StringMsg")
+    assert wait_until(pub.has_connections)
+    assert publish_until(lambda: pub.publish(StringMsg(data="1")), lambda: bool(first))
+    b.subscribe(topic, lambda d, _: second.append(d))
+    assert publish_until(lambda: pub.publish(StringMsg(data="2")), lambda: bool(second))
+    sub_first.close()
+    count = len(first)
+    before = len(second)
+    assert publish_until(lambda: pub.publish(StringMsg(data="3")), lambda: len(second) > before)
+    assert len(first) == count
+    assert StringMsg.FromString(second[-1]).data == "3"
+
+
 def test_no_wire_traffic_without_subscribers_and_listing(nodes: tuple[ZmqNode, ZmqNode]) -> None:
     a, b = nodes
     topic = unique("listed")
