@@ -456,7 +456,10 @@ def yield_cpu_to_light_topics() -> None:
     other light topics, in this process and in the processes that receive them. Raising a
     thread's own nice value needs no privilege; where it is not possible nothing changes.
     """
-    nice = int(os.environ.get(BULK_THREAD_NICE_ENV, BULK_THREAD_NICE))
+    try:
+        nice = int(os.environ.get(BULK_THREAD_NICE_ENV, BULK_THREAD_NICE))
+    except ValueError:  # not a number: the default
+        nice = BULK_THREAD_NICE
     if nice <= 0:
         return
     with contextlib.suppress(OSError, AttributeError):

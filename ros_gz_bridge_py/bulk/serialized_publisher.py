@@ -58,11 +58,6 @@ def _rcl() -> _Rcl | None:
     return _Rcl(publish, reset_error)
 
 
-def releases_gil() -> bool:
-    """True when publishing goes through rcl directly (the GIL released during the write)."""
-    return _rcl() is not None
-
-
 class SerializedPublisher:
     """Publishes CDR bytes (with their encapsulation header) on an rclpy publisher."""
 
