@@ -22,7 +22,6 @@ The bridge creates a wall-clock (steady) timer on the node that re-evaluates laz
 
 from __future__ import annotations
 
-import os
 import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -46,6 +45,7 @@ from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT, ServiceBridge
 from ros_gz_bridge_py.side_node import SideNode, side_node_name
+from ros_gz_bridge_py.switches import switched_off
 from ros_gz_bridge_py.transport import Node as GzNode
 from ros_gz_bridge_py.transport import NodeOptions, create_node
 
@@ -110,8 +110,8 @@ class Bridge:
             ),
             wall_time_stamps=self.options.override_timestamps_with_wall_time,
             override_frame_id=self.options.override_frame_id,
-            bulk_path=self.options.bulk_path and _switched_on(BULK_PATH_ENV),
-            light_read=self.options.light_read and _switched_on(LIGHT_READ_ENV),
+            bulk_path=self.options.bulk_path and not switched_off(BULK_PATH_ENV),
+            light_read=self.options.light_read and not switched_off(LIGHT_READ_ENV),
         )
         self._logger = ros_node.get_logger()
         self._lock = threading.RLock()
@@ -276,8 +276,3 @@ def _close_handle(handle: BridgeHandle) -> None:
         channel.close()
     if handle.service is not None:
         handle.service.close()
-
-
-def _switched_on(variable: str) -> bool:
-    """An environment switch is on unless set to ``off``."""
-    return os.environ.get(variable, "").lower() != "off"

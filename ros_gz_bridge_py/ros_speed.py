@@ -20,12 +20,13 @@ from collections.abc import Mapping, MutableMapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from ros_gz_bridge_py.switches import switched_off
+
 PROFILE = Path(__file__).resolve().parent / "resources" / "fastdds_shm_profile.xml"
 #: Set to off/0/false/no to keep Fast DDS's own transports.
 OPT_OUT_ENV = "ROS_GZ_BRIDGE_FASTDDS_PROFILE"
 PROFILE_ENVS = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")
 FAST_DDS_RMW = "rmw_fastrtps_cpp"
-_OFF = frozenset({"off", "0", "false", "no"})
 
 _LOG = logging.getLogger(__name__)
 
@@ -40,7 +41,7 @@ class ProfileDecision:
 
 def decide(env: Mapping[str, str]) -> ProfileDecision:
     """The decision for the environment ``env`` (no side effects)."""
-    if env.get(OPT_OUT_ENV, "").strip().lower() in _OFF:
+    if switched_off(OPT_OUT_ENV, env):
         return ProfileDecision(False, f"{OPT_OUT_ENV}={env[OPT_OUT_ENV]}")
     rmw = env.get("RMW_IMPLEMENTATION", "").strip()
     if rmw and rmw != FAST_DDS_RMW:
