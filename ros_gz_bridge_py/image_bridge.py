@@ -39,8 +39,8 @@ from ros_gz_bridge_py.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
-from ros_gz_bridge_py.runtime import apply_speed_settings, make_executor, spin_until_stopped
-from ros_gz_bridge_py.status import table_on_signal
+from ros_gz_bridge_py.runtime import apply_speed_settings
+from ros_gz_bridge_py.status import serve
 from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import NodeOptions
 
@@ -150,10 +150,7 @@ def run(topics: Sequence[ImageTopic], stop: StopSignal) -> int:
             return USAGE_EXIT
         if stop.requested:
             return 0
-        executor = make_executor()
-        executor.add_node(node)
-        with table_on_signal(bridge):
-            spin_until_stopped(executor, stop)
+        serve(node, bridge, stop)
     finally:
         if bridge is not None:
             bridge.close()

@@ -34,9 +34,9 @@ from ros_gz_bridge_py.config import (
     parse_parameter_bridges,
     read_yaml_file,
 )
-from ros_gz_bridge_py.runtime import apply_speed_settings, make_executor, spin_until_stopped
+from ros_gz_bridge_py.runtime import apply_speed_settings
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
-from ros_gz_bridge_py.status import DiagnosticsPublisher, start_diagnostics, table_on_signal
+from ros_gz_bridge_py.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import NodeOptions
 
@@ -152,10 +152,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 return 0
             bridge = build_bridge(node, cli, params)
             diagnostics = start_diagnostics(node, bridge, params["status_period"])
-            executor = make_executor()
-            executor.add_node(node)
-            with table_on_signal(bridge):
-                spin_until_stopped(executor, stop)
+            serve(node, bridge, stop)
         finally:
             if diagnostics is not None:
                 diagnostics.close()

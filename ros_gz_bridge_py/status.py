@@ -9,6 +9,8 @@ periods.
 
 Levels: STALE for a lazy channel whose input side is closed (nobody reads its output), WARN when
 conversion errors, queue drops or failed service calls happened in the period, OK otherwise.
+
+:func:`serve` is how both executables run a built bridge: spinning, with the table on SIGUSR1.
 """
 
 from __future__ import annotations
@@ -29,7 +31,9 @@ from rclpy.clock import Clock, ClockType
 
 from ros_gz_bridge_py.bridge import Bridge
 from ros_gz_bridge_py.channel import Channel, ChannelState, GzToRosChannel
+from ros_gz_bridge_py.runtime import make_executor, spin_until_stopped
 from ros_gz_bridge_py.services import ServiceBridge
+from ros_gz_bridge_py.stop_signal import StopSignal
 
 #: Prefix of every DiagnosticStatus name, as ``ros_gz_bridge: <direction> <ros name>``.
 NAME_PREFIX = "ros_gz_bridge"
@@ -277,6 +281,15 @@ def table_on_signal(
         yield
     finally:
         signal.signal(signum, previous)
+
+
+def serve(ros_node: Any, bridge: Bridge, stop: StopSignal) -> None:
+    """What both executables do once their bridges exist: spin ``ros_node`` until ``stop`` or
+    rclpy shutdown, printing the status table on SIGUSR1 meanwhile."""
+    executor = make_executor()
+    executor.add_node(ros_node)
+    with table_on_signal(bridge):
+        spin_until_stopped(executor, stop)
 
 
 def start_diagnostics(ros_node: Any, bridge: Bridge, period: object) -> DiagnosticsPublisher | None:
