@@ -436,14 +436,16 @@ class RosToGzChannel(Channel):
             )
 
     def _read(self, cdr: bytes) -> Any:
+        """The message in ``cdr`` for ``to_gz``: a light tree, or rclpy's message when the
+        encapsulation is not plain little-endian CDR."""
         tree = ros_cdr.read(cdr, self.pair.ros_class)
         return tree if tree is not None else deserialize_message(cdr, self.pair.ros_class)
 
     def _publish_serialized(self, publisher: Publisher, cdr: bytes) -> None:
         assert self.bulk is not None  # subscribed raw only with a bulk path
         payload = ros_cdr_to_gz(self.bulk, self.pair.ros_class, cdr)
-        if payload is None:  # not plain CDR: let rclpy read it and take the object path
-            publisher.publish(self.pair.to_gz(deserialize_message(cdr, self.pair.ros_class)))
+        if payload is None:  # not plain CDR: the object path
+            publisher.publish(self.pair.to_gz(self._read(cdr)))
         else:
             publisher.publish_raw(payload)
 
