@@ -48,6 +48,9 @@ _BASIC: dict[str, tuple[int, str]] = {
 }
 _BYTES = {"octet", "uint8"}
 _U32 = struct.Struct("<I")
+#: rosidl type classes (by name) of strings and of sequences.
+STRING_TYPES = frozenset({"UnboundedString", "BoundedString"})
+SEQUENCE_TYPES = frozenset({"UnboundedSequence", "BoundedSequence"})
 
 
 class _UnreadableTypeError(Exception):
@@ -85,11 +88,30 @@ def reader_for(msg_class: type[Any]) -> Reader | None:
     return _READERS[msg_class]
 
 
+def fields_of(msg_class: type[Any]) -> list[tuple[str, Any]]:
+    """(name, rosidl type) of each field of ``msg_class``, in wire order."""
+    names = msg_class.get_fields_and_field_types()
+    return list(zip(names, msg_class.SLOT_TYPES, strict=True))
+
+
+def basic_size(slot: Any) -> int | None:
+    """The wire size of a basic type (bool .. double) we read; None for any other type."""
+    basic = _basic_of(slot)
+    return _BASIC[basic][0] if basic in _BASIC else None
+
+
+def nested_class(slot: Any) -> type[Any]:
+    """The rclpy class of a nested message type."""
+    module = importlib.import_module(".".join(slot.namespaces))
+    cls: type[Any] = getattr(module, slot.name)
+    return cls
+
+
 def _struct_reader(msg_class: type[Any]) -> Reader:
-    names = list(msg_class.get_fields_and_field_types())
-    if not names:  # an empty message still carries one uint8 on the wire
+    fields = fields_of(msg_class)
+    if not fields:  # an empty message still carries one uint8 on the wire
         return _empty_reader
-    steps = _merge_basic_runs(list(zip(names, msg_class.SLOT_TYPES, strict=True)))
+    steps = _merge_basic_runs(fields)
     make = SimpleNamespace
 
     def read_struct(buf: bytes, pos: int) -> tuple[Any, int]:
@@ -163,13 +185,13 @@ def _value_reader(slot: Any) -> Reader:
     kind = type(slot).__name__
     if kind == "BasicType":
         return _basic_reader(slot.typename)
-    if kind in {"UnboundedString", "BoundedString"}:
+    if kind in STRING_TYPES:
         return _read_string
     if kind == "NamespacedType":
         return _nested_reader(slot)
     if kind == "Array":
         return _array_reader(slot.value_type, slot.size)
-    if kind in {"UnboundedSequence", "BoundedSequence"}:
+    if kind in SEQUENCE_TYPES:
         return _sequence_reader(slot.value_type)
     raise _UnreadableTypeError(kind)
 
@@ -199,8 +221,7 @@ def _read_string(buf: bytes, pos: int) -> tuple[str, int]:
 
 
 def _nested_reader(slot: Any) -> Reader:
-    module = importlib.import_module(".".join(slot.namespaces))
-    return _struct_reader(getattr(module, slot.name))
+    return _struct_reader(nested_class(slot))
 
 
 def _array_reader(value_type: Any, count: int) -> Reader:

@@ -4,15 +4,17 @@ A serialized ROS 2 message is a 4-byte encapsulation header (``00 01`` little en
 big endian, then two option bytes) and the body, whose primitives are aligned to their size
 counted from the start of the body. Strings and sequences are a ``uint32`` count then the
 elements. A :data:`Layout` lists a message's fields up to and including the bulk field, in the
-tokens below; :func:`locate_bulk` walks it (sans-IO, no copies).
+tokens below; :func:`layout_until` derives it from rclpy's type description and
+:func:`locate_bulk` walks it (sans-IO, no copies).
 """
 
 from __future__ import annotations
 
 import struct
 from dataclasses import dataclass
-from typing import Union
+from typing import Any, Union
 
+from ros_gz_bridge_py import ros_cdr
 from ros_gz_bridge_py.errors import ConversionError
 
 #: Encapsulation identifiers of plain CDR: big endian, little endian.
@@ -20,8 +22,9 @@ CDR_BE = b"\x00\x00"
 CDR_LE = b"\x00\x01"
 HEADER_SIZE = 4
 
-#: A field of a layout: "u8" (also bool, char), "u32" (also int32, float32), "str", "bulk"
-#: (the uint8[] being looked for), or a sequence of structs given by their own layout.
+#: A field of a layout: a primitive by its size, "u8", "u16", "u32" or "u64" (whatever its type),
+#: "str", "bulk" (the uint8[] being looked for), or a sequence of structs given by their own
+#: layout.
 Token = Union[str, "Sequence"]
 Layout = tuple[Token, ...]
 
@@ -33,8 +36,68 @@ class Sequence:
     element: Layout
 
 
-#: std_msgs/Header: builtin_interfaces/Time (int32 sec, uint32 nanosec), string frame_id.
-HEADER: Layout = ("u32", "u32", "str")
+#: Primitive tokens by wire size (and alignment).
+_SIZE_TOKENS = {1: "u8", 2: "u16", 4: "u32", 8: "u64"}
+_TOKEN_SIZES = {token: size for size, token in _SIZE_TOKENS.items()}
+#: Element types of a bulk field: one byte each.
+_BULK_ELEMENTS = frozenset({"uint8", "int8", "octet"})
+
+
+def layout_until(msg_class: type[Any], field: str) -> Layout:
+    """The layout of ``msg_class`` up to its ``uint8[]`` field ``field``, which ends it as "bulk".
+
+    Raises:
+        ValueError: ``field`` is not a sequence of one-byte elements (uint8, int8, byte), a
+            field after it is wider than one byte (splicing bytes in would move its
+            alignment), or a field before it has no token (a sequence of primitives).
+    """
+    fields = ros_cdr.fields_of(msg_class)
+    names = [name for name, _ in fields]
+    if field not in names:
+        msg = f"{msg_class.__name__} has no field {field!r}"
+        raise ValueError(msg)
+    index = names.index(field)
+    bulk = fields[index][1]
+    element = getattr(bulk, "value_type", None)
+    if (
+        type(bulk).__name__ not in ros_cdr.SEQUENCE_TYPES
+        or getattr(element, "typename", None) not in _BULK_ELEMENTS
+    ):
+        msg = f"{msg_class.__name__}.{field} is not a sequence of one-byte elements"
+        raise ValueError(msg)
+    for name, slot in fields[index + 1 :]:
+        if ros_cdr.basic_size(slot) != 1:
+            msg = f"{msg_class.__name__}.{name} after {field} is not one byte wide"
+            raise ValueError(msg)
+    tokens: list[Token] = []
+    for _, slot in fields[:index]:
+        tokens.extend(_tokens(slot))
+    return (*tokens, "bulk")
+
+
+def _tokens(slot: Any) -> Layout:
+    size = ros_cdr.basic_size(slot)
+    if size is not None:
+        return (_SIZE_TOKENS[size],)
+    kind = type(slot).__name__
+    if kind in ros_cdr.STRING_TYPES:
+        return ("str",)
+    if kind == "NamespacedType":
+        return _struct_tokens(ros_cdr.nested_class(slot))
+    if kind in ros_cdr.SEQUENCE_TYPES and type(slot.value_type).__name__ == "NamespacedType":
+        return (Sequence(_struct_tokens(ros_cdr.nested_class(slot.value_type))),)
+    msg = f"no CDR layout token for a field of type {kind}"
+    raise ValueError(msg)
+
+
+def _struct_tokens(msg_class: type[Any]) -> Layout:
+    fields = ros_cdr.fields_of(msg_class)
+    if not fields:  # an empty message still carries one uint8 on the wire
+        return ("u8",)
+    tokens: list[Token] = []
+    for _, slot in fields:
+        tokens.extend(_tokens(slot))
+    return tuple(tokens)
 
 
 @dataclass(frozen=True)
@@ -76,14 +139,14 @@ class _Walker:
 
     def walk(self, layout: Layout) -> BulkLocation | None:
         for field in layout:
-            if field == "u8":
-                self._advance(1)
-            elif field == "u32":
-                self._count()
+            if isinstance(field, str) and field in _TOKEN_SIZES:
+                size = _TOKEN_SIZES[field]
+                self.pos = self._aligned(size)
+                self._advance(size)
             elif field == "str":
                 self._advance(self._count())
             elif field == "bulk":
-                length_at = self.pos = self._aligned()
+                length_at = self.pos = self._aligned(4)
                 size = self._count()
                 start = self.pos
                 self._advance(size)
@@ -96,11 +159,11 @@ class _Walker:
                 raise ValueError(msg)
         return None
 
-    def _aligned(self) -> int:
-        return self.pos + (-(self.pos - HEADER_SIZE) % 4)
+    def _aligned(self, size: int) -> int:
+        return self.pos + (-(self.pos - HEADER_SIZE) % size)
 
     def _count(self) -> int:
-        self.pos = self._aligned()
+        self.pos = self._aligned(4)
         self._advance(4)
         value: int = self._u32.unpack_from(self.buf, self.pos - 4)[0]
         return value

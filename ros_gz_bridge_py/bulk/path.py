@@ -26,13 +26,13 @@ class BulkPath:
     """How one pair's bulk field maps between the gz protobuf and the ROS CDR.
 
     The ROS fields after the bulk field must all be 1-byte aligned (bool, uint8), so that
-    splicing bytes in does not move their alignment; true of Image (none) and PointCloud2
-    (``is_dense``).
+    splicing bytes in does not move their alignment; :func:`~.cdr.layout_until` checks it.
     """
 
     #: Field number of the bulk ``bytes`` field in the gz message.
     gz_field: int
-    #: The ROS message's CDR layout up to and including its ``uint8[]`` bulk field.
+    #: The ROS message's CDR layout up to and including its ``uint8[]`` bulk field
+    #: (from :func:`~.cdr.layout_until`).
     ros_layout: Layout
     gz_meta_to_ros: MetaConverter
     ros_meta_to_gz: MetaConverter

@@ -22,7 +22,7 @@ from typing import Any
 
 from sensor_msgs.msg import CameraInfo, Image
 
-from ros_gz_bridge_py.bulk.cdr import HEADER
+from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
 from ros_gz_bridge_py.errors import ConversionError
@@ -120,7 +120,7 @@ def image_to_ros(gz: Any) -> Any:
 #: Image on the bulk path: gz ``data`` is field 5; ROS ``data`` is the last field.
 IMAGE_BULK = BulkPath(
     gz_field=5,
-    ros_layout=(*HEADER, "u32", "u32", "str", "u8", "u32", "bulk"),
+    ros_layout=layout_until(Image, "data"),
     gz_meta_to_ros=image_meta_to_ros,
     ros_meta_to_gz=image_meta_to_gz,
 )

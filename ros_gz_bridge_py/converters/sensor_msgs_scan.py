@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from sensor_msgs.msg import LaserScan, PointCloud2, PointField, Range
 
-from ros_gz_bridge_py.bulk.cdr import HEADER, Sequence
+from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header, gz_to_ros_frame
 from ros_gz_bridge_py.errors import ConversionError
@@ -195,16 +195,7 @@ def point_cloud2_to_ros(gz: Any) -> Any:
 #: PointCloud2 on the bulk path: gz ``data`` is field 8; in ROS only ``is_dense`` follows it.
 POINT_CLOUD2_BULK = BulkPath(
     gz_field=8,
-    ros_layout=(
-        *HEADER,
-        "u32",
-        "u32",
-        Sequence(("str", "u32", "u8", "u32")),
-        "u8",
-        "u32",
-        "u32",
-        "bulk",
-    ),
+    ros_layout=layout_until(PointCloud2, "data"),
     gz_meta_to_ros=point_cloud2_meta_to_ros,
     ros_meta_to_gz=point_cloud2_meta_to_gz,
 )
