@@ -81,7 +81,7 @@ MAX_QUEUED_BYTES = 64 * 1024 * 1024
 
 class DeliveryQueue(Generic[T]):
     """Hands items to ``handler`` on a dedicated daemon thread, keeping the newest ``size``
-    items and, when ``weigh`` gives their sizes, no more than ``max_bytes`` (but always one).
+    items and no more than ``max_bytes`` of them as ``weigh`` measures (but always one).
 
     Built on :class:`queue.SimpleQueue`, whose put and get are single C calls: at tens of
     thousands of small messages per second a Condition-based queue costs the producer (the
@@ -96,7 +96,7 @@ class DeliveryQueue(Generic[T]):
         handler: Callable[[T], None],
         name: str,
         *,
-        weigh: Callable[[T], int] | None = None,
+        weigh: Callable[[T], int],
         max_bytes: int = MAX_QUEUED_BYTES,
     ) -> None:
         if size < 1:
@@ -119,17 +119,15 @@ class DeliveryQueue(Generic[T]):
         """Queue ``item``; False if that pushed out older ones."""
         items = self._items
         weigh = self._weigh
-        if weigh is not None:
-            self._bytes_put += weigh(item)
+        self._bytes_put += weigh(item)
         items.put(item)
         kept = True
-        while items.qsize() > self._size or (weigh is not None and self._over_budget()):
+        while items.qsize() > self._size or self._over_budget():
             try:
                 oldest = items.get_nowait()
             except queue.Empty:  # the delivery thread took it first
                 break
-            if weigh is not None:
-                self._bytes_dropped += weigh(cast(T, oldest))
+            self._bytes_dropped += weigh(cast(T, oldest))
             self.dropped += 1
             kept = False
         return kept
@@ -151,8 +149,7 @@ class DeliveryQueue(Generic[T]):
             item = cast(T, get())  # only _STOP is not a T, and it comes after close
             if self._closed:
                 return
-            if self._weigh is not None:
-                self._bytes_handled += self._weigh(item)
+            self._bytes_handled += self._weigh(item)
             self._handler(item)
 
 

@@ -301,7 +301,7 @@ class ZmqNode(Node):
         """A snapshot of the counters of the node and of both discovery engines."""
         with self._count_lock:
             counts = dict(self._counts)
-        counts["messages_received"] = counts.get("messages_received", 0) + self._received
+        counts["messages_received"] = self._received
         engines = (self._msg.counts, self._srv.counts)
         return TransportStats(
             datagrams_received=sum(c["received"] for c in engines),
