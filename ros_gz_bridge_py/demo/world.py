@@ -12,15 +12,14 @@ until SIGINT or SIGTERM.
 from __future__ import annotations
 
 import math
-import signal
 import threading
 import time
 from collections.abc import Callable
-from types import FrameType
 from typing import Any
 
 from ros_gz_bridge_py.demo import sim, topics
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import MessageInfo, Node, Publisher, create_node
 
 #: Physics steps per second; the publish periods below are in steps.
@@ -235,11 +234,11 @@ class World:
                 publisher.publish(build(now))
         self._steps += 1
 
-    def run(self, stop: threading.Event) -> None:
-        """Step at STEP_HZ on the wall clock until ``stop`` is set."""
+    def run(self, stop: StopSignal) -> None:
+        """Step at STEP_HZ on the wall clock until ``stop`` is requested."""
         period = 1.0 / STEP_HZ
         next_step = time.monotonic()
-        while not stop.is_set():
+        while not stop.requested:
             self.tick(time.time())
             next_step += period
             delay = next_step - time.monotonic()
@@ -249,14 +248,7 @@ class World:
 
 
 def main() -> int:
-    stop = threading.Event()
-
-    def request_stop(_signum: int, _frame: FrameType | None) -> None:
-        stop.set()
-
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, request_stop)
-    with create_node() as node:
+    with StopSignal() as stop, create_node() as node:
         world = World(node)
         print(f"READY: demo world publishing {len(topics.GZ_TO_ROS)} topics", flush=True)
         world.run(stop)

@@ -18,7 +18,6 @@ from __future__ import annotations
 import array
 import importlib
 import json
-import signal
 import sys
 import time
 from typing import Any
@@ -28,6 +27,8 @@ import rclpy
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+
+from ros_gz_bridge_py.stop_signal import StopSignal
 
 _DISTINCT_PER_TOPIC = 20
 _PUBLISH_PERIOD = 0.2
@@ -109,26 +110,19 @@ class Checker:
 
 def main() -> int:
     spec = json.loads(sys.argv[1])
-    stop = False
-
-    def request_stop(_signum: int, _frame: Any) -> None:
-        nonlocal stop
-        stop = True
-
-    signal.signal(signal.SIGTERM, request_stop)
-    signal.signal(signal.SIGINT, request_stop)
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    node = Node("e2e_ros_checker")
-    Checker(node, spec)
-    emit("READY")
-    end = time.monotonic() + float(spec.get("seconds", 60))
-    try:
-        while not stop and time.monotonic() < end:
-            rclpy.spin_once(node, timeout_sec=0.05)
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    with StopSignal() as stop:
+        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+        node = Node("e2e_ros_checker")
+        Checker(node, spec)
+        emit("READY")
+        end = time.monotonic() + float(spec.get("seconds", 60))
+        try:
+            while not stop.requested and time.monotonic() < end:
+                rclpy.spin_once(node, timeout_sec=0.05)
+        finally:
+            node.destroy_node()
+            rclpy.try_shutdown()
+        return 0
 
 
 if __name__ == "__main__":

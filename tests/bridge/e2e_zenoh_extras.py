@@ -9,14 +9,13 @@ SECONDS pass.
 
 from __future__ import annotations
 
-import signal
 import sys
 import time
-from typing import Any
 
 from google.protobuf import text_format
 
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import create_node
 
 REQUEST_TYPE = "gz.msgs.WorldControl"
@@ -30,30 +29,23 @@ def emit(text: str) -> None:
 
 def main() -> int:
     service, seconds = sys.argv[1], float(sys.argv[2])
-    stop = False
+    with StopSignal() as stop:
+        request_class = message_class(REQUEST_TYPE)
+        reply = message_class(REPLY_TYPE)(data=True).SerializeToString()
 
-    def request_stop(_signum: int, _frame: Any) -> None:
-        nonlocal stop
-        stop = True
+        def handle(payload: bytes) -> tuple[bool, bytes]:
+            request = request_class.FromString(payload)
+            emit(f"REQUEST {text_format.MessageToString(request, as_one_line=True)}")
+            return True, reply
 
-    signal.signal(signal.SIGTERM, request_stop)
-    signal.signal(signal.SIGINT, request_stop)
-    request_class = message_class(REQUEST_TYPE)
-    reply = message_class(REPLY_TYPE)(data=True).SerializeToString()
-
-    def handle(payload: bytes) -> tuple[bool, bytes]:
-        request = request_class.FromString(payload)
-        emit(f"REQUEST {text_format.MessageToString(request, as_one_line=True)}")
-        return True, reply
-
-    with create_node() as node:
-        emit(f"NODE {type(node).__name__}")
-        node.advertise_service(service, REQUEST_TYPE, REPLY_TYPE, handle)
-        emit("READY")
-        end = time.monotonic() + seconds
-        while not stop and time.monotonic() < end:
-            time.sleep(0.05)
-    return 0
+        with create_node() as node:
+            emit(f"NODE {type(node).__name__}")
+            node.advertise_service(service, REQUEST_TYPE, REPLY_TYPE, handle)
+            emit("READY")
+            end = time.monotonic() + seconds
+            while not stop.requested and time.monotonic() < end:
+                time.sleep(0.05)
+        return 0
 
 
 if __name__ == "__main__":

@@ -14,7 +14,6 @@ text>`` per message echoed.
 from __future__ import annotations
 
 import json
-import signal
 import sys
 import time
 from typing import Any
@@ -22,6 +21,7 @@ from typing import Any
 from google.protobuf import text_format
 
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import MessageInfo, create_node
 
 _PUBLISH_PERIOD = 0.2
@@ -34,15 +34,7 @@ def emit(text: str) -> None:
 
 def main() -> int:
     spec = json.loads(sys.argv[1])
-    stop = False
-
-    def request_stop(_signum: int, _frame: Any) -> None:
-        nonlocal stop
-        stop = True
-
-    signal.signal(signal.SIGTERM, request_stop)
-    signal.signal(signal.SIGINT, request_stop)
-    with create_node() as node:
+    with StopSignal() as stop, create_node() as node:
         emit(f"NODE {type(node).__name__}")
         publishers = []
         for topic, gz_type, text in spec.get("publish", []):
@@ -56,11 +48,11 @@ def main() -> int:
             node.subscribe_typed(topic, message_class(gz_type), echo)
         emit("READY")
         end = time.monotonic() + float(spec.get("seconds", 60))
-        while not stop and time.monotonic() < end:
+        while not stop.requested and time.monotonic() < end:
             for publisher, msg in publishers:
                 publisher.publish(msg)
             time.sleep(_PUBLISH_PERIOD)
-    return 0
+        return 0
 
 
 if __name__ == "__main__":

@@ -7,34 +7,26 @@ on ``tcp/127.0.0.1:PORT`` only, without scouting, prints ``READY`` and runs unti
 
 from __future__ import annotations
 
-import signal
 import sys
 import time
-from typing import Any
 
 import zenoh
 
+from ros_gz_bridge_py.stop_signal import StopSignal
 from ros_gz_bridge_py.transport.zenoh_config import endpoints_config
 
 
 def main() -> int:
     port, seconds = int(sys.argv[1]), float(sys.argv[2])
-    stop = False
-
-    def request_stop(_signum: int, _frame: Any) -> None:
-        nonlocal stop
-        stop = True
-
-    signal.signal(signal.SIGTERM, request_stop)
-    signal.signal(signal.SIGINT, request_stop)
-    config = endpoints_config("router", listen=[f"tcp/127.0.0.1:{port}"])
-    with zenoh.open(config):
-        sys.stdout.write("READY\n")
-        sys.stdout.flush()
-        end = time.monotonic() + seconds
-        while not stop and time.monotonic() < end:
-            time.sleep(0.05)
-    return 0
+    with StopSignal() as stop:
+        config = endpoints_config("router", listen=[f"tcp/127.0.0.1:{port}"])
+        with zenoh.open(config):
+            sys.stdout.write("READY\n")
+            sys.stdout.flush()
+            end = time.monotonic() + seconds
+            while not stop.requested and time.monotonic() < end:
+                time.sleep(0.05)
+        return 0
 
 
 if __name__ == "__main__":
