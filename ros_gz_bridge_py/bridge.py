@@ -22,6 +22,7 @@ The bridge creates a wall-clock (steady) timer on the node that re-evaluates laz
 
 from __future__ import annotations
 
+import os
 import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -30,6 +31,7 @@ from typing import Any
 from rclpy.clock import Clock, ClockType
 
 from ros_gz_bridge_py.channel import (
+    BULK_THREAD_NICE,
     Channel,
     ChannelContext,
     GzToRosChannel,
@@ -53,6 +55,8 @@ from ros_gz_bridge_py.transport import NodeOptions, create_node
 BULK_PATH_ENV = "ROS_GZ_BRIDGE_BULK_PATH"
 #: Environment switch: ``off`` makes ROS->Gazebo channels take rclpy's message objects.
 LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
+#: Environment setting: the nice offset of bulk-path delivery threads (an integer, 0: none).
+BULK_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
 
 
 @dataclass
@@ -112,6 +116,7 @@ class Bridge:
             override_frame_id=self.options.override_frame_id,
             bulk_path=self.options.bulk_path and not switched_off(BULK_PATH_ENV),
             light_read=self.options.light_read and not switched_off(LIGHT_READ_ENV),
+            bulk_nice=_bulk_nice(ros_node.get_logger()),
         )
         self._logger = ros_node.get_logger()
         self._lock = threading.RLock()
@@ -276,3 +281,18 @@ def _close_handle(handle: BridgeHandle) -> None:
         channel.close()
     if handle.service is not None:
         handle.service.close()
+
+
+def _bulk_nice(logger: Any) -> int:
+    """:data:`BULK_NICE_ENV` as an integer; a value that is not one is reported, not used."""
+    text = os.environ.get(BULK_NICE_ENV, "").strip()
+    if not text:
+        return BULK_THREAD_NICE
+    try:
+        return int(text)
+    except ValueError:
+        logger.warning(
+            f"{BULK_NICE_ENV}={text!r} is not an integer; using {BULK_THREAD_NICE} "
+            f"(set a whole number, 0 to keep image threads at normal priority)"
+        )
+        return BULK_THREAD_NICE

@@ -56,9 +56,8 @@ from ros_gz_bridge_py.transport import MessageInfo, Node, Publisher, Subscriptio
 ERROR_LOG_PERIOD = 5.0
 #: Fewest messages a Gazebo->ROS delivery queue holds.
 MIN_DELIVERY_QUEUE = 100
-#: How much lower the CPU priority (nice) of bulk-path delivery threads is; 0 keeps it.
+#: How much lower the CPU priority (nice) of bulk-path delivery threads is, by default.
 BULK_THREAD_NICE = 10
-BULK_THREAD_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
 
 
 class ChannelState(enum.Enum):
@@ -116,6 +115,8 @@ class ChannelContext:
     bulk_path: bool = True
     #: ROS->Gazebo: read serialized messages with ros_cdr (off: rclpy's message objects).
     light_read: bool = True
+    #: Nice offset of bulk-path delivery threads (0 keeps their priority).
+    bulk_nice: int = BULK_THREAD_NICE
     #: OwnPublications per resolved ROS topic, shared by the two halves of a bidirectional bridge.
     own_publications: Callable[[str], OwnPublications] = field(
         default_factory=_own_publications_table
@@ -325,7 +326,7 @@ class GzToRosChannel(Channel):
         assert self.bulk is not None  # subscribed this way only with a bulk path
         if self._yielding_thread != threading.get_ident():
             self._yielding_thread = threading.get_ident()
-            yield_cpu_to_light_topics()
+            yield_cpu_to_light_topics(self.ctx.bulk_nice)
         try:
             cdr = gz_to_ros_cdr(self.bulk, self._gz_class, memoryview(payload), self._finish)
         except Exception as err:
@@ -450,18 +451,14 @@ class RosToGzChannel(Channel):
             publisher.publish_raw(payload)
 
 
-def yield_cpu_to_light_topics() -> None:
-    """Lower the calling thread's CPU priority by :data:`BULK_THREAD_NICE` (Linux, per thread).
+def yield_cpu_to_light_topics(nice: int) -> None:
+    """Lower the calling thread's CPU priority by ``nice`` (Linux, per thread; 0: unchanged).
 
     The delivery thread of an image or point cloud channel spends milliseconds of CPU per
     message (copies, the DDS write); on a busy machine that would delay ``/clock`` and the
     other light topics, in this process and in the processes that receive them. Raising a
     thread's own nice value needs no privilege; where it is not possible nothing changes.
     """
-    try:
-        nice = int(os.environ.get(BULK_THREAD_NICE_ENV, BULK_THREAD_NICE))
-    except ValueError:  # not a number: the default
-        nice = BULK_THREAD_NICE
     if nice <= 0:
         return
     with contextlib.suppress(OSError, AttributeError):
