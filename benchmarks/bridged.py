@@ -103,9 +103,16 @@ def ceilings(seconds: float, cases: Cases) -> Ceilings:
 
 
 def through_bridge(
-    seconds: float, which: Backend, ceiling: Ceilings, gz_cases: Cases, ros_cases: Cases
+    seconds: float,
+    which: Backend,
+    ceiling: Ceilings,
+    gz_cases: Cases,
+    ros_cases: Cases,
+    *,
+    depth: int | None = None,
 ) -> list[Row]:
-    """GZ->ROS and ROS->GZ flows through one parameter_bridge with a channel per kind and way."""
+    """GZ->ROS and ROS->GZ flows through one parameter_bridge with a channel per kind and way
+    (``depth``: the history depth of the ROS subscribers, None for the bridge's default)."""
     gz2ros = {kind: topic_name(f"g2r_{kind}") for kind, _ in gz_cases}
     ros2gz = {kind: topic_name(f"r2g_{kind}") for kind, _ in ros_cases}
     arguments = [bridge_argument(t, k, "gz2ros") for k, t in gz2ros.items()]
@@ -115,8 +122,10 @@ def through_bridge(
         for way, cases, topics in (("GZ->ROS", gz_cases, gz2ros), ("ROS->GZ", ros_cases, ros2gz)):
             ends = ("gz-pub", "ros-sub") if way == "GZ->ROS" else ("ros-pub", "gz-sub")
             for kind, hz in cases:
-                flow = Flow(*ends, kind, seconds, hz)
+                flow = Flow(*ends, kind, seconds, hz, depth=depth if way == "GZ->ROS" else None)
                 result = flow_through(flow, topics[kind], which, bridge)
                 path = f"{way} parameter_bridge ({which.name})"
+                if depth is not None and way == "GZ->ROS":
+                    path += f", subscriber depth {depth}"
                 rows.append(Row(path, kind, hz, result, ceiling.get((kind, hz))))
     return rows

@@ -21,8 +21,10 @@ import pytest
 
 from benchmarks.payloads import KINDS
 from benchmarks.transport import STATS_LINE
+from benchmarks.workers import MATCH_WAIT
+from benchmarks.workers import SETTLE as PUBLISH_SETTLE
 from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
-from tests.gzpeer import PeerProcess, start_process, stop_processes, wait_for_line
+from tests.gzpeer import PeerProcess, peer_binary, start_process, stop_processes, wait_for_line
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
@@ -126,11 +128,58 @@ class CpuWindow:
 # --- processes --------------------------------------------------------------------------------
 
 
+#: The sentence every report uses to say what its Gazebo ends are.
+GZ_ENDS = (
+    "Gazebo ends: on ZeroMQ, the C++ peer on the real Ignition Transport 11 (`tests/peer`, "
+    "modes kind-pub and kind-sub), which serializes every message anew as a simulator does; "
+    "on Zenoh, our Python workers (`benchmarks.workers`; Fortress has no Zenoh backend)."
+)
+
+
+def uses_ign_peer(env: Mapping[str, str]) -> bool:
+    """Whether the Gazebo ends of a flow in ``env`` are the C++ peer on Ignition Transport 11.
+
+    They are on ZeroMQ: a real Gazebo library, publishing at the cost a simulator pays. Zenoh
+    needs our Python workers (Fortress has no Zenoh backend), and ``BENCH_GZ_END=python``
+    asks for them on ZeroMQ too.
+    """
+    return env.get("GZ_TRANSPORT_IMPLEMENTATION") != "zenoh" and env.get("BENCH_GZ_END") != "python"
+
+
+def gz_message_file(kind: str) -> Path:
+    """The Gazebo message of ``kind``, serialized into a file for the C++ peer's kind-pub."""
+    spec = KINDS[kind]
+    path = ROOT / ".build" / "bench_messages" / f"{kind}.pb"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(spec.pair.to_gz(spec.make_ros()).SerializeToString())
+    return path
+
+
 def worker(
     role: str, topic: str, kind: str, seconds: float, env: Mapping[str, str], *extra: str
 ) -> PeerProcess:
+    """A publisher or subscriber process of ``role`` (see ``benchmarks.workers``)."""
+    if role in {"gz-pub", "gz-sub"} and uses_ign_peer(env):
+        return ign_worker(role, topic, kind, seconds, env, *extra)
     command = [sys.executable, "-m", "benchmarks.workers", role, topic, kind, str(seconds)]
     return start_process([*command, *extra], env)
+
+
+def ign_worker(
+    role: str, topic: str, kind: str, seconds: float, env: Mapping[str, str], *extra: str
+) -> PeerProcess:
+    """The C++ peer's kind-pub / kind-sub as a worker: the same lines, the same STATS."""
+    spec = KINDS[kind]
+    if "--slow-ms" in extra:
+        msg = "the C++ Gazebo subscriber has no --slow-ms"
+        raise ValueError(msg)
+    if role == "gz-pub":
+        mode = ["kind-pub", topic, spec.ignition_type, str(gz_message_file(kind)), str(seconds)]
+        mode += ["--wait", str(MATCH_WAIT), "--settle", str(PUBLISH_SETTLE)]
+    else:
+        mode = ["kind-sub", topic, spec.ignition_type, str(seconds)]
+    options = ["--stamp", spec.gz_stamp_path, "--wire-type", spec.gz_type]
+    return start_process([str(peer_binary()), *mode, *options, *extra], env)
 
 
 def bridge_argument(ros_topic: str, kind: str, direction: str) -> str:

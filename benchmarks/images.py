@@ -3,8 +3,8 @@
 Usage: ``.venv/bin/python -m benchmarks.images [--seconds S] [--no-zenoh]``; writes the
 ``images`` section of BENCHMARKS.md. The ceiling is an rclpy publisher -> rclpy subscriber with
 the same settings as the bridge (Fast DDS SHM profile, EventsExecutor, allocator tuning). The
-Gazebo ends are Python ``benchmarks.workers`` on the bridge's backend (ZeroMQ, or Zenoh on
-explicit loopback endpoints).
+Gazebo ends are those of ``benchmarks.harness.worker`` (the C++ Ignition Transport peer on
+ZeroMQ, Python workers on Zenoh, on explicit loopback endpoints).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from benchmarks.bridged import (
     flow_through,
     through_bridge,
 )
-from benchmarks.harness import Flow, bridge_argument, topic_name
+from benchmarks.harness import GZ_ENDS, Flow, bridge_argument, topic_name
 from benchmarks.report import write_section
 from benchmarks.tables import Row, latency_goal, rate_goal, table
 
@@ -116,6 +116,7 @@ Gazebo publisher is not slowed down by its subscribers as an rclpy one is (DDS r
 flat out it sends several times what the bridge converts, and the bridge receives, then
 drops, the rest. The rows "paced at the ceiling's rate" publish from Gazebo at the msg/s the
 ceiling reached flat out, to show whether the bridge keeps up with what rclpy itself does.
+{GZ_ENDS}
 
 {table(ceiling_rows + rows)}
 

@@ -16,7 +16,7 @@ import time
 from dataclasses import dataclass, field
 
 from benchmarks.bridged import backend, bridge_process, flow_through
-from benchmarks.harness import Flow, FlowResult, bridge_argument, rss_mb, topic_name
+from benchmarks.harness import GZ_ENDS, Flow, FlowResult, bridge_argument, rss_mb, topic_name
 from benchmarks.report import write_section
 from benchmarks.tables import Row, table, verdict
 
@@ -117,7 +117,7 @@ def run(flood_seconds: float, slow_seconds: float) -> str:
 Command: `.venv/bin/python -m benchmarks.memory --flood-seconds {flood_seconds:g} \
 --slow-seconds {slow_seconds:g}`
 
-A Python Gazebo publisher sends 1920x1080 rgb8 images back to back through a fresh
+A Gazebo publisher sends 1920x1080 rgb8 images back to back through a fresh
 parameter_bridge (Gazebo -> ROS) to an rclpy subscriber: first for {flood_seconds:g} s, then
 for {slow_seconds:g} s to a subscriber that sleeps {SLOW_MS:g} ms in each callback. The
 bridge's RSS (/proc/<pid>/status VmRSS) is sampled every {SAMPLE_PERIOD:g} s from {WARM_UP:g} s
@@ -126,7 +126,7 @@ first third (single samples swing by ~100 MB as 6 MB frames are received, queued
 freed, so first-versus-last-sample differences measure the swing, not a leak; the peak and the
 trajectory are shown too). Images the bridge
 cannot pass on are dropped (its per-channel queue drops the oldest; the ROS publisher keeps the
-last 10).
+last 10). {GZ_ENDS}
 
 {table(rows)}
 

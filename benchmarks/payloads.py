@@ -38,6 +38,24 @@ class Kind:
     def has_header(self) -> bool:
         return self.stamp_at == "header"
 
+    @property
+    def gz_stamp_path(self) -> str:
+        """Where the stamp lives in the Gazebo message, as the C++ peer's ``--stamp`` path."""
+        return _GZ_STAMP_PATHS[self.stamp_at]
+
+    @property
+    def ignition_type(self) -> str:
+        """The Fortress (ignition-msgs8) name of :attr:`gz_type`, for the C++ peer."""
+        return self.gz_type.replace("gz.msgs.", "ignition.msgs.", 1)
+
+
+_GZ_STAMP_PATHS = {
+    "header": "header.stamp",
+    "transform": "pose.0.header.stamp",
+    "clock": "sim",
+    "twist": "linear.x",
+}
+
 
 def _image(width: int, height: int) -> Any:
     from sensor_msgs.msg import Image  # noqa: PLC0415 - ROS imports only where used

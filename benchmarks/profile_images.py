@@ -80,6 +80,8 @@ def pids_with(needle: str) -> list[int]:
 def role_of(pid: int) -> str:
     with open(f"/proc/{pid}/cmdline", "rb") as cmdline:
         words = [word.decode(errors="replace") for word in cmdline.read().split(b"\0")]
+    if "kind-pub" in words:  # the C++ Gazebo publisher (benchmarks.harness.ign_worker)
+        return "gz-pub"
     for role in ("gz-pub", "ros-sub"):
         if role in words:
             return role

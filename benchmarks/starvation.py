@@ -18,7 +18,7 @@ import time
 from dataclasses import dataclass
 
 from benchmarks.bridged import Backend, backend, bridge_process, flow_through
-from benchmarks.harness import Flow, FlowResult, bridge_argument, topic_name
+from benchmarks.harness import GZ_ENDS, Flow, FlowResult, bridge_argument, topic_name
 from benchmarks.report import write_section
 from benchmarks.tables import Row, table, verdict
 from tests.gzpeer import PeerProcess
@@ -137,7 +137,7 @@ def run(seconds: float) -> str:
 
 Command: `.venv/bin/python -m benchmarks.starvation --seconds {seconds:g}`
 
-One bridge process with two Gazebo -> ROS channels: `/clock` (a Python Gazebo publisher at
+One bridge process with two Gazebo -> ROS channels: `/clock` (a Gazebo publisher at
 {CLOCK_HZ:g} Hz, `sim` = CLOCK_MONOTONIC) and a 1920x1080 rgb8 Image topic. First the clock
 alone ({seconds:g} s), then the clock twice while another publisher sends images (the flood
 starts ~{MARGIN + 8:g} s before the first clock phase and outlasts the second): once to an
@@ -149,7 +149,7 @@ bounded queue in the bridge; the image channel takes the bulk path, whose DDS wr
 with the GIL released. "The bridge published" is the clock channel's own counter (SIGUSR1
 status table) over the phase: what the bridge did, apart from what the subscriber process,
 sharing 2 cores with four other busy processes, managed to take before its history
-overflowed. Bridge CPU: % of one core over the window.
+overflowed. Bridge CPU: % of one core over the window. {GZ_ENDS}
 
 {table(rows)}
 

@@ -22,7 +22,10 @@ constexpr char kUsage[] =
     "  reply SERVICE REQTYPE REPTYPE SECONDS [--fail] [--response TEXTPROTO] [--sha]\n"
     "  call SERVICE REQTYPE REPTYPE TIMEOUT_MS [TEXTPROTO]\n"
     "  bench-pub TOPIC SIZE SECONDS [--hz HZ] [--wait S]\n"
-    "  bench-sub TOPIC SECONDS [--count N]\n";
+    "  bench-sub TOPIC SECONDS [--count N]\n"
+    "  kind-pub TOPIC TYPE FILE SECONDS --stamp PATH [--hz HZ] [--wait S] [--settle S]\n"
+    "      [--wire-type WIRETYPE]\n"
+    "  kind-sub TOPIC TYPE SECONDS --stamp PATH [--count N] [--wire-type WIRETYPE]\n";
 
 }  // namespace
 
@@ -31,7 +34,8 @@ int main(int argc, char **argv) {
       {"pub", peer::RunPub},         {"echo", peer::RunEcho},
       {"relay", peer::RunRelay},     {"reply", peer::RunReply},
       {"call", peer::RunCall},       {"bench-pub", peer::RunBenchPub},
-      {"bench-sub", peer::RunBenchSub}};
+      {"bench-sub", peer::RunBenchSub},   {"kind-pub", peer::RunKindPub},
+      {"kind-sub", peer::RunKindSub}};
   try {
     const peer::Args args(argc, argv, {"sha", "hex", "fail"});
     const auto mode = modes.find(args.Word(0, "MODE"));

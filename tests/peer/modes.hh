@@ -12,5 +12,7 @@ int RunReply(const Args &args);
 int RunCall(const Args &args);
 int RunBenchPub(const Args &args);
 int RunBenchSub(const Args &args);
+int RunKindPub(const Args &args);
+int RunKindSub(const Args &args);
 
 }  // namespace peer

@@ -1,0 +1,102 @@
+"""The C++ peer's typed benchmark modes (kind-pub, kind-sub) against our node.
+
+The benchmarks put these modes at the Gazebo end of every ZeroMQ flow, so the stamp they write
+and read at a field path is what every latency figure rests on. Here our own node checks both:
+what the real ign-transport publisher sends (the file's message, stamped with the send time),
+and what the real subscriber reads back from messages we stamp.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from ros_gz_bridge_py.msgs import message_class
+from tests.gzpeer import Inbox, start_peer, unique_name, wait_for_line, wait_until
+
+pytestmark = pytest.mark.peer
+
+NS = 1_000_000_000
+
+
+def test_kind_pub_sends_the_file_message_stamped_at_the_path(
+    ign_peer: Path, gz_node: Any, tmp_path: Path
+) -> None:
+    odometry = message_class("gz.msgs.Odometry")
+    original = odometry()
+    original.header.data.add(key="frame_id", value=["odom"])
+    original.pose.position.x = 1.5
+    original.twist.angular.z = -0.25
+    message_file = tmp_path / "odometry.pb"
+    message_file.write_bytes(original.SerializeToString())
+    topic = unique_name("kind_pub")
+    inbox = Inbox()
+    gz_node.subscribe_typed(topic, odometry, inbox, msg_type="gz.msgs.Odometry")
+
+    before = time.monotonic_ns()
+    peer = start_peer(
+        "kind-pub", topic, "ignition.msgs.Odometry", str(message_file), "0.5",
+        "--hz", "40", "--stamp", "header.stamp", "--wire-type", "gz.msgs.Odometry",
+    )  # fmt: skip
+    sent = int(wait_for_line(peer, r"^SENT (\d+)", 15)[1])
+    after = time.monotonic_ns()
+    items = inbox.wait_for_count(sent, timeout=5)
+
+    stamps = [msg.header.stamp.sec * NS + msg.header.stamp.nsec for msg, _ in items]
+    assert len(stamps) == sent >= 10
+    assert stamps == sorted(set(stamps))
+    assert before < stamps[0]
+    assert stamps[-1] < after
+    for msg, info in items:
+        assert info.msg_type == "gz.msgs.Odometry"
+        msg.header.ClearField("stamp")
+        assert msg == original
+
+
+@pytest.mark.parametrize(
+    ("gz_type", "path"),
+    [("gz.msgs.Pose_V", "pose.0.header.stamp"), ("gz.msgs.Twist", "linear.x")],
+)
+def test_kind_sub_reads_the_stamp_we_write(
+    ign_peer: Path, gz_node: Any, gz_type: str, path: str
+) -> None:
+    topic = unique_name("kind_sub")
+    ignition_type = gz_type.replace("gz.msgs.", "ignition.msgs.")
+    peer = start_peer(
+        "kind-sub", topic, ignition_type, "20", "--count", "20", "--stamp", path,
+        "--wire-type", gz_type,
+    )  # fmt: skip
+    wait_for_line(peer, r"^READY$")
+    publisher = gz_node.advertise(topic, gz_type)
+    wait_until(publisher.has_connections, 10, "the peer's subscription")
+    time.sleep(0.3)  # its ZeroMQ connection comes up just after discovery
+    msg = message_class(gz_type)()
+    deadline = time.monotonic() + 15
+    while peer.poll() is None and time.monotonic() < deadline:
+        now = time.monotonic_ns()
+        if gz_type == "gz.msgs.Twist":
+            msg.linear.x = now / NS
+        else:
+            msg.ClearField("pose")
+            msg.pose.add().header.stamp.sec, msg.pose[0].header.stamp.nsec = divmod(now, NS)
+        publisher.publish(msg)
+        time.sleep(0.02)
+
+    stats = wait_for_line(peer, r"^STATS count=(\d+) .* median_us=([\d.]+) p99_us=([\d.]+)", 5)
+    assert int(stats[1]) == 20
+    # Latencies from our stamps: positive and far below a second on loopback.
+    assert 0 < float(stats[2]) <= float(stats[3]) < 1_000_000
+
+
+def test_kind_pub_rejects_a_stamp_path_the_type_lacks(ign_peer: Path, tmp_path: Path) -> None:
+    message_file = tmp_path / "twist.pb"
+    message_file.write_bytes(b"")
+    peer = start_peer(
+        "kind-pub", unique_name("bad_path"), "ignition.msgs.Twist", str(message_file), "1",
+        "--stamp", "header.nonsense",
+    )  # fmt: skip
+    assert peer.wait(10) == 2
+    assert "stamp path header.nonsense: no field nonsense" in peer.output()
