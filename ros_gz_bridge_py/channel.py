@@ -231,8 +231,6 @@ class GzToRosChannel(Channel):
         self._publish: Callable[[Any], None] = _closed_publish
         self._subscription: Subscription | None = None
         self._finish = self._make_finisher()
-        #: The delivery thread already made to yield (see yield_cpu_to_light_topics).
-        self._yielding_thread: int | None = None
 
     def describe(self) -> str:
         return (
@@ -288,6 +286,7 @@ class GzToRosChannel(Channel):
                 ignore_local=True,
                 queue_size=depth,
                 copy=False,
+                on_delivery_start=lambda: yield_cpu_to_light_topics(self.ctx.bulk_nice),
             )
             return
         self._subscription = self.ctx.gz_node.subscribe_typed(
@@ -326,9 +325,6 @@ class GzToRosChannel(Channel):
         """The bulk path: Gazebo payload straight to a serialized ROS message."""
         self.stats.received += 1
         assert self.bulk is not None  # subscribed this way only with a bulk path
-        if self._yielding_thread != threading.get_ident():
-            self._yielding_thread = threading.get_ident()
-            yield_cpu_to_light_topics(self.ctx.bulk_nice)
         try:
             cdr = gz_to_ros_cdr(self.bulk, self._gz_class, memoryview(payload), self._finish)
         except Exception as err:

@@ -174,16 +174,28 @@ class Node(abc.ABC):
         ignore_local: bool = False,
         queue_size: int | None = None,
         copy: bool = True,
+        on_delivery_start: Callable[[], None] | None = None,
     ) -> Subscription:
         """Receive raw payloads of ``msg_type`` (exact string; GENERIC_TYPE = any).
 
         ``queue_size`` None runs ``callback`` on the node's I/O thread; N gives the
-        subscription its own delivery thread behind a drop-oldest queue of N messages.
+        subscription its own delivery thread behind a drop-oldest queue of N messages, which
+        first runs ``on_delivery_start`` (e.g. to set its own priority).
         ``copy=False`` hands over the backend's buffer (``bytes`` or a read-only
         ``memoryview``) instead of copying it into ``bytes``.
         """
+        if on_delivery_start is not None and queue_size is None:
+            msg = "on_delivery_start needs a queue_size: without one there is no delivery thread"
+            raise ValueError(msg)
         deliver = raw_deliverer(self.count, callback, copy=copy)
-        return self._add_subscription(topic, msg_type, deliver, ignore_local, queue_size)
+        return self._add_subscription(
+            topic,
+            msg_type,
+            deliver,
+            ignore_local=ignore_local,
+            queue_size=queue_size,
+            on_delivery_start=on_delivery_start,
+        )
 
     def subscribe_typed(
         self,
@@ -203,7 +215,14 @@ class Node(abc.ABC):
         """
         deliver = typed_deliverer(self.count, msg_class, callback)
         wanted = msg_type or msg_class.DESCRIPTOR.full_name
-        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size)
+        return self._add_subscription(
+            topic,
+            wanted,
+            deliver,
+            ignore_local=ignore_local,
+            queue_size=queue_size,
+            on_delivery_start=None,
+        )
 
     @abc.abstractmethod
     def count(self, name: str, amount: int = 1) -> None:
@@ -215,8 +234,10 @@ class Node(abc.ABC):
         topic: str,
         msg_type: str,
         deliver: Deliver,
+        *,
         ignore_local: bool,
         queue_size: int | None,
+        on_delivery_start: Callable[[], None] | None,
     ) -> Subscription:
         """Register a subscription that hands each matching payload to ``deliver``."""
 

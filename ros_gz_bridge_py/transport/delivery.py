@@ -88,6 +88,7 @@ class DeliveryQueue(Generic[T]):
     node's I/O thread) more than the message itself. The bound is kept by the producer, which
     takes the oldest item out when the queue is over ``size``; a get racing with that can make
     the queue briefly hold one more or one fewer item, never an unbounded number.
+    ``on_start`` runs on the delivery thread before it takes the first item.
     """
 
     def __init__(
@@ -98,6 +99,7 @@ class DeliveryQueue(Generic[T]):
         *,
         weigh: Callable[[T], int],
         max_bytes: int = MAX_QUEUED_BYTES,
+        on_start: Callable[[], None] | None = None,
     ) -> None:
         if size < 1:
             msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
@@ -110,6 +112,7 @@ class DeliveryQueue(Generic[T]):
         self._bytes_put = self._bytes_dropped = self._bytes_handled = 0
         self._items: queue.SimpleQueue[T | object] = queue.SimpleQueue()
         self._handler = handler
+        self._on_start = on_start
         self._closed = False
         self.dropped = 0
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
@@ -144,6 +147,8 @@ class DeliveryQueue(Generic[T]):
             self._thread.join()
 
     def _run(self) -> None:
+        if self._on_start is not None:
+            self._on_start()
         get = self._items.get
         while True:
             item = cast(T, get())  # only _STOP is not a T, and it comes after close

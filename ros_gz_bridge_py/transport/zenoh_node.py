@@ -272,16 +272,19 @@ class ZenohNode(Node):
         topic: str,
         msg_type: str,
         deliver: Deliver,
+        *,
         ignore_local: bool,
         queue_size: int | None,
+        on_delivery_start: Callable[[], None] | None,
     ) -> ZenohSubscription:
         fqn = self._fqn(topic)
         token = message_token(
             fqn, self.process_uuid, self.node_uuid, EntityKind.SUBSCRIBER, msg_type
         )
         sub = ZenohSubscription(
-            self, topic, fqn, msg_type, deliver, ignore_local=ignore_local, queue_size=queue_size
-        )
+            self, topic, fqn, msg_type, deliver,
+            ignore_local=ignore_local, queue_size=queue_size, on_delivery_start=on_delivery_start,
+        )  # fmt: skip
         try:
             # The subscriber first: once a gz publisher sees the token, it may put.
             zenoh_subscriber = self._declare(

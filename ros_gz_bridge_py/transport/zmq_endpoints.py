@@ -75,6 +75,7 @@ class ZmqSubscription(Subscription):
         *,
         ignore_local: bool,
         queue_size: int | None,
+        on_delivery_start: Callable[[], None] | None,
     ) -> None:
         self.topic = topic
         self.fqn = fqn
@@ -87,7 +88,11 @@ class ZmqSubscription(Subscription):
         self._queue: DeliveryQueue[Delivery] | None = None
         if queue_size is not None:
             self._queue = DeliveryQueue(
-                queue_size, self._run, f"gz-sub {topic}", weigh=payload_size
+                queue_size,
+                self._run,
+                f"gz-sub {topic}",
+                weigh=payload_size,
+                on_start=on_delivery_start,
             )
 
     @property

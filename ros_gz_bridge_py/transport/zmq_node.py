@@ -382,12 +382,14 @@ class ZmqNode(Node):
         topic: str,
         msg_type: str,
         deliver: Callable[[Frame, MessageInfo], None],
+        *,
         ignore_local: bool,
         queue_size: int | None,
+        on_delivery_start: Callable[[], None] | None,
     ) -> ZmqSubscription:
         sub = ZmqSubscription(
             self, topic, self._fqn(topic), msg_type, deliver,
-            ignore_local=ignore_local, queue_size=queue_size,
+            ignore_local=ignore_local, queue_size=queue_size, on_delivery_start=on_delivery_start,
         )  # fmt: skip
         try:
             self._call(lambda: self._start_subscription(sub))

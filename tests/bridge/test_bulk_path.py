@@ -20,6 +20,8 @@ import pytest
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import Image, PointCloud2, PointField
 
+from ros_gz_bridge_py.bridge import BULK_PATH_ENV as BULK_ENV
+from ros_gz_bridge_py.channel import BULK_THREAD_NICE
 from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.transport import Node as GzNode
 from tests.bridge.behaviour_harness import (
@@ -70,6 +72,7 @@ class Topics:
 class RunningBridge:
     process: PeerProcess
     topics: Topics
+    variant: str
 
 
 @pytest.fixture(scope="module", params=list(VARIANTS))
@@ -93,7 +96,7 @@ def bridge(request: pytest.FixtureRequest) -> Iterator[RunningBridge]:
     try:
         for _ in range(5):
             wait_for_line(process, r"\]: Creating ", timeout=30)
-        yield RunningBridge(process, topics)
+        yield RunningBridge(process, topics, request.param)
     finally:
         process.stop()
 
@@ -213,6 +216,22 @@ def test_gazebo_to_ros_image_from_the_real_peer(
     assert (msg.width, msg.height, msg.step) == (WIDTH, HEIGHT, WIDTH * 3)
     assert (msg.encoding, msg.is_bigendian, msg.header.frame_id) == ("rgb8", 0, "a/b")
     assert bytes(msg.data) == pattern_bytes(size)
+    # The delivery threads of the two bulk channels (image, cloud) lowered their own priority
+    # when they started, by the default BULK_THREAD_NICE; no other thread did.
+    bulk = VARIANTS[bridge.variant].get(BULK_ENV) != "off"
+    expected = [BULK_THREAD_NICE, BULK_THREAD_NICE] if bulk else []
+    assert thread_nice_values(bridge.process.pid) == expected
+
+
+def thread_nice_values(pid: int) -> list[int]:
+    """The nice values of ``pid``'s threads that are not 0 (field 19 of /proc/.../stat)."""
+    values = []
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        with open(f"/proc/{pid}/task/{tid}/stat", encoding="ascii") as stat:
+            nice = int(stat.read().rsplit(")", 1)[1].split()[16])
+        if nice:
+            values.append(nice)
+    return values
 
 
 def test_gazebo_to_ros_cloud(bridge: RunningBridge, ros_side: RosSide, gz_node: GzNode) -> None:

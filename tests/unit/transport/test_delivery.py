@@ -74,3 +74,25 @@ def test_close_discards_pending_items_and_stops_the_thread() -> None:
     closer.join(5)
     assert not closer.is_alive()
     assert handled == [b"first"]
+
+
+def test_on_start_runs_on_the_delivery_thread_before_the_first_item() -> None:
+    events: list[tuple[str, int]] = []
+    done = threading.Event()
+
+    def handle(item: bytes) -> None:
+        events.append((item.decode(), threading.get_ident()))
+        done.set()
+
+    queue = DeliveryQueue(
+        10,
+        handle,
+        "test",
+        weigh=len,
+        on_start=lambda: events.append(("start", threading.get_ident())),
+    )
+    queue.put(b"item")
+    assert done.wait(5)
+    queue.close()
+    assert [name for name, _ in events] == ["start", "item"]
+    assert events[0][1] == events[1][1] != threading.get_ident()

@@ -168,6 +168,27 @@ def test_queue_size_drops_oldest() -> None:
         assert node.stats.messages_dropped == 3
 
 
+def test_on_delivery_start_runs_on_the_subscription_thread() -> None:
+    with create_node() as node:
+        topic = unique("start")
+        threads: list[tuple[str, int]] = []
+        node.subscribe(
+            topic,
+            lambda _p, _i: threads.append(("message", threading.get_ident())),
+            queue_size=4,
+            on_delivery_start=lambda: threads.append(("start", threading.get_ident())),
+        )
+        node.advertise(topic, "gz.msgs.StringMsg").publish(StringMsg(data="x"))
+        assert wait_until(lambda: len(threads) == 2)
+        assert [what for what, _ in threads] == ["start", "message"]
+        assert threads[0][1] == threads[1][1] != threading.get_ident()
+
+
+def test_on_delivery_start_without_a_queue_is_refused() -> None:
+    with create_node() as node, pytest.raises(ValueError, match="needs a queue_size"):
+        node.subscribe(unique("noqueue"), lambda _p, _i: None, on_delivery_start=lambda: None)
+
+
 def test_callback_errors_are_counted(nodes: tuple[ZmqNode, ZmqNode]) -> None:
     a, b = nodes
     topic = unique("boom")
