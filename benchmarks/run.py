@@ -3,6 +3,8 @@
 Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
 about 12 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
 Each module writes its own section; a module that fails is reported and the others still run.
+The Gazebo ends of ZeroMQ flows are the C++ peer on the real ign-transport 11 (built on first
+use, see ``tests/gzpeer.py``); ``BENCH_GZ_END=python`` puts our Python workers there instead.
 """
 
 from __future__ import annotations

@@ -33,7 +33,26 @@ def paced_goal(row: Row) -> str:
     return (
         f"- {what}: {result.received}/{result.sent} delivered ({result.share:.1%}), "
         f"{result.rate:,.0f} msg/s, median {result.median_us / 1000:.2f} ms — "
-        f"{verdict(met, f'{GOAL_RATE - result.rate:,.0f} msg/s')}"
+        f"{verdict(met, f'{GOAL_RATE - result.rate:,.0f} msg/s')}{cost(row)}"
+    )
+
+
+def cost(row: Row) -> str:
+    """The bridge's CPU time per delivered message, and what the goal rate would take."""
+    result = row.result
+    if result.cpu is None or result.rate <= 0:
+        return ""
+    per_message_us = result.cpu / 100 / result.rate * 1e6
+    needed = per_message_us * GOAL_RATE / 1e6
+    bound = (
+        ": more than one core, while the bridge's Python work runs on one core at a time (the "
+        "GIL), so its own per-message work bounds this channel"
+        if needed > 1
+        else ""
+    )
+    return (
+        f"; the bridge spent {per_message_us:,.0f} µs of CPU per message "
+        f"({GOAL_RATE:,.0f} msg/s would take {needed:.0%} of a core{bound})"
     )
 
 

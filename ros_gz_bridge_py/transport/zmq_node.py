@@ -4,7 +4,8 @@ Each :class:`ZmqNode` is a full gz participant with its own process UUID (two no
 Python process look like two processes on the wire). It owns two UDP discovery sockets (msg
 and srv port, each with its own :class:`DiscoveryEngine`) and the five ZMQ sockets of
 gz-transport-protocol.md §2.1: PUB (bound), SUB (connected to publishers), replier ROUTER
-(bound), requester ROUTER (connected to providers), responseReceiver ROUTER (bound).
+(bound), requester ROUTER (connected to providers), responseReceiver ROUTER (bound). The
+service side (offers, calls, retried ROUTER sends) is :class:`~.zmq_services.ServiceRouter`.
 
 Threading model:
 
@@ -29,14 +30,12 @@ from __future__ import annotations
 import collections
 import concurrent.futures
 import contextlib
-import errno
 import logging
 import socket
 import threading
 import time
 import uuid
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
 import zmq
@@ -70,22 +69,14 @@ from ros_gz_bridge_py.transport.wire import (
     MessagePublisher,
     PublisherRecord,
     ServicePublisher,
-    ServiceRequest,
-    ServiceResponse,
     decode_data,
-    decode_request,
-    decode_response,
-    encode_request,
-    encode_response,
 )
 from ros_gz_bridge_py.transport.zmq_endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
+from ros_gz_bridge_py.transport.zmq_services import PendingCall, RouterSockets, ServiceRouter
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 T = TypeVar("T")
 
-#: How long a ROUTER send to a peer that is not routable yet is retried (§2.9.3: gz sleeps
-#: 100 ms after connecting; we retry instead of sleeping).
-ROUTE_RETRY = 1.0
 #: Poll timeout while a retry is pending, and the longest poll otherwise (§2.5: 250 ms).
 RETRY_POLL = 0.005
 MAX_POLL = 0.25
@@ -96,34 +87,8 @@ READ_BATCH = 64
 COPY_BELOW = 64 * 1024
 #: Cached routes (topic, sender, type frames -> subscriptions, info); cleared beyond this size.
 ROUTE_CACHE_SIZE = 1024
-#: Response types that make a call one-way (§2.9.3).
-ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
 #: Where received data goes: the subscriptions that accept it, and what they are told.
 Route = tuple[tuple[ZmqSubscription, ...], MessageInfo]
-
-
-@dataclass(eq=False)
-class _Call:
-    """A service call waiting for a provider, a route or a response."""
-
-    fqn: str
-    request: bytes
-    request_type: str
-    response_type: str
-    deadline: float
-    callback: ReplyCallback
-    request_uuid: str = field(default_factory=lambda: str(uuid.uuid4()))
-    dispatched: bool = False
-
-
-@dataclass(eq=False)
-class _RoutedSend:
-    """A ROUTER send retried while the peer is not routable yet."""
-
-    sock: Any
-    frames: list[Frame]
-    deadline: float
-    on_sent: Callable[[], None] | None = None
 
 
 class ZmqNode(Node):
@@ -162,11 +127,6 @@ class ZmqNode(Node):
         # reconnects if the publisher comes back there, and disconnecting a pipe with data in
         # flight trips a libzmq assertion (fq.cpp, seen with ign-transport11's `-p`).
         self._sub_connected: set[str] = set()
-        self._requester_connected: set[str] = set()
-        self._replier_connected: set[str] = set()
-        self._offers: dict[tuple[str, str, str], ZmqServiceOffer] = {}
-        self._calls: dict[str, _Call] = {}
-        self._routed: list[_RoutedSend] = []
         self._open_resources()
 
     # --- start and stop --------------------------------------------------------------------
@@ -198,6 +158,11 @@ class ZmqNode(Node):
         engine_args: dict[str, Any] = {"local_ips": {self.host}, "relays": self.settings.relays}
         self._msg = DiscoveryEngine(self.process_uuid, now, **engine_args)
         self._srv = DiscoveryEngine(self.process_uuid, now, **engine_args)
+        sockets = RouterSockets(
+            self._srv, lambda out: self._send(self._srv_udp, out), self._requester,
+            self._replier, self.response_address, self.response_id, self.node_uuid,
+        )  # fmt: skip
+        self._services = ServiceRouter(sockets, self.count)
         self._wake_r.setblocking(False)
         self._wake_w.setblocking(False)
         self._io_thread = threading.Thread(target=self._io_main, name="gz-io", daemon=True)
@@ -252,8 +217,7 @@ class ZmqNode(Node):
                 self._end_subscription(sub)
         for engine, udp in ((self._msg, self._msg_udp), (self._srv, self._srv_udp)):
             self._send(udp, engine.bye())
-        for call in list(self._calls.values()):
-            self._finish(call, None, b"")
+        self._services.cancel_all()
 
     def _release(self) -> None:
         with self._pub_lock:
@@ -464,23 +428,13 @@ class ZmqNode(Node):
             Scope.ALL, srv=ServicePublisher(self.replier_id, request_type, response_type),
         )  # fmt: skip
         offer = ZmqServiceOffer(self, record, handler, (record.topic, request_type, response_type))
-
-        def command() -> None:
-            self._offers[offer.key] = offer
-            self._send(self._srv_udp, self._srv.advertise(record))
-
-        self._call(command)
+        self._call(lambda: self._services.add_offer(offer))
         return offer
 
     def unadvertise_service(self, offer: ZmqServiceOffer) -> None:
         """Withdraw ``offer`` (called by its ``close``)."""
-
-        def command() -> None:
-            self._offers.pop(offer.key, None)
-            self._send(self._srv_udp, self._srv.unadvertise(offer.record))
-
         with contextlib.suppress(TransportError):
-            self._call(command)
+            self._call(lambda: self._services.remove_offer(offer))
 
     def _on_node_thread(self) -> bool:
         return threading.current_thread() is self._io_thread
@@ -495,102 +449,11 @@ class ZmqNode(Node):
         callback: ReplyCallback,
     ) -> None:
         """Call ``service``; ``callback`` runs exactly once on the I/O thread."""
-        call = _Call(
+        call = PendingCall(
             self._fqn(service), bytes(request), request_type, response_type,
             time.monotonic() + timeout, callback,
         )  # fmt: skip
-        self._post(lambda: self._start_call(call))
-
-    def _start_call(self, call: _Call) -> None:
-        offer = self._offers.get((call.fqn, call.request_type, call.response_type))
-        if offer is not None:
-            ok, payload = self._run_handler(offer, call.request)
-            self._finish(call, ok, b"" if call.response_type in ONE_WAY_TYPES else payload)
-            return
-        self._calls[call.request_uuid] = call
-        if not self._dispatch_call(call):
-            self._send(self._srv_udp, self._srv.subscribe(call.fqn))
-
-    def _dispatch_call(self, call: _Call) -> bool:
-        """Send ``call`` to the first provider with exactly its types; False if none is known."""
-        for record in self._srv.remote_publishers(call.fqn):
-            srv = record.srv
-            if srv is None or (srv.request_type, srv.response_type) != (
-                call.request_type,
-                call.response_type,
-            ):
-                continue
-            if record.address not in self._requester_connected:
-                self._requester.connect(record.address)
-                self._requester_connected.add(record.address)
-            request = ServiceRequest(
-                call.fqn, self.response_address, self.response_id, self.node_uuid,
-                call.request_uuid, call.request, call.request_type, call.response_type,
-            )  # fmt: skip
-            one_way = call.response_type in ONE_WAY_TYPES
-            call.dispatched = True
-            self._routed.append(
-                _RoutedSend(
-                    self._requester,
-                    encode_request(srv.socket_id, request),
-                    min(call.deadline, time.monotonic() + ROUTE_RETRY),
-                    (lambda: self._finish(call, True, b"")) if one_way else None,
-                )
-            )
-            return True
-        return False
-
-    def _finish(self, call: _Call, ok: bool | None, payload: bytes) -> None:
-        self._calls.pop(call.request_uuid, None)
-        try:
-            call.callback(ok, payload)
-        except Exception:
-            self.count("callback_errors")
-            _LOG.exception("service reply callback for %s raised", call.fqn)
-
-    def _run_handler(self, offer: ZmqServiceOffer, request: bytes) -> tuple[bool, bytes]:
-        try:
-            ok, payload = offer.handler(request)
-        except Exception:
-            self.count("callback_errors")
-            _LOG.exception("service handler for %s raised", offer.record.topic)
-            return False, b""
-        return ok, payload if ok else b""
-
-    def _on_request(self, frames: list[Frame]) -> None:
-        """§2.9.3: look up the handler, run it, answer unless one-way."""
-        request = decode_request(frames)
-        key = (request.service, request.request_type, request.response_type)
-        offer = self._offers.get(key)
-        if offer is None:
-            self.count("requests_unhandled")
-            _LOG.debug("no handler for service request %s", key)
-            return
-        ok, payload = self._run_handler(offer, bytes(request.payload))
-        if request.response_type in ONE_WAY_TYPES:
-            return
-        if request.response_address not in self._replier_connected:
-            self._replier.connect(request.response_address)
-            self._replier_connected.add(request.response_address)
-        response = ServiceResponse(
-            request.service, request.node_uuid, request.request_uuid, payload, ok
-        )
-        self._routed.append(
-            _RoutedSend(
-                self._replier,
-                encode_response(request.response_id, response),
-                time.monotonic() + ROUTE_RETRY,
-            )
-        )
-
-    def _on_response(self, frames: list[Frame]) -> None:
-        response = decode_response(frames)
-        call = self._calls.get(response.request_uuid)
-        if call is None or call.fqn != response.service or response.node_uuid != self.node_uuid:
-            self.count("responses_unmatched")
-            _LOG.debug("unmatched service response for %s", response.service)
-            return
-        self._finish(call, response.ok, bytes(response.payload))
+        self._post(lambda: self._services.start_call(call))
 
     # --- listings ---------------------------------------------------------------------------
 
@@ -688,12 +551,10 @@ class ZmqNode(Node):
 
     def _poll_timeout(self) -> float:
         now = time.monotonic()
-        if self._routed or self._commands:
-            return RETRY_POLL if self._routed else 0.0
+        if self._services.retrying or self._commands:
+            return RETRY_POLL if self._services.retrying else 0.0
         deadline = min(self._msg.next_deadline(), self._srv.next_deadline(), now + MAX_POLL)
-        for call in self._calls.values():
-            deadline = min(deadline, call.deadline)
-        return max(0.0, deadline - now)
+        return max(0.0, self._services.next_deadline(deadline) - now)
 
     def _io_turn(self, ready: dict[Any, int]) -> None:
         if self._wake_r.fileno() in ready:
@@ -706,8 +567,8 @@ class ZmqNode(Node):
                 self._read_discovery(udp, engine)
         handlers = (
             (self._sub, self._on_data),
-            (self._replier, self._on_request),
-            (self._responses, self._on_response),
+            (self._replier, self._services.on_request),
+            (self._responses, self._services.on_response),
         )
         for sock, handler in handlers:
             if sock in ready:
@@ -717,9 +578,7 @@ class ZmqNode(Node):
             out, events = engine.tick(now)
             self._send(udp, out)
             self._handle_events(engine, events)
-        self._retry_routed(now)
-        for call in [c for c in self._calls.values() if c.deadline <= now]:
-            self._finish(call, None, b"")
+        self._services.turn(now)
 
     def _read_discovery(self, udp: DiscoverySocket, engine: DiscoveryEngine) -> None:
         for _ in range(READ_BATCH):
@@ -785,9 +644,7 @@ class ZmqNode(Node):
             if engine is self._msg:
                 self._handle_topic_event(event)
             elif isinstance(event, PublisherAdded):
-                for call in [c for c in self._calls.values() if not c.dispatched]:
-                    if call.fqn == event.record.topic:
-                        self._dispatch_call(call)
+                self._services.provider_found(event.record.topic)
         with self._changed:
             self._generation += 1
             self._changed.notify_all()
@@ -799,21 +656,6 @@ class ZmqNode(Node):
                 self._connect_publisher(event.record, subs)
         elif isinstance(event, SubscriberAdded | SubscriberRemoved):
             self._wire_types[event.topic] = self._msg.subscriber_types(event.topic)
-
-    def _retry_routed(self, now: float) -> None:
-        pending, self._routed = self._routed, []
-        for routed in pending:
-            try:
-                routed.sock.send_multipart(routed.frames, zmq.NOBLOCK)
-            except zmq.ZMQError as error:
-                if error.errno in (errno.EHOSTUNREACH, zmq.EAGAIN) and now < routed.deadline:
-                    self._routed.append(routed)
-                else:
-                    self.count("send_failures")
-                    _LOG.debug("service message not routable: %s", error)
-                continue
-            if routed.on_sent is not None:
-                routed.on_sent()
 
 
 def _receive_message(sock: Any) -> list[Frame]:
