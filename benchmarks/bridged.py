@@ -17,6 +17,7 @@ from benchmarks.harness import (
     FlowResult,
     bench_env,
     bridge_argument,
+    bridge_config,
     failed,
     free_port,
     run_flow,
@@ -51,12 +52,15 @@ def backend(name: str) -> Backend:
 
 @contextmanager
 def bridge_process(
-    arguments: list[str], env: dict[str, str], executable: str = "parameter_bridge"
+    arguments: list[str],
+    env: dict[str, str],
+    executable: str = "parameter_bridge",
+    channels: int | None = None,
 ) -> Iterator[PeerProcess | None]:
     """A running bridge (None when it failed to start); stopped on exit."""
     bridge: PeerProcess | None = None
     try:
-        bridge = start_bridge(arguments, env, executable)
+        bridge = start_bridge(arguments, env, executable, channels)
     except FlowFailure as error:
         print(f"{executable} did not start: {failed(error).error}", file=sys.stderr)
     try:
@@ -111,21 +115,28 @@ def through_bridge(
     *,
     depth: int | None = None,
 ) -> list[Row]:
-    """GZ->ROS and ROS->GZ flows through one parameter_bridge with a channel per kind and way
-    (``depth``: the history depth of the ROS subscribers, None for the bridge's default)."""
+    """GZ->ROS and ROS->GZ flows through one parameter_bridge with a channel per kind and way.
+
+    ``depth``: the history depth of the ROS ends and of the bridge's channels (its YAML
+    ``publisher_queue`` and ``subscriber_queue``); None keeps everyone's default, 10.
+    """
     gz2ros = {kind: topic_name(f"g2r_{kind}") for kind, _ in gz_cases}
     ros2gz = {kind: topic_name(f"r2g_{kind}") for kind, _ in ros_cases}
-    arguments = [bridge_argument(t, k, "gz2ros") for k, t in gz2ros.items()]
-    arguments += [bridge_argument(t, k, "ros2gz") for k, t in ros2gz.items()]
+    channels = [(t, k, "gz2ros") for k, t in gz2ros.items()]
+    channels += [(t, k, "ros2gz") for k, t in ros2gz.items()]
+    if depth is None:
+        arguments = [bridge_argument(*channel) for channel in channels]
+    else:
+        arguments = bridge_config(channels, depth)
     rows = []
-    with bridge_process(arguments, which.bridge_env) as bridge:
+    with bridge_process(arguments, which.bridge_env, channels=len(channels)) as bridge:
         for way, cases, topics in (("GZ->ROS", gz_cases, gz2ros), ("ROS->GZ", ros_cases, ros2gz)):
             ends = ("gz-pub", "ros-sub") if way == "GZ->ROS" else ("ros-pub", "gz-sub")
             for kind, hz in cases:
-                flow = Flow(*ends, kind, seconds, hz, depth=depth if way == "GZ->ROS" else None)
+                flow = Flow(*ends, kind, seconds, hz, depth=depth)
                 result = flow_through(flow, topics[kind], which, bridge)
                 path = f"{way} parameter_bridge ({which.name})"
-                if depth is not None and way == "GZ->ROS":
-                    path += f", subscriber depth {depth}"
+                if depth is not None:
+                    path += f", queues {depth}"
                 rows.append(Row(path, kind, hz, result, ceiling.get((kind, hz))))
     return rows

@@ -182,6 +182,24 @@ def ign_worker(
     return start_process([str(peer_binary()), *mode, *options, *extra], env)
 
 
+def bridge_config(channels: Sequence[tuple[str, str, str]], queue: int) -> list[str]:
+    """Bridge arguments for a YAML config of ``(topic, kind, "gz2ros" | "ros2gz")`` channels
+    whose ``publisher_queue`` and ``subscriber_queue`` are ``queue``."""
+    entries = []
+    for topic, kind, direction in channels:
+        spec = KINDS[kind]
+        entries.append(
+            f"- ros_topic_name: {topic}\n  gz_topic_name: {topic}\n"
+            f"  ros_type_name: {spec.ros_type}\n  gz_type_name: {spec.gz_type}\n"
+            f"  direction: {'GZ_TO_ROS' if direction == 'gz2ros' else 'ROS_TO_GZ'}\n"
+            f"  publisher_queue: {queue}\n  subscriber_queue: {queue}\n"
+        )
+    path = ROOT / ".build" / "bench_configs" / f"{uuid.uuid4().hex[:8]}.yaml"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("".join(entries), encoding="utf-8")
+    return ["--ros-args", "-p", f"config_file:={path}"]
+
+
 def bridge_argument(ros_topic: str, kind: str, direction: str) -> str:
     """``topic@ros_type[gz_type`` (``direction`` "gz2ros") or ``]`` ("ros2gz")."""
     spec = KINDS[kind]
@@ -190,12 +208,16 @@ def bridge_argument(ros_topic: str, kind: str, direction: str) -> str:
 
 
 def start_bridge(
-    arguments: Sequence[str], env: Mapping[str, str], executable: str = "parameter_bridge"
+    arguments: Sequence[str],
+    env: Mapping[str, str],
+    executable: str = "parameter_bridge",
+    channels: int | None = None,
 ) -> PeerProcess:
-    """Start a bridge executable and wait until it created all its channels."""
+    """Start a bridge executable and wait until it created all its channels (one per
+    argument unless ``channels`` says how many)."""
     bridge = start_process([str(BIN / executable), *arguments], env)
     if executable == "parameter_bridge":
-        for _ in arguments:
+        for _ in range(len(arguments) if channels is None else channels):
             wait_for_line(bridge, r"Creating (GZ->ROS|ROS->GZ)", 30)
     else:
         time.sleep(3)
@@ -234,7 +256,7 @@ class Flow:
     seconds: float
     hz: float = 0.0
     slow_ms: float = 0.0
-    #: History depth of a ros-sub subscriber (None: the bridge's default, 10).
+    #: History depth of the ROS end, publisher or subscriber (None: the bridge's default, 10).
     depth: int | None = None
 
 
@@ -256,16 +278,17 @@ def run_flow(
             pub_env[f"{prefix}TRANSPORT_SNDHWM"] = LARGE_HWM
     cpu = CpuWindow(bridge_pid)
     extra = ("--slow-ms", str(flow.slow_ms)) if flow.slow_ms else ()
-    if flow.depth is not None:
-        extra = (*extra, "--depth", str(flow.depth))
-    sub = worker(flow.subscriber, topic, flow.kind, flow.seconds + 60, env, *extra)
+    depth = () if flow.depth is None else ("--depth", str(flow.depth))
+    sub_extra = (*extra, *depth) if flow.subscriber == "ros-sub" else extra
+    pub_extra = ("--hz", str(flow.hz), *(depth if flow.publisher == "ros-pub" else ()))
+    sub = worker(flow.subscriber, topic, flow.kind, flow.seconds + 60, env, *sub_extra)
     pub: PeerProcess | None = None
     try:
         wait_for_line(sub, r"^READY$", 30)
         if bridge_pid is not None:
             wait_for_line(sub, r"^MATCHED$", 20)
             time.sleep(SETTLE)
-        pub = worker(flow.publisher, topic, flow.kind, flow.seconds, pub_env, "--hz", str(flow.hz))
+        pub = worker(flow.publisher, topic, flow.kind, flow.seconds, pub_env, *pub_extra)
         wait_for_line(pub, r"^CONNECTED$", 40)
         wait_for_line(pub, r"^START$", 10)
         cpu.begin()

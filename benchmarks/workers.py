@@ -107,10 +107,10 @@ def _ros_qos(depth: int | None = None) -> Any:
     return endpoint_qos(None, depth)
 
 
-def ros_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
+def ros_pub(topic: str, kind: Kind, seconds: float, hz: float, depth: int | None) -> None:
     rclpy = _ros_start()
     node = rclpy.create_node(f"bench_pub_{os.getpid()}")
-    publisher = node.create_publisher(kind.pair.ros_class, topic, _ros_qos())
+    publisher = node.create_publisher(kind.pair.ros_class, topic, _ros_qos(depth))
     msg = kind.make_ros()
     say("READY")
     deadline = time.monotonic() + MATCH_WAIT
@@ -220,11 +220,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("seconds", type=float)
     parser.add_argument("--hz", type=float, default=0.0, help="publishers: rate (0: flat out)")
     parser.add_argument("--slow-ms", type=float, default=0.0, help="subscribers: work per message")
-    parser.add_argument("--depth", type=int, default=None, help="ros-sub: history depth")
+    parser.add_argument("--depth", type=int, default=None, help="ros ends: history depth")
     args = parser.parse_args(argv)
     kind = KINDS[args.kind]
     if args.role == "ros-pub":
-        ros_pub(args.topic, kind, args.seconds, args.hz)
+        ros_pub(args.topic, kind, args.seconds, args.hz, args.depth)
     elif args.role == "ros-sub":
         ros_sub(args.topic, kind, args.seconds, args.slow_ms / 1000, args.depth)
     elif args.role == "gz-pub":
