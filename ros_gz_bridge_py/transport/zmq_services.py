@@ -113,9 +113,7 @@ class ServiceRouter:
         if request.response_type in ONE_WAY_TYPES:
             return
         replier = self._io.replier
-        if request.response_address not in self._replier_connected:
-            replier.connect(request.response_address)
-            self._replier_connected.add(request.response_address)
+        _connect_once(replier, request.response_address, self._replier_connected)
         response = ServiceResponse(
             request.service, request.node_uuid, request.request_uuid, payload, ok
         )
@@ -159,9 +157,7 @@ class ServiceRouter:
             ):
                 continue
             requester = self._io.requester
-            if record.address not in self._requester_connected:
-                requester.connect(record.address)
-                self._requester_connected.add(record.address)
+            _connect_once(requester, record.address, self._requester_connected)
             request = ServiceRequest(
                 call.fqn, self._io.response_address, self._io.response_id, self._io.node_uuid,
                 call.request_uuid, call.request, call.request_type, call.response_type,
@@ -229,3 +225,10 @@ class ServiceRouter:
                 routed.on_sent()
         for call in [c for c in self._calls.values() if c.deadline <= now]:
             self._finish(call, None, b"")
+
+
+def _connect_once(sock: Any, address: str, connected: set[str]) -> None:
+    """Connect ``sock`` to ``address`` the first time only (``connected`` remembers)."""
+    if address not in connected:
+        sock.connect(address)
+        connected.add(address)
