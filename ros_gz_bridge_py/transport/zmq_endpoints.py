@@ -13,16 +13,13 @@ from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
-from ros_gz_bridge_py.transport.delivery import DeliveryQueue, payload_size
 from ros_gz_bridge_py.transport.wire import Frame, PublisherRecord, encode_data
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zmq_node import ZmqNode
+    from ros_gz_bridge_py.transport.zmq_reader import SubscriptionReader
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
-
-#: One received message: the payload (not copied) and what the callback learns about it.
-Delivery = tuple[Frame, MessageInfo]
 
 
 class ZmqPublisher(Publisher):
@@ -63,7 +60,8 @@ class ZmqPublisher(Publisher):
 
 
 class ZmqSubscription(Subscription):
-    """One subscription: matching rule, decoder and optional delivery queue."""
+    """One subscription: matching rule, decoder and, with a queue, its own reader (a SUB
+    socket and thread, :mod:`~.zmq_reader`)."""
 
     def __init__(
         self,
@@ -85,35 +83,31 @@ class ZmqSubscription(Subscription):
         self._node = node
         self._deliver = deliver
         self._closed = False
-        self._queue: DeliveryQueue[Delivery] | None = None
+        self.reader: SubscriptionReader | None = None
         if queue_size is not None:
-            self._queue = DeliveryQueue(
-                queue_size,
-                self._run,
-                f"gz-sub {topic}",
-                weigh=payload_size,
-                on_start=on_delivery_start,
+            self.reader = node.new_reader(
+                fqn, self.accepts, self._run, queue_size, on_delivery_start
             )
 
     @property
     def dropped(self) -> int:
         """Messages the bounded queue dropped (oldest first)."""
-        return self._queue.dropped if self._queue is not None else 0
+        return self.reader.dropped if self.reader is not None else 0
 
     def accepts(self, msg_type: str) -> bool:
         """True if a message of ``msg_type`` is for this subscription (exact or generic)."""
         return self.msg_type in (GENERIC_TYPE, msg_type)
 
     def offer(self, payload: Frame, info: MessageInfo) -> None:
-        """Deliver now, or queue for the delivery thread."""
-        if self._queue is None:
-            self._run((payload, info))
-        elif not self._queue.put((payload, info)):
-            self._node.count("messages_dropped")
+        """Deliver now, or hand to the reader's thread (an intra-process message)."""
+        if self.reader is None:
+            self._run(payload, info)
+        else:
+            self.reader.offer_local(bytes(payload), info)
 
-    def _run(self, item: Delivery) -> None:
+    def _run(self, payload: Frame, info: MessageInfo) -> None:
         if not self._closed:
-            self._deliver(*item)
+            self._deliver(payload, info)
 
     def close(self) -> None:
         """Unsubscribe this subscription only; idempotent."""
@@ -121,8 +115,8 @@ class ZmqSubscription(Subscription):
             return
         self._closed = True
         self._node.unsubscribe(self)
-        if self._queue is not None:
-            self._queue.close()
+        if self.reader is not None:
+            self.reader.close()
 
 
 @dataclass(eq=False)

@@ -10,13 +10,16 @@ service side (offers, calls, retried ROUTER sends) is :class:`~.zmq_services.Ser
 Threading model:
 
 * One I/O thread (``gz-io``) owns the discovery engines, the UDP sockets and every ZMQ socket
-  except PUB. Calls from other threads (advertise, subscribe, close, listings, requests) are
-  posted to it as commands and, where they return something, waited for.
+  except PUB and the queued subscriptions' own SUB sockets. Calls from other threads
+  (advertise, subscribe, close, listings, requests) are posted to it as commands and, where
+  they return something, waited for.
 * The PUB socket is used directly by the publishing thread, under a lock (ZMQ sockets are not
   thread-safe; the lock also gives the memory barrier between threads).
 * Callbacks: subscription callbacks with ``queue_size=None``, service handlers and
   ``request_async`` callbacks run on the I/O thread, so they must be quick; with
-  ``queue_size=N`` a subscription's callback runs on its own delivery thread. Intra-process
+  ``queue_size=N`` a subscription has its own SUB socket and thread, which reads the topic's
+  messages and runs the callback (:mod:`~.zmq_reader`; the I/O thread only tells it which
+  publishers to connect to). Intra-process
   messages are handed over in the publishing thread (to the queue, or to the callback when
   there is none), as gz-transport does.
 * Publishing, ``has_connections``, ``stats`` and every public method are thread-safe;
@@ -72,6 +75,7 @@ from ros_gz_bridge_py.transport.wire import (
     decode_data,
 )
 from ros_gz_bridge_py.transport.zmq_endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
+from ros_gz_bridge_py.transport.zmq_reader import SubscriptionReader, receive_message
 from ros_gz_bridge_py.transport.zmq_services import PendingCall, RouterSockets, ServiceRouter
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
@@ -82,9 +86,6 @@ RETRY_POLL = 0.005
 MAX_POLL = 0.25
 #: Messages read from one socket per loop turn, so no socket starves the others.
 READ_BATCH = 64
-#: Frames up to this size are copied into ``bytes`` on receipt (cheaper than a view for small
-#: ones); larger frames, such as images, are handed on as zero-copy views.
-COPY_BELOW = 64 * 1024
 #: Cached routes (topic, sender, type frames -> subscriptions, info); cleared beyond this size.
 ROUTE_CACHE_SIZE = 1024
 #: Where received data goes: the subscriptions that accept it, and what they are told.
@@ -265,7 +266,8 @@ class ZmqNode(Node):
         """A snapshot of the counters of the node and of both discovery engines."""
         with self._count_lock:
             counts = dict(self._counts)
-        counts["messages_received"] = self._received
+        readers = [s.reader for subs in self._subscriptions.values() for s in subs if s.reader]
+        counts["messages_received"] = self._received + sum(r.received for r in readers)
         engines = (self._msg.counts, self._srv.counts)
         return TransportStats(
             datagrams_received=sum(c["received"] for c in engines),
@@ -341,6 +343,21 @@ class ZmqNode(Node):
             for sub in self._subscriptions.get(publisher.fqn, ())
         )
 
+    def new_reader(
+        self,
+        fqn: str,
+        accepts: Callable[[str], bool],
+        deliver: Callable[[Frame, MessageInfo], None],
+        size: int,
+        on_start: Callable[[], None] | None,
+    ) -> SubscriptionReader:
+        """The SUB socket and thread of a queued subscription (see :mod:`~.zmq_reader`)."""
+        return SubscriptionReader(
+            self._context, fqn=fqn, partition=self.partition, accepts=accepts,
+            deliver=deliver, size=size, rcvhwm=self.settings.rcvhwm, count=self.count,
+            on_start=on_start,
+        )  # fmt: skip
+
     def _add_subscription(
         self,
         topic: str,
@@ -369,7 +386,7 @@ class ZmqNode(Node):
             known = self._subscriptions.get(fqn, ())
             self._subscriptions[fqn] = (*known, sub)
             self._routes.clear()
-        if not known:
+        if sub.reader is None and not any(s.reader is None for s in known):
             self._sub.setsockopt(zmq.SUBSCRIBE, fqn.encode())
         sub.record = PublisherRecord(
             fqn, self.pub_address, self.process_uuid, self.node_uuid, Scope.ALL,
@@ -396,17 +413,23 @@ class ZmqNode(Node):
             self._routes.clear()
         if sub.record is not None:
             self._msg.remove_local_subscriber(sub.record)
+        if sub.reader is None and not any(s.reader is None for s in remaining):
+            self._sub.setsockopt(zmq.UNSUBSCRIBE, fqn.encode())
         if remaining:
             return
-        self._sub.setsockopt(zmq.UNSUBSCRIBE, fqn.encode())
         processes = [r.process_uuid for r in self._msg.remote_publishers(fqn)]
         self._send(
             self._msg_udp, self._msg.disconnect(fqn, self.node_uuid, self.pub_address, processes)
         )
 
     def _connect_publisher(self, record: PublisherRecord, subs: Sequence[ZmqSubscription]) -> None:
-        """§2.8.1 step 4-5: connect the SUB once per address, NEW_CONNECTION if a type matches."""
-        if record.address not in self._sub_connected:
+        """§2.8.1 step 4-5: connect the SUB once per address, NEW_CONNECTION if a type matches.
+
+        Queued subscriptions read their own SUB socket, which their reader connects."""
+        for sub in subs:
+            if sub.reader is not None:
+                sub.reader.connect(record.address)
+        if any(sub.reader is None for sub in subs) and record.address not in self._sub_connected:
             try:
                 self._sub.connect(record.address)
             except zmq.ZMQError as error:
@@ -592,7 +615,7 @@ class ZmqNode(Node):
     def _read_frames(self, sock: Any, handler: Callable[[list[Frame]], None]) -> None:
         for _ in range(READ_BATCH):
             try:
-                frames = _receive_message(sock)
+                frames = receive_message(sock)
             except zmq.Again:
                 return
             try:
@@ -628,7 +651,9 @@ class ZmqNode(Node):
         info = MessageInfo(
             name, message.msg_type, self.partition, message.sender, intra_process=False
         )
-        accepting = tuple(sub for sub in subs if sub.accepts(message.msg_type))
+        accepting = tuple(
+            sub for sub in subs if sub.reader is None and sub.accepts(message.msg_type)
+        )
         key = (frames[0], frames[1], frames[3])
         if all(isinstance(frame, bytes) for frame in key):
             if len(self._routes) >= ROUTE_CACHE_SIZE:
@@ -656,17 +681,3 @@ class ZmqNode(Node):
                 self._connect_publisher(event.record, subs)
         elif isinstance(event, SubscriberAdded | SubscriberRemoved):
             self._wire_types[event.topic] = self._msg.subscriber_types(event.topic)
-
-
-def _receive_message(sock: Any) -> list[Frame]:
-    """One multipart message, frame by frame (much cheaper than ``recv_multipart``).
-
-    Raises:
-        zmq.Again: no message is waiting.
-    """
-    frames: list[Frame] = []
-    while True:
-        frame = sock.recv(zmq.NOBLOCK, copy=False)
-        frames.append(frame.bytes if len(frame) < COPY_BELOW else frame.buffer)
-        if not frame.more:
-            return frames

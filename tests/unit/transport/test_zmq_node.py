@@ -149,16 +149,18 @@ def test_queue_size_drops_oldest() -> None:
     with create_node() as node:
         topic = unique("queue")
         release = threading.Event()
+        entered = threading.Event()
         got: list[str] = []
 
         def slow(msg: Any, _: MessageInfo) -> None:
+            entered.set()
             release.wait(10)
             got.append(msg.data)
 
         sub = node.subscribe_typed(topic, StringMsg, slow, queue_size=2)
         pub = node.advertise(topic, "gz.msgs.StringMsg")
         pub.publish(StringMsg(data="0"))
-        assert wait_until(lambda: sub._queue is not None and sub._queue._items.empty())  # type: ignore[attr-defined]
+        assert entered.wait(5)
         for i in range(1, 6):
             pub.publish(StringMsg(data=str(i)))
         release.set()
@@ -166,6 +168,43 @@ def test_queue_size_drops_oldest() -> None:
         assert got == ["0", "4", "5"]
         assert sub.dropped == 3
         assert node.stats.messages_dropped == 3
+
+
+def test_queued_subscriptions_read_only_their_own_topic(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+    """A queued subscription reads its own SUB socket, subscribed by topic prefix as ZeroMQ
+    does: messages of a longer topic sharing the prefix must not reach it, nor a type it does
+    not accept; a queued and an unqueued subscription of one topic each get every message."""
+    a, b = nodes
+    short = unique("prefix")
+    longer = short + "_longer"
+    got: dict[str, list[str]] = {"short": [], "longer": [], "unqueued": [], "wrong_type": []}
+
+    def into(key: str) -> Callable[[Any, MessageInfo], None]:
+        return lambda msg, _info: got[key].append(msg.data)
+
+    b.subscribe_typed(short, StringMsg, into("short"), queue_size=10)
+    b.subscribe_typed(short, StringMsg, into("unqueued"))
+    b.subscribe_typed(longer, StringMsg, into("longer"), queue_size=10)
+    b.subscribe_typed(
+        longer, StringMsg, into("wrong_type"), msg_type="gz.msgs.Int32", queue_size=10
+    )
+    pub_short = a.advertise(short, "gz.msgs.StringMsg")
+    pub_longer = a.advertise(longer, "gz.msgs.StringMsg")
+    assert wait_until(lambda: pub_short.has_connections() and pub_longer.has_connections())
+    received_before = b.stats.messages_received
+    assert publish_until(
+        lambda: pub_longer.publish(StringMsg(data="long")), lambda: bool(got["longer"])
+    )
+    assert publish_until(
+        lambda: pub_short.publish(StringMsg(data="short")),
+        lambda: bool(got["short"]) and bool(got["unqueued"]),
+    )
+    time.sleep(0.2)  # anything misrouted would have arrived by now
+    assert set(got["short"]) == set(got["unqueued"]) == {"short"}
+    assert set(got["longer"]) == {"long"}
+    assert got["wrong_type"] == []
+    # Counted once per subscription that read it: the readers' messages are in the stats.
+    assert b.stats.messages_received >= received_before + 3
 
 
 def test_on_delivery_start_runs_on_the_subscription_thread() -> None:

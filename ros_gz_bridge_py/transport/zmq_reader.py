@@ -1,0 +1,230 @@
+"""A subscription's own ZeroMQ SUB socket, read and delivered by one thread.
+
+Through the node's shared SUB socket, every message of a queued subscription crossed two
+threads: the I/O thread read its four frames (pyzmq releases the GIL around each read) and
+handed it to the subscription's delivery thread. At kilohertz rates those hand-overs cost
+more than converting the message. A :class:`SubscriptionReader` instead owns a SUB socket
+subscribed to its one topic and connected to that topic's publishers, and its thread both
+reads and delivers: no hand-over, and each topic has its own TCP connection, so a flooded
+topic's back-pressure never holds another topic's messages.
+
+The newest ``size`` messages (and at most ``max_bytes`` of them) wait; the socket is drained
+between deliveries, so when the callback is slower than the publisher the oldest are dropped
+and counted, as with ROS "keep last". ZeroMQ sockets are single-threaded: connects and local
+(intra-process) messages from other threads are posted to the reader and it wakes up.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import logging
+import socket
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import zmq
+
+from ros_gz_bridge_py.errors import RemoteProtocolError
+from ros_gz_bridge_py.transport.api import MessageInfo
+from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
+from ros_gz_bridge_py.transport.names import decompose
+from ros_gz_bridge_py.transport.wire import DATA_FRAMES, Frame, decode_data
+
+_LOG = logging.getLogger("ros_gz_bridge_py.transport")
+
+#: Frames up to this size are copied into ``bytes`` on receipt (cheaper than a view for small
+#: ones); larger frames, such as images, are handed on as zero-copy views.
+COPY_BELOW = 64 * 1024
+#: Cached message infos per (topic, sender, type) frames; cleared beyond this size.
+INFO_CACHE_SIZE = 1024
+#: Longest time one delivery run goes on before the socket is drained again (s).
+DELIVERY_SLICE = 0.001
+#: Longest poll while idle (s): how late a close is noticed at worst.
+IDLE_POLL = 0.25
+#: Messages read from the socket per drain, so a flood cannot hold the thread in reading.
+READ_BATCH = 256
+#: One waiting message: the payload and what the callback is told about it.
+Delivery = tuple[Frame, MessageInfo]
+
+
+class SubscriptionReader:
+    """The SUB socket and thread of one queued subscription (see the module docstring)."""
+
+    def __init__(
+        self,
+        context: Any,
+        *,
+        fqn: str,
+        partition: str,
+        accepts: Callable[[str], bool],
+        deliver: Callable[[Frame, MessageInfo], None],
+        size: int,
+        rcvhwm: int,
+        count: Callable[[str], None],
+        on_start: Callable[[], None] | None = None,
+        max_bytes: int = MAX_QUEUED_BYTES,
+    ) -> None:
+        if size < 1:
+            msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
+            raise ValueError(msg)
+        self.fqn = fqn
+        self.dropped = 0
+        self.received = 0
+        self._partition = partition
+        self._name = (decompose(fqn) or ("", fqn))[1]
+        self._accepts = accepts
+        self._deliver = deliver
+        self._size = size
+        self._max_bytes = max_bytes
+        self._count = count
+        self._on_start = on_start
+        self._pending: collections.deque[Delivery] = collections.deque()
+        self._pending_bytes = 0
+        self._infos: dict[tuple[Frame, Frame, Frame], MessageInfo | None] = {}
+        self._connected: set[str] = set()
+        self._posted: collections.deque[Callable[[], None]] = collections.deque()
+        self._closed = False
+        self._wake_r, self._wake_w = socket.socketpair()
+        self._wake_r.setblocking(False)
+        self._wake_w.setblocking(False)
+        self._sock = context.socket(zmq.SUB)
+        self._sock.setsockopt(zmq.LINGER, 0)
+        if rcvhwm:
+            self._sock.setsockopt(zmq.RCVHWM, rcvhwm)
+        self._sock.setsockopt(zmq.SUBSCRIBE, fqn.encode())
+        self._thread = threading.Thread(target=self._run, name=f"gz-sub {self._name}", daemon=True)
+        self._thread.start()
+
+    # --- from any thread --------------------------------------------------------------------
+
+    def connect(self, address: str) -> None:
+        """Connect to a publisher of the topic (once per address)."""
+        self._post(lambda: self._connect(address))
+
+    def offer_local(self, payload: bytes, info: MessageInfo) -> None:
+        """An intra-process message: queued like a received one."""
+        self._post(lambda: self._keep((payload, info)))
+
+    def close(self) -> None:
+        """Stop after the message being delivered; pending ones are discarded. Idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self._wake()
+        if self._thread is not threading.current_thread():
+            self._thread.join()
+
+    def _post(self, command: Callable[[], None]) -> None:
+        if not self._closed:
+            self._posted.append(command)
+            self._wake()
+
+    def _wake(self) -> None:
+        with contextlib.suppress(OSError):
+            self._wake_w.send(b"\0")
+
+    # --- the reader thread ------------------------------------------------------------------
+
+    def _run(self) -> None:
+        try:
+            if self._on_start is not None:
+                self._on_start()
+            poller = zmq.Poller()
+            poller.register(self._sock, zmq.POLLIN)
+            poller.register(self._wake_r.fileno(), zmq.POLLIN)
+            while not self._closed:
+                poller.poll(0 if self._pending else int(IDLE_POLL * 1000))
+                self._turn()
+        finally:
+            self._sock.close(linger=0)
+            self._wake_r.close()
+            self._wake_w.close()
+
+    def _turn(self) -> None:
+        with contextlib.suppress(BlockingIOError):
+            self._wake_r.recv(4096)
+        while self._posted:
+            self._posted.popleft()()
+        self._drain()
+        end = time.monotonic() + DELIVERY_SLICE
+        while self._pending and not self._closed:
+            payload, info = self._pending.popleft()
+            self._pending_bytes -= len(payload)
+            self._deliver(payload, info)
+            if time.monotonic() >= end:
+                return
+
+    def _connect(self, address: str) -> None:
+        if address in self._connected:
+            return
+        try:
+            self._sock.connect(address)
+        except zmq.ZMQError as error:
+            self._count("frames_malformed")
+            _LOG.debug("cannot connect to publisher %r: %s", address, error)
+            return
+        self._connected.add(address)
+
+    def _drain(self) -> None:
+        for _ in range(READ_BATCH):
+            try:
+                frames = receive_message(self._sock)
+            except zmq.Again:
+                return
+            try:
+                info = self._info(frames)
+            except RemoteProtocolError as error:
+                self._count("frames_malformed")
+                _LOG.debug("dropped ZMQ message: %s", error)
+                continue
+            if info is not None:
+                self.received += 1
+                self._keep((frames[2], info))
+
+    def _info(self, frames: list[Frame]) -> MessageInfo | None:
+        """What the callback is told about a message, None if it is not for us (another topic
+        with our name as prefix, or a type we do not accept); cached per topic, sender, type."""
+        key = (frames[0], frames[1], frames[3]) if len(frames) == DATA_FRAMES else None
+        if key is not None and key in self._infos:
+            return self._infos[key]
+        message = decode_data(frames)
+        info = None
+        if message.topic == self.fqn and self._accepts(message.msg_type):
+            info = MessageInfo(
+                self._name, message.msg_type, self._partition, message.sender, intra_process=False
+            )
+        if key is not None and all(isinstance(frame, bytes) for frame in key):
+            if len(self._infos) >= INFO_CACHE_SIZE:
+                self._infos.clear()
+            self._infos[key] = info
+        return info
+
+    def _keep(self, item: Delivery) -> None:
+        """Queue ``item``, dropping the oldest beyond ``size`` messages or ``max_bytes``."""
+        self._pending.append(item)
+        self._pending_bytes += len(item[0])
+        pending = self._pending
+        while len(pending) > self._size or (
+            self._pending_bytes > self._max_bytes and len(pending) > 1
+        ):
+            payload, _ = pending.popleft()
+            self._pending_bytes -= len(payload)
+            self.dropped += 1
+            self._count("messages_dropped")
+
+
+def receive_message(sock: Any) -> list[Frame]:
+    """One multipart message, frame by frame (much cheaper than ``recv_multipart``).
+
+    Raises:
+        zmq.Again: no message is waiting.
+    """
+    frames: list[Frame] = []
+    while True:
+        frame = sock.recv(zmq.NOBLOCK, copy=False)
+        frames.append(frame.bytes if len(frame) < COPY_BELOW else frame.buffer)
+        if not frame.more:
+            return frames
