@@ -286,9 +286,10 @@ the ticks and holds the GIL in {convert_gil:.0f}%; `SerializedPublisher.publish`
 and hands it to the subscriber) in {publish:.0f}%, holding the GIL in only {publish_gil:.0f}%
 because ctypes releases it, so the other channels' threads run meanwhile. That thread used
 {delivery_cpu:.0f}% of a core; some thread of the bridge held the GIL in {gil:.0f}% of the ticks.
-libzmq's I/O thread used {zmq_io:.0f}% of a core receiving every frame the publisher sent: a
-Gazebo publisher has no flow control, so flat out it sends many times what the bridge converts,
-and the bridge pays the TCP receive of frames its bounded queue then drops (keep newest). What
+libzmq's I/O thread used {zmq_io:.0f}% of a core receiving frames: a Gazebo publisher has no
+flow control beyond TCP's (the channel's own connection; what does not fit is dropped at the
+publisher), so flat out it sends more than the bridge converts, and the bridge pays the TCP
+receive of frames its bounded queue then drops to keep the newest. What
 bounds the rate is therefore the machine: three processes moving 6 MB frames with, per frame
 delivered, the publisher's serialization, two kernel TCP copies, the bridge's one copy, Fast
 DDS's copy and the subscriber's deserialization, plus the receive cost of the dropped frames;

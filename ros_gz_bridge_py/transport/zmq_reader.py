@@ -136,8 +136,14 @@ class SubscriptionReader:
             poller.register(self._sock, zmq.POLLIN)
             poller.register(self._wake_r.fileno(), zmq.POLLIN)
             while not self._closed:
-                poller.poll(0 if self._pending else int(IDLE_POLL * 1000))
-                self._turn()
+                try:
+                    poller.poll(0 if self._pending else int(IDLE_POLL * 1000))
+                    self._turn()
+                except zmq.ContextTerminated:  # the node went away without closing us
+                    return
+                except Exception:  # the reader must survive anything, as the I/O thread does
+                    self._count("io_errors")
+                    _LOG.exception("unexpected error reading %s", self.fqn)
         finally:
             self._sock.close(linger=0)
             self._wake_r.close()
