@@ -104,6 +104,22 @@ TypedCallback = Callable[[Any, MessageInfo], None]
 ServiceHandler = Callable[[bytes], tuple[bool, bytes]]
 #: Async service callback: ``(True/False, reply)`` on a reply, ``(None, b"")`` on timeout.
 ReplyCallback = Callable[[bool | None, bytes], None]
+#: Response types that make a service call one-way (ZeroMQ §2.9.3, Zenoh §4.6): there is no
+#: reply, the call is done once the request is sent.
+ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
+
+
+@dataclass(eq=False)
+class ServiceCall:
+    """A service call waiting for a provider or a reply; each backend adds its own state."""
+
+    fqn: str
+    request: bytes
+    request_type: str
+    response_type: str
+    deadline: float
+    callback: ReplyCallback
+    dispatched: bool = False
 
 
 class Publisher(abc.ABC):

@@ -50,9 +50,11 @@ import zenoh
 from ros_gz_bridge_py.errors import LocalProtocolError, TransportError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import (
+    ONE_WAY_TYPES,
     MessageInfo,
     Node,
     ReplyCallback,
+    ServiceCall,
     ServiceHandler,
     TopicInfo,
     TransportStats,
@@ -78,24 +80,15 @@ from ros_gz_bridge_py.transport.zenoh_keys import (
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 
-#: Response types that make a call one-way (§4.6): done once the query is sent.
-ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
 #: Extra time given to Zenoh's own query timeout, so our deadline decides "timeout" and a
 #: query completing before it means "no reply".
 QUERY_GRACE = 1.0
 
 
 @dataclass(eq=False)
-class _Call:
+class _Call(ServiceCall):
     """A service call waiting for a provider or a reply; finished exactly once."""
 
-    fqn: str
-    request: bytes
-    request_type: str
-    response_type: str
-    deadline: float
-    callback: ReplyCallback
-    dispatched: bool = False
     done: bool = field(default=False)
 
     def matches(self, token: GraphToken) -> bool:

@@ -18,7 +18,7 @@ from typing import Any
 
 import zmq
 
-from ros_gz_bridge_py.transport.api import ReplyCallback
+from ros_gz_bridge_py.transport.api import ONE_WAY_TYPES, ServiceCall
 from ros_gz_bridge_py.transport.discovery import DiscoveryEngine, Outgoing
 from ros_gz_bridge_py.transport.wire import (
     Frame,
@@ -36,22 +36,13 @@ _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 #: How long a ROUTER send to a peer that is not routable yet is retried (§2.9.3: gz sleeps
 #: 100 ms after connecting; we retry instead of sleeping).
 ROUTE_RETRY = 1.0
-#: Response types that make a call one-way (§2.9.3).
-ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
 
 
 @dataclass(eq=False)
-class PendingCall:
+class PendingCall(ServiceCall):
     """A service call waiting for a provider, a route or a response."""
 
-    fqn: str
-    request: bytes
-    request_type: str
-    response_type: str
-    deadline: float
-    callback: ReplyCallback
     request_uuid: str = field(default_factory=lambda: str(uuid.uuid4()))
-    dispatched: bool = False
 
 
 @dataclass(eq=False)
