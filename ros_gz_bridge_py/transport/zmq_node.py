@@ -643,7 +643,9 @@ class ZmqNode(Node):
 
     def _route(self, frames: list[Frame]) -> None:
         message = decode_data(frames)
-        subs = self._subscriptions.get(message.topic)
+        # Queued subscriptions read their own sockets: a message for a topic that has only
+        # those reached this socket by prefix (ZeroMQ matches prefixes) and is not ours.
+        subs = tuple(s for s in self._subscriptions.get(message.topic, ()) if s.reader is None)
         if not subs:
             return
         self._received += 1
@@ -651,9 +653,7 @@ class ZmqNode(Node):
         info = MessageInfo(
             name, message.msg_type, self.partition, message.sender, intra_process=False
         )
-        accepting = tuple(
-            sub for sub in subs if sub.reader is None and sub.accepts(message.msg_type)
-        )
+        accepting = tuple(sub for sub in subs if sub.accepts(message.msg_type))
         key = (frames[0], frames[1], frames[3])
         if all(isinstance(frame, bytes) for frame in key):
             if len(self._routes) >= ROUTE_CACHE_SIZE:
