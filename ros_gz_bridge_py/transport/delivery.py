@@ -79,6 +79,17 @@ def payload_size(item: tuple[Payload, MessageInfo]) -> int:
 MAX_QUEUED_BYTES = 64 * 1024 * 1024
 
 
+def require_queue_size(size: int) -> None:
+    """Refuse a subscription queue that could hold no message.
+
+    Raises:
+        ValueError: ``size`` is below 1.
+    """
+    if size < 1:
+        msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
+        raise ValueError(msg)
+
+
 class DeliveryQueue(Generic[T]):
     """Hands items to ``handler`` on a dedicated daemon thread, keeping the newest ``size``
     items and no more than ``max_bytes`` of them as ``weigh`` measures (but always one).
@@ -101,9 +112,7 @@ class DeliveryQueue(Generic[T]):
         max_bytes: int = MAX_QUEUED_BYTES,
         on_start: Callable[[], None] | None = None,
     ) -> None:
-        if size < 1:
-            msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
-            raise ValueError(msg)
+        require_queue_size(size)
         self._size = size
         self._weigh = weigh
         self._max_bytes = max_bytes

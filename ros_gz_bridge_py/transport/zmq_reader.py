@@ -29,7 +29,7 @@ import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.transport.api import MessageInfo
-from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
+from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES, require_queue_size
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.wire import DATA_FRAMES, Frame, decode_data
 
@@ -67,9 +67,7 @@ class SubscriptionReader:
         on_start: Callable[[], None] | None = None,
         max_bytes: int = MAX_QUEUED_BYTES,
     ) -> None:
-        if size < 1:
-            msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
-            raise ValueError(msg)
+        require_queue_size(size)
         self.fqn = fqn
         self.dropped = 0
         self.received = 0

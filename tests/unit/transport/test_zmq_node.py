@@ -226,6 +226,11 @@ def test_on_delivery_start_runs_on_the_subscription_thread() -> None:
         assert threads[0][1] == threads[1][1] != threading.get_ident()
 
 
+def test_a_queue_of_no_messages_is_refused() -> None:
+    with create_node() as node, pytest.raises(ValueError, match="queue_size must be at least 1"):
+        node.subscribe(unique("noroom"), lambda _p, _i: None, queue_size=0)
+
+
 def test_on_delivery_start_without_a_queue_is_refused() -> None:
     with create_node() as node, pytest.raises(ValueError, match="needs a queue_size"):
         node.subscribe(unique("noqueue"), lambda _p, _i: None, on_delivery_start=lambda: None)
