@@ -95,15 +95,20 @@ Cases = tuple[tuple[str, float], ...]
 Ceilings = dict[tuple[str, float], FlowResult]
 
 
-def ceilings(seconds: float, cases: Cases) -> Ceilings:
-    """rclpy publisher -> rclpy subscriber of each case, no bridge, the bridge's settings."""
+def unbridged(seconds: float, cases: Cases, ends: tuple[str, str], label: str) -> Ceilings:
+    """Publisher -> subscriber (``ends``, worker roles) of each case with no bridge between."""
     env = bench_env()
     results = {}
     for kind, hz in cases:
-        topic = topic_name(f"ceil_{kind}")
-        results[kind, hz] = run_flow(Flow("ros-pub", "ros-sub", kind, seconds, hz), topic, env)
-        print(f"ceiling {kind} {hz:g}: {results[kind, hz]}", file=sys.stderr, flush=True)
+        topic = topic_name(f"{label.replace(' ', '_')}_{kind}")
+        results[kind, hz] = run_flow(Flow(*ends, kind, seconds, hz), topic, env)
+        print(f"{label} {kind} {hz:g}: {results[kind, hz]}", file=sys.stderr, flush=True)
     return results
+
+
+def ceilings(seconds: float, cases: Cases) -> Ceilings:
+    """rclpy publisher -> rclpy subscriber of each case, no bridge, the bridge's settings."""
+    return unbridged(seconds, cases, ("ros-pub", "ros-sub"), "ceiling")
 
 
 def through_bridge(

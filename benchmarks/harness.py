@@ -7,6 +7,7 @@ over the publishing window; its RSS from ``/proc/<pid>/status``.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import socket
@@ -146,8 +147,10 @@ def uses_ign_peer(env: Mapping[str, str]) -> bool:
     return env.get("GZ_TRANSPORT_IMPLEMENTATION") != "zenoh" and env.get("BENCH_GZ_END") != "python"
 
 
+@functools.cache
 def gz_message_file(kind: str) -> Path:
-    """The Gazebo message of ``kind``, serialized into a file for the C++ peer's kind-pub."""
+    """The Gazebo message of ``kind``, serialized into a file for the C++ peer's kind-pub
+    (written once per run: a 1080p image is 6 MB to convert)."""
     spec = KINDS[kind]
     path = ROOT / ".build" / "bench_messages" / f"{kind}.pb"
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -21,14 +21,13 @@ from benchmarks.bridged import (
     ceilings,
     flow_through,
     through_bridge,
+    unbridged,
 )
 from benchmarks.harness import (
     GZ_ENDS,
     Flow,
     FlowResult,
-    bench_env,
     bridge_argument,
-    run_flow,
     topic_name,
 )
 from benchmarks.report import write_section
@@ -102,13 +101,7 @@ Hops = dict[tuple[str, float], FlowResult]
 def hops_alone(seconds: float) -> Hops:
     """The Gazebo publisher straight to a Gazebo subscriber: what the ZeroMQ hop that every
     bridged frame also takes costs on this machine, without the bridge or ROS."""
-    env = bench_env()
-    results = {}
-    for kind, hz in HOP_CASES:
-        flow = Flow("gz-pub", "gz-sub", kind, seconds, hz)
-        results[kind, hz] = run_flow(flow, topic_name(f"hop_{kind}"), env)
-        print(f"hop alone {kind} {hz:g}: {results[kind, hz]}", file=sys.stderr, flush=True)
-    return results
+    return unbridged(seconds, HOP_CASES, ("gz-pub", "gz-sub"), "hop alone")
 
 
 def hop_note(row: Row, hops: Hops) -> str:

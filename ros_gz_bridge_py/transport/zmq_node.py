@@ -20,8 +20,8 @@ Threading model:
   ``queue_size=N`` a subscription has its own SUB socket and thread, which reads the topic's
   messages and runs the callback (:mod:`~.zmq_reader`; the I/O thread only tells it which
   publishers to connect to). Intra-process
-  messages are handed over in the publishing thread (to the queue, or to the callback when
-  there is none), as gz-transport does.
+  messages are handed over by the publishing thread (posted to the subscription's reader, or
+  to the callback when there is no queue), as gz-transport does.
 * Publishing, ``has_connections``, ``stats`` and every public method are thread-safe;
   ``request`` must not be called from the I/O thread (it would wait for itself).
 * Bad network input never raises out of the I/O thread: it is counted in ``stats`` and logged
