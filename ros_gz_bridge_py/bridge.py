@@ -22,6 +22,7 @@ The bridge creates a wall-clock (steady) timer on the node that re-evaluates laz
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import threading
 from collections.abc import Iterable
@@ -45,6 +46,8 @@ from ros_gz_bridge_py.config import (
 )
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
+from ros_gz_bridge_py.gz_version import GARDEN
+from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT, ServiceBridge
 from ros_gz_bridge_py.side_node import SideNode, side_node_name
 from ros_gz_bridge_py.switches import switched_off
@@ -82,6 +85,13 @@ class BridgeOptions:
     #: ROS->Gazebo channels read serialized messages with ros_cdr
     #: (``ROS_GZ_BRIDGE_LIGHT_READ=off`` also disables).
     light_read: bool = True
+    #: The simulator's Gazebo line when the user names it (``gz_version``, ``GZ_VERSION``);
+    #: only ``garden`` changes anything: its ``gz.msgs.*`` have Fortress layouts and names.
+    gz_version: str = ""
+
+    @property
+    def garden(self) -> bool:
+        return self.gz_version == GARDEN
 
 
 class Bridge:
@@ -100,6 +110,10 @@ class Bridge:
         self.ros_node = ros_node
         self.registry = registry or default_registry()
         self._owns_gz_node = gz_node is None
+        if self.options.garden:
+            gz_options = dataclasses.replace(
+                gz_options or NodeOptions(), legacy_spelling=Spelling.GZ
+            )
         self.gz_node = gz_node if gz_node is not None else create_node(gz_options)
         self._side: SideNode | None = None
         self._ctx = ChannelContext(
@@ -209,7 +223,7 @@ class Bridge:
 
     def _add_topic(self, spec: TopicBridgeSpec) -> BridgeHandle:
         try:
-            pair = self.registry.get(spec.ros_type, spec.gz_type)
+            layouts = self.registry.layouts(spec.ros_type, spec.gz_type, garden=self.options.garden)
         except UnsupportedTypeError as err:
             raise UnsupportedTypeError(
                 _failed_text(spec, err.message), spec.source or None
@@ -223,7 +237,7 @@ class Bridge:
             kinds.append(RosToGzChannel)
         try:
             for kind in kinds:
-                channel = kind(self._ctx, spec, pair, lazy)
+                channel = kind(self._ctx, spec, layouts, lazy)
                 self._logger.info(f"Creating {channel.describe()} (Lazy {int(lazy)})")
                 handle.channels.append(channel)
                 self._guard_loops(channel, handle.channels)

@@ -44,6 +44,7 @@ from ros_gz_bridge_py.bulk.path import BulkPath, gz_to_ros_cdr, ros_cdr_to_gz
 from ros_gz_bridge_py.bulk.serialized_publisher import SerializedPublisher
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.loop_guard import OwnPublications
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.qos import (
@@ -130,21 +131,28 @@ class ChannelContext:
 
 
 class Channel(abc.ABC):
-    """One direction of one topic: lifecycle, lazy switching and counters."""
+    """One direction of one topic: lifecycle, lazy switching and counters.
+
+    ``layouts`` gives the pair that reads and writes each spelling of the Gazebo type on the
+    wire (``Registry.layouts``); ``pair`` is the one of the configured spelling.
+    """
 
     direction: Direction
 
-    def __init__(self, ctx: ChannelContext, spec: TopicBridgeSpec, pair: Pair, lazy: bool) -> None:
+    def __init__(
+        self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
+    ) -> None:
         self.ctx = ctx
         self.spec = spec
-        self.pair = pair
+        self.layouts = layouts
+        self.pair = layouts[spec.gz_type]
         self.lazy = lazy
         self.state = ChannelState.CREATED
         self.stats = ChannelStats()
         self.ros_topic = ctx.resolve(spec.ros_topic)
         self._logger = ctx.ros_node.get_logger()
         self._last_error_log = 0.0
-        self.bulk: BulkPath | None = pair.bulk if ctx.bulk_path else None
+        self.bulk: BulkPath | None = self.pair.bulk if ctx.bulk_path else None
 
     def start(self) -> None:
         """Open the output side, and the input side unless the channel is lazy."""
@@ -220,13 +228,23 @@ def has_top_level_header(ros_class: type[Any]) -> bool:
 
 
 class GzToRosChannel(Channel):
-    """Gazebo subscription -> converter -> ROS publisher."""
+    """Gazebo subscription -> converter -> ROS publisher.
+
+    Each message is decoded in the layout of the spelling it arrived with (a Fortress
+    ``ignition.msgs.IMU`` is not laid out as a Harmonic ``gz.msgs.IMU``).
+    """
 
     direction = Direction.GZ_TO_ROS
 
-    def __init__(self, ctx: ChannelContext, spec: TopicBridgeSpec, pair: Pair, lazy: bool) -> None:
-        super().__init__(ctx, spec, pair, lazy)
-        self._gz_class = message_class(spec.gz_type)
+    def __init__(
+        self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
+    ) -> None:
+        super().__init__(ctx, spec, layouts, lazy)
+        self._gz_class = message_class(self.pair.gz_type)
+        #: Wire type -> (pair, gz message class) to read it with.
+        self._readers = {
+            name: (pair, message_class(pair.gz_type)) for name, pair in layouts.items()
+        }
         self._qos = gz_to_ros_publisher_qos(self.ros_topic, spec.qos_profile, spec.publisher_queue)
         self._publisher: Any = None
         self._publish: Callable[[Any], None] = _closed_publish
@@ -279,24 +297,17 @@ class GzToRosChannel(Channel):
 
     def _open_input(self) -> None:
         depth = max(self._qos.depth, MIN_DELIVERY_QUEUE)
-        if self.bulk is not None:
-            self._subscription = self.ctx.gz_node.subscribe(
-                self.spec.gz_topic,
-                self._on_gz_payload,
-                self.spec.gz_type,
-                ignore_local=True,
-                queue_size=depth,
-                copy=False,
-                on_delivery_start=lambda: yield_cpu_to_light_topics(self.ctx.bulk_nice),
-            )
-            return
-        self._subscription = self.ctx.gz_node.subscribe_typed(
+        bulk = self.bulk is not None
+        self._subscription = self.ctx.gz_node.subscribe(
             self.spec.gz_topic,
-            self._gz_class,
-            self._on_gz_message,
-            msg_type=self.spec.gz_type,
+            self._on_gz_payload if bulk else self._on_gz_message,
+            self.spec.gz_type,
             ignore_local=True,
             queue_size=depth,
+            copy=False,
+            on_delivery_start=(lambda: yield_cpu_to_light_topics(self.ctx.bulk_nice))
+            if bulk
+            else None,
         )
 
     def _close_input(self) -> None:
@@ -310,10 +321,20 @@ class GzToRosChannel(Channel):
             for info in self.ctx.ros_node.get_subscriptions_info_by_topic(self.ros_topic)
         )
 
-    def _on_gz_message(self, gz_msg: Any, _info: MessageInfo) -> None:
+    def _on_gz_message(self, payload: Any, info: MessageInfo) -> None:
         self.stats.received += 1
+        pair, gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))
         try:
-            ros_msg = self.pair.to_ros(gz_msg)
+            gz_msg = gz_class.FromString(payload)
+        except Exception as err:
+            self._conversion_failed(
+                ConversionError(
+                    f"undecodable {info.msg_type} payload of {len(payload)} bytes: {err}"
+                )
+            )
+            return
+        try:
+            ros_msg = pair.to_ros(gz_msg)
             if self._finish is not None:
                 self._finish(ros_msg)
         except Exception as err:
@@ -322,12 +343,13 @@ class GzToRosChannel(Channel):
         self._publish(ros_msg)
         self.stats.published += 1
 
-    def _on_gz_payload(self, payload: Any, _info: MessageInfo) -> None:
+    def _on_gz_payload(self, payload: Any, info: MessageInfo) -> None:
         """The bulk path: Gazebo payload straight to a serialized ROS message."""
         self.stats.received += 1
         assert self.bulk is not None  # subscribed this way only with a bulk path
+        gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))[1]
         try:
-            cdr = gz_to_ros_cdr(self.bulk, self._gz_class, memoryview(payload), self._finish)
+            cdr = gz_to_ros_cdr(self.bulk, gz_class, memoryview(payload), self._finish)
         except Exception as err:
             self._conversion_failed(err)
             return
@@ -345,13 +367,19 @@ class RosToGzChannel(Channel):
 
     direction = Direction.ROS_TO_GZ
 
-    def __init__(self, ctx: ChannelContext, spec: TopicBridgeSpec, pair: Pair, lazy: bool) -> None:
-        super().__init__(ctx, spec, pair, lazy)
+    def __init__(
+        self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
+    ) -> None:
+        super().__init__(ctx, spec, layouts, lazy)
+        #: Where the spellings differ in layout (the IMU), each is converted on its own.
+        self._per_spelling = len({id(pair) for pair in layouts.values()}) > 1
         self._qos = endpoint_qos(spec.qos_profile, spec.subscriber_queue)
         self._own = ctx.own_publications(self.ros_topic)
         self._gz_publisher: Publisher | None = None
         self._light = (
-            ctx.light_read and self.bulk is None and ros_cdr.reader_for(pair.ros_class) is not None
+            ctx.light_read
+            and self.bulk is None
+            and ros_cdr.reader_for(self.pair.ros_class) is not None
         )
         self._subscription: Any = None
         self._subscription_node: Any = None
@@ -420,10 +448,12 @@ class RosToGzChannel(Channel):
         try:
             if self.bulk is not None:
                 self._publish_serialized(publisher, ros_msg)
-            elif self._light:
-                publisher.publish(self.pair.to_gz(self._read(ros_msg)))
             else:
-                publisher.publish(self.pair.to_gz(ros_msg))
+                msg = self._read(ros_msg) if self._light else ros_msg
+                if self._per_spelling:
+                    self._publish_per_spelling(publisher, msg)
+                else:
+                    publisher.publish(self.pair.to_gz(msg))
         except Exception as err:
             self._conversion_failed(err)
             return
@@ -434,6 +464,13 @@ class RosToGzChannel(Channel):
                 f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
                 "(showing msg only once per type)"
             )
+
+    def _publish_per_spelling(self, publisher: Publisher, msg: Any) -> None:
+        """Convert once per layout the subscribers need (and the configured one, for local
+        subscribers), each sent only in its spelling."""
+        for wire_type in publisher.wire_types() | {publisher.msg_type}:
+            payload = self.layouts[wire_type].to_gz(msg).SerializeToString()
+            publisher.publish_raw(payload, as_type=wire_type)
 
     def _read(self, cdr: bytes) -> Any:
         """The message in ``cdr`` for ``to_gz``: a light tree, or rclpy's message when the

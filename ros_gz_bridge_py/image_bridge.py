@@ -8,13 +8,16 @@ switching and error counting are the bridge's. Run it as ``image_bridge`` or
 Beyond ros_gz_image (ros_gz issues #701, #778, #752): ``GZ_TOPIC:=ROS_TOPIC`` renames,
 ``config_file`` takes a parameter_bridge YAML (its Image and CameraInfo entries), ``camera_info``
 bridges the camera's CameraInfo too, ``lazy`` subscribes to Gazebo only while ROS listens, and
-``gz_type`` lets Fortress users match ``ignition.msgs.Image``. A frame whose data is shorter than
-height x width x bytes per pixel, or whose pixel format has no ROS encoding, is counted, logged
-(throttled) and not published. There is no image_transport: only the raw topic is published.
+no type needs naming for any Gazebo line: ``gz.msgs.Image`` takes Fortress's
+``ignition.msgs.Image`` publishers as well (``gz_type`` stays as an override). A frame whose
+data is shorter than height x width x bytes per pixel, or whose pixel format has no ROS
+encoding, is counted, logged (throttled) and not published. There is no image_transport: only
+the raw topic is published.
 """
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -26,6 +29,7 @@ from rclpy.signals import SignalHandlerOptions
 from ros_gz_bridge_py.bridge import Bridge, BridgeOptions
 from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
 from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.gz_version import GZ_VERSION_ENV, check_gz_version
 from ros_gz_bridge_py.image_bridge_args import (
     USAGE,
     ImageTopic,
@@ -62,6 +66,7 @@ class Settings:
     override_frame_id: str
     override_timestamps_with_wall_time: bool
     gz_transport_implementation: str
+    gz_version: str
 
 
 def declare_parameters(node: Node) -> Settings:
@@ -78,6 +83,8 @@ def declare_parameters(node: Node) -> Settings:
         override_timestamps_with_wall_time=False,
         # Ours, as in parameter_bridge: "zeromq" or "zenoh"; empty = GZ_TRANSPORT_IMPLEMENTATION.
         gz_transport_implementation="",
+        # Ours, as in parameter_bridge: the simulator's Gazebo line when it must be said.
+        gz_version=os.environ.get(GZ_VERSION_ENV, ""),
     )
     values = {
         name: node.declare_parameter(name, value).value for name, value in vars(defaults).items()
@@ -116,6 +123,7 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic]) -> Bridge | None:
     settings = declare_parameters(node)
     try:
         gz_type = check_gz_type(settings.gz_type)
+        gz_version = check_gz_version(settings.gz_version)
     except ConfigError as err:
         node.get_logger().error(str(err))
         return None
@@ -133,6 +141,7 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic]) -> Bridge | None:
             heartbeat=max(settings.subscription_heartbeat, 1) / 1000.0,
             override_timestamps_with_wall_time=settings.override_timestamps_with_wall_time,
             override_frame_id=settings.override_frame_id,
+            gz_version=gz_version,
         ),
         gz_options=NodeOptions(implementation=settings.gz_transport_implementation or None),
     )

@@ -23,8 +23,8 @@ from ros_gz_bridge_py.errors import ConfigError
 
 IMAGE_ROS_TYPE = "sensor_msgs/msg/Image"
 CAMERA_INFO_ROS_TYPE = "sensor_msgs/msg/CameraInfo"
-#: ``gz_type`` values: Harmonic and newer publish ``gz.msgs.Image``, Fortress
-#: ``ignition.msgs.Image``.
+#: ``gz_type`` values: the two spellings of one message, each taking publishers of both
+#: (Harmonic and newer publish ``gz.msgs.Image``, Fortress ``ignition.msgs.Image``).
 GZ_IMAGE_TYPES = ("gz.msgs.Image", "ignition.msgs.Image")
 RENAME = ":="
 ROS_ARGS_START = "--ros-args"
@@ -55,7 +55,9 @@ Parameters (--ros-args -p NAME:=VALUE):
   config_file:=FILE       parameter_bridge YAML; its Image and CameraInfo entries are bridged
   lazy:=true              subscribe to Gazebo only while ROS has subscribers
   subscription_heartbeat:=MS   how often lazy bridges check for subscribers (default 1000)
-  gz_type:=ignition.msgs.Image  the Gazebo type name Fortress publishes (default gz.msgs.Image)
+  gz_type:=TYPE           the Gazebo type (default gz.msgs.Image; either spelling takes the
+                          publishers of every Gazebo line, Fortress's ignition.msgs.Image too)
+  gz_version:=garden      the simulator is Garden (default: the GZ_VERSION variable)
   override_frame_id:=FRAME      set header.frame_id of every bridged message
   override_timestamps_with_wall_time:=true   set header.stamp to the wall time
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import os
 import sys
 from collections.abc import Sequence
 from typing import Any
@@ -34,6 +35,8 @@ from ros_gz_bridge_py.config import (
     parse_parameter_bridges,
     read_yaml_file,
 )
+from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.gz_version import GZ_VERSION_ENV, check_gz_version
 from ros_gz_bridge_py.runtime import apply_speed_settings
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.status import DiagnosticsPublisher, serve, start_diagnostics
@@ -73,6 +76,8 @@ def declare_parameters(node: Node) -> dict[str, Any]:
         "service_timeout": DEFAULT_TIMEOUT,
         # Ours: "zeromq" or "zenoh"; empty = GZ_TRANSPORT_IMPLEMENTATION, as gz-transport does.
         "gz_transport_implementation": "",
+        # Ours: the simulator's Gazebo line, when it must be said (only "garden" matters).
+        "gz_version": os.environ.get(GZ_VERSION_ENV, ""),
     }
     values = {name: node.declare_parameter(name, value).value for name, value in defaults.items()}
     names = node.declare_parameter("bridge_names", Parameter.Type.STRING_ARRAY).value
@@ -174,6 +179,11 @@ def build_bridge(node: Node, cli: ParseResult, params: dict[str, Any]) -> Bridge
         )
     for source in sources:
         report(node, source)
+    try:
+        gz_version = check_gz_version(params["gz_version"])
+    except ConfigError as err:
+        node.get_logger().error(str(err))
+        gz_version = ""
     bridge = Bridge(
         node,
         options=BridgeOptions(
@@ -182,6 +192,7 @@ def build_bridge(node: Node, cli: ParseResult, params: dict[str, Any]) -> Bridge
             override_timestamps_with_wall_time=params["override_timestamps_with_wall_time"],
             override_frame_id=params["override_frame_id"],
             service_timeout=params["service_timeout"],
+            gz_version=gz_version,
         ),
         gz_options=NodeOptions(implementation=params["gz_transport_implementation"] or None),
     )

@@ -14,9 +14,10 @@ from __future__ import annotations
 from typing import Any
 
 from ros_gz_bridge_py.config import ServiceBridgeSpec
-from ros_gz_bridge_py.converters.registry import ServicePair, canonical_gz_type
+from ros_gz_bridge_py.converters.registry import ServicePair
 from ros_gz_bridge_py.errors import ConfigError, ConversionError, TransportError
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.side_node import SideNode
 from ros_gz_bridge_py.transport import Node
 
@@ -40,7 +41,7 @@ def resolve_gz_types(spec: ServiceBridgeSpec, pair: ServicePair) -> tuple[str, s
     ):
         if not given:
             chosen.append(expected)
-        elif canonical_gz_type(given) == canonical_gz_type(expected):
+        elif same_message(given, expected):
             chosen.append(given)
         else:
             msg = (

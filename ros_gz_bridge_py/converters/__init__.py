@@ -8,7 +8,6 @@ from ros_gz_bridge_py.converters.registry import (
     Registry,
     ServicePair,
     build_registry,
-    canonical_gz_type,
     default_registry,
 )
 
@@ -17,6 +16,5 @@ __all__ = [
     "Registry",
     "ServicePair",
     "build_registry",
-    "canonical_gz_type",
     "default_registry",
 ]

@@ -26,6 +26,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.errors import BridgeError, UnsupportedTypeError
+from ros_gz_bridge_py.msgs.names import Spelling, canonical_type, respell, spelling_of, spellings
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.bulk.path import BulkPath
@@ -48,16 +49,6 @@ BUILTIN_MODULES: tuple[str, ...] = (
     "rcl_interfaces",
     "ros_gz_interfaces",
 )
-
-GZ_PREFIX = "gz.msgs."
-IGN_PREFIX = "ignition.msgs."
-
-
-def canonical_gz_type(name: str) -> str:
-    """Return ``gz.msgs.X`` for ``ignition.msgs.X``; any other name unchanged."""
-    if name.startswith(IGN_PREFIX):
-        return GZ_PREFIX + name[len(IGN_PREFIX) :]
-    return name
 
 
 @dataclass(frozen=True)
@@ -135,7 +126,7 @@ class Registry:
         """The pair for exactly these names, accepting both Gazebo prefixes."""
         pair = self._by_key.get((ros_type, gz_type))
         if pair is None:
-            pair = self._by_key.get((ros_type, canonical_gz_type(gz_type)))
+            pair = self._by_key.get((ros_type, canonical_type(gz_type)))
         return pair
 
     def get(self, ros_type: str, gz_type: str) -> Pair:
@@ -144,6 +135,22 @@ class Registry:
         if pair is not None:
             return pair
         raise UnsupportedTypeError(self._explain_missing(ros_type, gz_type))
+
+    def layouts(self, ros_type: str, gz_type: str, *, garden: bool = False) -> dict[str, Pair]:
+        """The pair that reads and writes each spelling of ``gz_type`` on the wire.
+
+        The spellings share one pair, except where the layout differs by Gazebo line (the
+        IMU: ``ignition.msgs.IMU`` is the Fortress layout). ``garden``: the simulator is
+        Garden, whose ``gz.msgs.*`` messages have the Fortress layout.
+
+        Raises:
+            UnsupportedTypeError: the pair does not exist.
+        """
+        layouts = {}
+        for name in spellings(gz_type):
+            layout = respell(name, Spelling.IGNITION) if garden else name
+            layouts[name] = self.get(ros_type, layout)
+        return layouts
 
     def get_service(self, ros_type: str) -> ServicePair:
         service = self._services_by_type.get(ros_type)
@@ -160,7 +167,7 @@ class Registry:
         exact = [p.ros_type for p in self.pairs if p.gz_type == gz_type]
         if exact:
             return exact
-        canonical = canonical_gz_type(gz_type)
+        canonical = canonical_type(gz_type)
         return [p.ros_type for p in self.pairs if p.gz_type == canonical]
 
     def _explain_missing(self, ros_type: str, gz_type: str) -> str:
@@ -168,7 +175,7 @@ class Registry:
         if "/" in ros_type and "/msg/" not in ros_type and "/srv/" not in ros_type:
             pkg, _, name = ros_type.partition("/")
             return f"{text}; ROS types are written in full: did you mean [{pkg}/msg/{name}]?"
-        if not gz_type.startswith((GZ_PREFIX, IGN_PREFIX)):
+        if spelling_of(gz_type) is None:
             return f"{text}; Gazebo types are written gz.msgs.X (or ignition.msgs.X)"
         pkg = ros_type.split("/", 1)[0]
         if pkg in self.unavailable:

@@ -7,9 +7,7 @@ use, so no generated ``_pb2`` modules exist.
 
 from __future__ import annotations
 
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE
 from ros_gz_bridge_py.msgs.pool import known_types, message_class
-
-#: The type name Gazebo Transport uses for "any message type" (generic subscribers).
-GENERIC_TYPE: str = "google.protobuf.Message"
 
 __all__ = ["GENERIC_TYPE", "known_types", "message_class"]

@@ -14,10 +14,9 @@ from typing import Any
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 
 from ros_gz_bridge_py.errors import UnsupportedTypeError
+from ros_gz_bridge_py.msgs.names import canonical_type
 
 DESCRIPTOR_SET_NAME = "gz_msgs.desc"
-GZ_PREFIX = "gz.msgs."
-IGNITION_PREFIX = "ignition.msgs."
 
 # Two pools would give two classes for one type (and CopyFrom between them fails), so the
 # first load is serialised; classes are then unique per descriptor.
@@ -52,10 +51,8 @@ def _resolve(type_name: str, names: tuple[str, ...]) -> str:
     """The pool name for ``type_name``: an exact match, else ignition.msgs.X read as gz.msgs.X."""
     if type_name in names:
         return type_name
-    if type_name.startswith(IGNITION_PREFIX):
-        alias = GZ_PREFIX + type_name.removeprefix(IGNITION_PREFIX)
-        if alias in names:
-            return alias
+    if canonical_type(type_name) in names:
+        return canonical_type(type_name)
     message = (
         f"unknown Gazebo message type {type_name!r}: expected 'gz.msgs.Name' or "
         "'ignition.msgs.Name' with a name known to this bridge; list the known types with "

@@ -6,6 +6,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from ros_gz_bridge_py.errors import TransportError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import (
@@ -45,6 +47,8 @@ def create_node(options: NodeOptions | None = None) -> Node:
     """
     options = options or NodeOptions()
     settings = TransportSettings.from_env()
+    if options.legacy_spelling is not None:
+        settings = dataclasses.replace(settings, legacy_spelling=options.legacy_spelling)
     implementation = (options.implementation or settings.implementation).lower()
     if implementation == "zenoh":
         # Imported here so the ZeroMQ path never loads zenoh.

@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass
 from typing import Any, Self
 
 from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
-from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling
 from ros_gz_bridge_py.transport.delivery import Deliver, raw_deliverer, typed_deliverer
 
 
@@ -33,11 +33,14 @@ class NodeOptions:
 
     ``partition`` None reads GZ_PARTITION, then IGN_PARTITION, else ``<hostname>:<user>``.
     ``implementation`` None reads GZ_TRANSPORT_IMPLEMENTATION (default ``zeromq``).
+    ``legacy_spelling`` None assumes Fortress (``ignition.msgs``) for gz-transport 11/12 peers;
+    ``Spelling.GZ`` says they are Garden.
     """
 
     partition: str | None = None
     namespace: str = ""
     implementation: str | None = None
+    legacy_spelling: Spelling | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,18 +126,27 @@ class ServiceCall:
 
 
 class Publisher(abc.ABC):
-    """An advertised topic."""
+    """An advertised topic, announced under both spellings of its type (docs/protocol.md §9)."""
 
     topic: str
     msg_type: str
+    #: ``msg_type`` and its other spelling (if it has one).
+    names: tuple[str, ...]
 
     @abc.abstractmethod
     def publish(self, msg: Any) -> None:
         """Serialize ``msg`` once and send it to every matching subscriber."""
 
     @abc.abstractmethod
-    def publish_raw(self, payload: bytes | bytearray | memoryview) -> None:
-        """Send an already-serialized message of this publisher's type."""
+    def publish_raw(
+        self, payload: bytes | bytearray | memoryview, *, as_type: str | None = None
+    ) -> None:
+        """Send an already-serialized message of this publisher's type, once to each
+        subscriber in a spelling it takes; ``as_type`` (one of ``names``) only that spelling."""
+
+    @abc.abstractmethod
+    def wire_types(self) -> frozenset[str]:
+        """The spellings of ``names`` remote subscribers need now."""
 
     @abc.abstractmethod
     def has_connections(self) -> bool:

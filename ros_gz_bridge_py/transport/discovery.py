@@ -14,7 +14,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
-from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.wire import (
     WIRE_VERSION,
@@ -26,6 +26,7 @@ from ros_gz_bridge_py.transport.wire import (
     decode_discovery,
     encode_discovery,
 )
+from ros_gz_bridge_py.transport.wire_types import PeerSpellings, RemoteSubscriber
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 
@@ -96,6 +97,7 @@ class DiscoveryEngine:
         local_ips: Iterable[str] = (),
         relays: Iterable[str] = (),
         version: int = WIRE_VERSION,
+        legacy_spelling: Spelling = Spelling.IGNITION,
     ) -> None:
         self.process_uuid = process_uuid
         self.version = version
@@ -108,8 +110,12 @@ class DiscoveryEngine:
         # topic -> process uuid -> records
         self._remote: dict[str, dict[str, list[PublisherRecord]]] = {}
         self._activity: dict[str, float] = {}
-        # topic -> {(process, node): msg_type}
-        self._subscribers: dict[str, dict[tuple[str, str], str]] = {}
+        # topic -> {(process, node): the type names it registered for}
+        self._subscribers: dict[str, dict[tuple[str, str], frozenset[str]]] = {}
+        # topic -> process -> when it last sent SUBSCRIBE for it
+        self._subscribe_seen: dict[str, dict[str, float]] = {}
+        #: What each peer process calls its message types (docs/protocol.md §9).
+        self.spellings = PeerSpellings(legacy_spelling)
         self._next_heartbeat = now
         self._next_activity = now + ACTIVITY_INTERVAL
 
@@ -130,9 +136,20 @@ class DiscoveryEngine:
             for records in by_process.values():
                 yield from records
 
-    def subscriber_types(self, topic: str) -> frozenset[str]:
-        """Types of the remote subscribers registered for our FQN ``topic``."""
-        return frozenset(self._subscribers.get(topic, {}).values())
+    def remote_subscribers(self, topic: str) -> tuple[RemoteSubscriber, ...]:
+        """The remote nodes registered (NEW_CONNECTION) for our FQN ``topic``."""
+        return tuple(
+            RemoteSubscriber(process, node, types)
+            for (process, node), types in self._subscribers.get(topic, {}).items()
+        )
+
+    def subscribe_sightings(self) -> dict[str, dict[str, float]]:
+        """FQN -> process -> when that process last sent SUBSCRIBE for it (any partition)."""
+        return {topic: dict(seen) for topic, seen in self._subscribe_seen.items()}
+
+    def processes(self) -> list[str]:
+        """Every peer process heard from and not yet expired."""
+        return list(self._activity)
 
     def next_deadline(self) -> float:
         """When :meth:`tick` next has something to do."""
@@ -252,7 +269,7 @@ class DiscoveryEngine:
             out += [Outgoing(relayed, ip) for ip in self._relays]
         self._activity[message.process_uuid] = now
         try:
-            more, events = self._dispatch(message, source_ip)
+            more, events = self._dispatch(message, source_ip, now)
         except RemoteProtocolError as error:
             self.counts["malformed"] += 1
             _LOG.debug("discovery: dropped %s from %s: %s", message.type.name, source_ip, error)
@@ -287,9 +304,13 @@ class DiscoveryEngine:
             return source_ip in self._local_ips or source_ip.startswith("127.")
         return True
 
-    def _dispatch(self, message: DiscoveryMessage, source_ip: str) -> Result:
+    def _dispatch(self, message: DiscoveryMessage, source_ip: str, now: float) -> Result:
         kind = message.type
-        if kind in (DiscoveryType.HEARTBEAT, DiscoveryType.SUBSCRIBERS_REP):
+        if kind == DiscoveryType.HEARTBEAT:
+            # gz-transport 13+ fill a publisher record in heartbeats; 11 and 12 do not.
+            self.spellings.saw_heartbeat(message.process_uuid, message.pub is not None)
+            return [], []
+        if kind == DiscoveryType.SUBSCRIBERS_REP:
             return [], []
         if kind == DiscoveryType.BYE:
             return [], self._forget_process(message.process_uuid)
@@ -297,6 +318,8 @@ class DiscoveryEngine:
             if message.topic is None:
                 msg = "SUBSCRIBE without a topic"
                 raise RemoteProtocolError(msg)
+            seen = self._subscribe_seen.setdefault(message.topic, {})
+            seen[message.process_uuid] = now
             return self._answer_subscribe(message.topic, source_ip), []
         if kind == DiscoveryType.SUBSCRIBERS_REQ:
             out: list[Outgoing] = []
@@ -311,6 +334,8 @@ class DiscoveryEngine:
             if not self._in_scope(pub, source_ip):
                 return [], []
             if kind == DiscoveryType.ADVERTISE:
+                if pub.msg is not None:
+                    self.spellings.saw_type(pub.process_uuid, pub.msg_type)
                 return [], self._on_advertise(pub)
             return [], self._on_unadvertise(pub)
         if kind == DiscoveryType.NEW_CONNECTION:
@@ -356,6 +381,11 @@ class DiscoveryEngine:
 
     def _forget_process(self, process: str) -> list[Event]:
         self._activity.pop(process, None)
+        self.spellings.forget(process)
+        for topic in list(self._subscribe_seen):
+            self._subscribe_seen[topic].pop(process, None)
+            if not self._subscribe_seen[topic]:
+                del self._subscribe_seen[topic]
         events: list[Event] = []
         for topic in list(self._remote):
             records = self._remote[topic].pop(process, [])
@@ -372,9 +402,10 @@ class DiscoveryEngine:
             return []
         key = (record.process_uuid, record.node_uuid)
         subscribers = self._subscribers.setdefault(record.topic, {})
-        if subscribers.get(key) == record.msg.msg_type:
+        known = subscribers.get(key, frozenset())
+        if record.msg.msg_type in known:
             return []
-        subscribers[key] = record.msg.msg_type
+        subscribers[key] = known | {record.msg.msg_type}
         return [SubscriberAdded(record.topic, *key, record.msg.msg_type)]
 
     def _on_end_connection(self, record: PublisherRecord) -> list[Event]:

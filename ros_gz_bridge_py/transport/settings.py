@@ -15,6 +15,8 @@ import uuid
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from ros_gz_bridge_py.msgs.names import Spelling
+
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 
 DEFAULT_MULTICAST_IP = "239.255.0.7"
@@ -90,6 +92,9 @@ class TransportSettings:
     sndhwm: int = DEFAULT_HWM
     #: GZ_TRANSPORT_IMPLEMENTATION, lower-cased: "zeromq" (default) or "zenoh".
     implementation: str = "zeromq"
+    #: What ZeroMQ peers of gz-transport 11/12 (Fortress, Garden: no record in their
+    #: heartbeats) call their types, when nothing else tells (docs/protocol.md §9).
+    legacy_spelling: Spelling = Spelling.IGNITION
 
     @classmethod
     def from_env(cls, env: Mapping[str, str] | None = None) -> TransportSettings:

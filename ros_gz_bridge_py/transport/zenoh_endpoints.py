@@ -13,9 +13,10 @@ from typing import TYPE_CHECKING, Any
 
 import zenoh
 
-from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, spellings
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue, payload_size
+from ros_gz_bridge_py.transport.wire_types import WireTypeCache
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zenoh_node import ZenohNode
@@ -48,23 +49,29 @@ class ZenohPublisher(Publisher):
         self.topic = topic
         self.fqn = fqn
         self.msg_type = msg_type
-        #: The attachment of every put: the type name as raw bytes (§4.5).
-        self.attachment = msg_type.encode()
+        self.names = spellings(msg_type)
+        #: The attachment of a put in each spelling: the type name as raw bytes (§4.5).
+        self.attachments = {name: name.encode() for name in self.names}
         self.zenoh_publisher, self._token = entities
+        self._wire_types = WireTypeCache(node.subscriber_book, fqn, self.names)
         self._node = node
         self._closed = False
+
+    def wire_types(self) -> frozenset[str]:
+        """The spellings remote subscribers (MS tokens) need now."""
+        return self._wire_types.get()
 
     def publish(self, msg: Any) -> None:
         """Serialize ``msg`` once and send it (see :meth:`publish_raw`)."""
         self.publish_raw(msg.SerializeToString())
 
-    def publish_raw(self, payload: bytes | bytearray | memoryview) -> None:
-        """Deliver to local subscriptions, and put on Zenoh if a remote MS token matches.
-
-        After ``close`` (of this publisher or the node) it does nothing.
-        """
+    def publish_raw(
+        self, payload: bytes | bytearray | memoryview, *, as_type: str | None = None
+    ) -> None:
+        """Deliver to local subscriptions, and put on Zenoh once per spelling a remote MS token
+        needs (``as_type``: only that spelling). After ``close`` it does nothing."""
         if not self._closed:
-            self._node.publish(self, payload)
+            self._node.publish(self, payload, as_type)
 
     def has_connections(self) -> bool:
         """True if a remote MS token or a local subscription matches."""
@@ -96,6 +103,8 @@ class ZenohSubscription(Subscription):
         self.topic = topic
         self.fqn = fqn
         self.msg_type = msg_type
+        self.names = spellings(msg_type)
+        self.generic = msg_type == GENERIC_TYPE
         self.ignore_local = ignore_local
         #: The Zenoh subscriber and MS token, in declaration order.
         self.entities: list[Any] = []
@@ -118,8 +127,9 @@ class ZenohSubscription(Subscription):
         return self._queue.dropped if self._queue is not None else 0
 
     def accepts(self, msg_type: str) -> bool:
-        """True if a message of ``msg_type`` is for this subscription (exact or generic)."""
-        return self.msg_type in (GENERIC_TYPE, msg_type)
+        """True if a message of ``msg_type`` is for this subscription (either spelling of
+        its type, or any type for a generic subscription)."""
+        return msg_type in self.names or self.generic
 
     def offer(self, payload: bytes, info: MessageInfo) -> None:
         """Deliver now, or queue for the delivery thread."""

@@ -48,7 +48,7 @@ from typing import Any
 import zenoh
 
 from ros_gz_bridge_py.errors import LocalProtocolError, TransportError
-from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.msgs.names import Spelling, canonical_type, same_message
 from ros_gz_bridge_py.transport.api import (
     ONE_WAY_TYPES,
     MessageInfo,
@@ -62,6 +62,7 @@ from ros_gz_bridge_py.transport.api import (
 from ros_gz_bridge_py.transport.delivery import Deliver
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber, SubscriberBook
 from ros_gz_bridge_py.transport.zenoh_config import Overrides, session_config
 from ros_gz_bridge_py.transport.zenoh_endpoints import (
     ZenohPublisher,
@@ -96,8 +97,14 @@ class _Call(ServiceCall):
         return (
             token.kind == EntityKind.SERVICE
             and token.fqn == self.fqn
-            and (token.request_type, token.response_type) == (self.request_type, self.response_type)
+            and same_message(token.request_type, self.request_type)
+            and same_message(token.response_type, self.response_type)
         )
+
+
+def _offer_key(fqn: str, request_type: str, response_type: str) -> tuple[str, str, str]:
+    """What a call must match to be served by a local offer (either spelling of each type)."""
+    return fqn, canonical_type(request_type), canonical_type(response_type)
 
 
 class ZenohNode(Node):
@@ -138,8 +145,10 @@ class ZenohNode(Node):
         self._changed = threading.Condition(self._lock)
         self._generation = 0
         self._graph: dict[str, GraphToken] = {}
+        #: Remote subscribers (MS tokens) per topic; Zenoh peers are Jetty or later, so they
+        #: read gz.msgs names (docs/protocol.md §9).
+        self.subscriber_book = SubscriberBook(default_spelling=Spelling.GZ)
         # Read by publishing threads without the lock; replaced, never mutated.
-        self._wire_types: dict[str, frozenset[str]] = {}
         self._subscriptions: dict[str, tuple[ZenohSubscription, ...]] = {}
         self._publishers: set[ZenohPublisher] = set()
         self._offers: dict[tuple[str, str, str], ZenohServiceOffer] = {}
@@ -203,10 +212,11 @@ class ZenohNode(Node):
     # --- topics -----------------------------------------------------------------------------
 
     def advertise(self, topic: str, msg_type: str) -> ZenohPublisher:
-        """Declare a Zenoh publisher on the topic's FQN and its MP token."""
+        """Declare a Zenoh publisher on the topic's FQN and its MP token (gz.msgs spelling:
+        Zenoh peers are Jetty or later)."""
         fqn = self._fqn(topic)
         token = message_token(
-            fqn, self.process_uuid, self.node_uuid, EntityKind.PUBLISHER, msg_type
+            fqn, self.process_uuid, self.node_uuid, EntityKind.PUBLISHER, canonical_type(msg_type)
         )
         zenoh_publisher = self._declare(
             "publisher",
@@ -228,32 +238,40 @@ class ZenohNode(Node):
         with self._lock:
             self._publishers.discard(publisher)
 
-    def publish(self, publisher: ZenohPublisher, payload: bytes | bytearray | memoryview) -> None:
-        """Local delivery, then a put if a remote MS token matches (§4.5 gating)."""
+    def publish(
+        self,
+        publisher: ZenohPublisher,
+        payload: bytes | bytearray | memoryview,
+        as_type: str | None = None,
+    ) -> None:
+        """Local delivery, then one put per spelling a remote MS token needs (§4.5 gating);
+        ``as_type`` limits both to that spelling."""
         fqn, msg_type = publisher.fqn, publisher.msg_type
         data = payload if isinstance(payload, bytes) else bytes(payload)
-        local = [
-            sub
-            for sub in self._subscriptions.get(fqn, ())
-            if not sub.ignore_local and sub.accepts(msg_type)
-        ]
-        if local:
-            info = MessageInfo(publisher.topic, msg_type, self.partition, "", intra_process=True)
-            for sub in local:
-                sub.offer(data, info)
-        types = self._wire_types.get(fqn)
-        if not types or not (msg_type in types or GENERIC_TYPE in types):
-            return
-        try:
-            publisher.zenoh_publisher.put(data, attachment=publisher.attachment)
-        except zenoh.ZError as error:
-            self.count("send_failures")
-            _LOG.debug("Zenoh put on %s failed: %s", fqn, error)
+        if as_type is None or as_type == msg_type:
+            local = [
+                sub
+                for sub in self._subscriptions.get(fqn, ())
+                if not sub.ignore_local and sub.accepts(msg_type)
+            ]
+            if local:
+                info = MessageInfo(
+                    publisher.topic, msg_type, self.partition, "", intra_process=True
+                )
+                for sub in local:
+                    sub.offer(data, info)
+        for wire_type in publisher.wire_types():
+            if as_type is not None and wire_type != as_type:
+                continue
+            try:
+                publisher.zenoh_publisher.put(data, attachment=publisher.attachments[wire_type])
+            except zenoh.ZError as error:
+                self.count("send_failures")
+                _LOG.debug("Zenoh put on %s failed: %s", fqn, error)
 
     def has_connections(self, publisher: ZenohPublisher) -> bool:
         """True if a remote MS token or a local subscription matches ``publisher``."""
-        types = self._wire_types.get(publisher.fqn, frozenset())
-        if publisher.msg_type in types or GENERIC_TYPE in types:
+        if publisher.wire_types():
             return True
         return any(
             not sub.ignore_local and sub.accepts(publisher.msg_type)
@@ -272,7 +290,7 @@ class ZenohNode(Node):
     ) -> ZenohSubscription:
         fqn = self._fqn(topic)
         token = message_token(
-            fqn, self.process_uuid, self.node_uuid, EntityKind.SUBSCRIBER, msg_type
+            fqn, self.process_uuid, self.node_uuid, EntityKind.SUBSCRIBER, canonical_type(msg_type)
         )
         sub = ZenohSubscription(
             self, topic, fqn, msg_type, deliver,
@@ -338,7 +356,13 @@ class ZenohNode(Node):
     ) -> ZenohServiceOffer:
         """Declare a queryable on the service FQN and its SS token (§4.6)."""
         fqn = self._fqn(service)
-        token = service_token(fqn, self.process_uuid, self.node_uuid, request_type, response_type)
+        token = service_token(
+            fqn,
+            self.process_uuid,
+            self.node_uuid,
+            canonical_type(request_type),
+            canonical_type(response_type),
+        )
         offer = ZenohServiceOffer(self, service, (fqn, request_type, response_type), handler)
         try:
             queryable = self._declare(
@@ -354,14 +378,14 @@ class ZenohNode(Node):
             offer.close()
             raise
         with self._lock:
-            self._offers[offer.key] = offer
+            self._offers[_offer_key(*offer.key)] = offer
         return offer
 
     def forget_offer(self, offer: ZenohServiceOffer) -> None:
         """Drop ``offer`` from the local-call registry (called by its ``close``)."""
         with self._lock:
-            if self._offers.get(offer.key) is offer:
-                del self._offers[offer.key]
+            if self._offers.get(_offer_key(*offer.key)) is offer:
+                del self._offers[_offer_key(*offer.key)]
 
     def _run_handler(self, offer: ZenohServiceOffer, request: bytes) -> tuple[bool, bytes]:
         try:
@@ -405,7 +429,7 @@ class ZenohNode(Node):
         )  # fmt: skip
         with self._lock:
             self._check_open()
-            if (call.fqn, request_type, response_type) in self._offers:
+            if _offer_key(call.fqn, request_type, response_type) in self._offers:
                 self._local_calls.append(call)
                 self._changed.notify_all()
                 return
@@ -420,16 +444,20 @@ class ZenohNode(Node):
     def _send_query(self, call: _Call) -> None:
         """``get`` on the service FQN; payload omitted when empty, as gz does."""
 
+        one_way = call.response_type in ONE_WAY_TYPES
+
         def on_reply(reply: zenoh.Reply) -> None:
             sample = reply.ok
             if sample is None:
                 _LOG.debug("error reply from service %s ignored", call.fqn)
                 return
-            self._finish(call, True, sample.payload.to_bytes())
+            if not one_way:  # a one-way call is done once sent, whatever comes back
+                self._finish(call, True, sample.payload.to_bytes())
 
         def on_done() -> None:
-            failed = time.monotonic() < call.deadline
-            self._finish(call, False if failed else None, b"")
+            if not one_way:
+                failed = time.monotonic() < call.deadline
+                self._finish(call, False if failed else None, b"")
 
         remaining = max(0.0, call.deadline - time.monotonic())
         try:
@@ -444,7 +472,7 @@ class ZenohNode(Node):
             _LOG.debug("Zenoh get on %s failed: %s", call.fqn, error)
             self._finish(call, False, b"")
             return
-        if call.response_type in ONE_WAY_TYPES:
+        if one_way:
             self._finish(call, True, b"")
 
     def _finish(self, call: _Call, ok: bool | None, payload: bytes) -> None:
@@ -462,7 +490,7 @@ class ZenohNode(Node):
 
     def _run_local_call(self, call: _Call) -> None:
         with self._lock:
-            offer = self._offers.get((call.fqn, call.request_type, call.response_type))
+            offer = self._offers.get(_offer_key(call.fqn, call.request_type, call.response_type))
         if offer is None:
             self._finish(call, False, b"")
             return
@@ -497,13 +525,7 @@ class ZenohNode(Node):
             else:
                 self._graph.pop(key, None)
             if token.kind == EntityKind.SUBSCRIBER and token.process_uuid != self.process_uuid:
-                self._wire_types[token.fqn] = frozenset(
-                    t.msg_type
-                    for t in self._graph.values()
-                    if t.kind == EntityKind.SUBSCRIBER
-                    and t.fqn == token.fqn
-                    and t.process_uuid != self.process_uuid
-                )
+                self._update_subscribers(token.fqn)
             if alive and token.kind == EntityKind.SERVICE:
                 for call in self._calls:
                     if not call.dispatched and call.matches(token):
@@ -512,6 +534,20 @@ class ZenohNode(Node):
             self._generation += 1
             self._changed.notify_all()
         return ready
+
+    def _update_subscribers(self, fqn: str) -> None:
+        """The MS tokens of other processes on ``fqn``, per node (caller holds the lock)."""
+        types: dict[tuple[str, str], set[str]] = {}
+        for token in self._graph.values():
+            if (
+                token.kind == EntityKind.SUBSCRIBER
+                and token.fqn == fqn
+                and token.process_uuid != self.process_uuid
+            ):
+                types.setdefault((token.process_uuid, token.node_uuid), set()).add(token.msg_type)
+        self.subscriber_book.set_subscribers(
+            fqn, tuple(RemoteSubscriber(p, n, frozenset(t)) for (p, n), t in types.items())
+        )
 
     def _names(self, kind: EntityKind) -> list[str]:
         with self._lock:

@@ -44,7 +44,7 @@ from typing import Any, TypeVar
 import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError
-from ros_gz_bridge_py.msgs import GENERIC_TYPE
+from ros_gz_bridge_py.msgs.names import spellings
 from ros_gz_bridge_py.transport.api import (
     MessageInfo,
     Node,
@@ -74,6 +74,7 @@ from ros_gz_bridge_py.transport.wire import (
     ServicePublisher,
     decode_data,
 )
+from ros_gz_bridge_py.transport.wire_types import SubscriberBook, WireTypeCache
 from ros_gz_bridge_py.transport.zmq_endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
 from ros_gz_bridge_py.transport.zmq_reader import SubscriptionReader, receive_message
 from ros_gz_bridge_py.transport.zmq_services import PendingCall, RouterSockets, ServiceRouter
@@ -107,6 +108,9 @@ class ZmqNode(Node):
         fully_qualified_name(self.partition, namespace, "/check")
         self.process_uuid = str(uuid.uuid4())
         self.node_uuid = str(uuid.uuid4())
+        #: The node id of the announcements of our publishers under their other spelling
+        #: (gz peers keep one record per node and address, so it must differ).
+        self.respelled_node_uuid = str(uuid.uuid4())
         self.host = determine_host(self.settings.ip, self.settings.multicast_ip)
         self._counts: collections.Counter[str] = collections.Counter()
         # Touched by the I/O thread only: the per-message fast path takes no lock.
@@ -122,7 +126,9 @@ class ZmqNode(Node):
         self._stopping = False
         # Read by publishing threads without the I/O thread; replaced, never mutated.
         self._subscriptions: dict[str, tuple[ZmqSubscription, ...]] = {}
-        self._wire_types: dict[str, frozenset[str]] = {}
+        #: Remote subscribers per topic, written on the I/O thread (docs/protocol.md §9).
+        self.subscriber_book = SubscriberBook()
+        self._spellings_version = -1
         self._sub_lock = threading.Lock()
         # I/O thread only. Like gz, the SUB socket never disconnects from an address: ZMQ
         # reconnects if the publisher comes back there, and disconnecting a pipe with data in
@@ -156,7 +162,11 @@ class ZmqNode(Node):
         self.replier_address: str = self._replier.getsockopt_string(zmq.LAST_ENDPOINT)
         self.response_address: str = self._responses.getsockopt_string(zmq.LAST_ENDPOINT)
         now = time.monotonic()
-        engine_args: dict[str, Any] = {"local_ips": {self.host}, "relays": self.settings.relays}
+        engine_args: dict[str, Any] = {
+            "local_ips": {self.host},
+            "relays": self.settings.relays,
+            "legacy_spelling": self.settings.legacy_spelling,
+        }
         self._msg = DiscoveryEngine(self.process_uuid, now, **engine_args)
         self._srv = DiscoveryEngine(self.process_uuid, now, **engine_args)
         sockets = RouterSockets(
@@ -284,59 +294,81 @@ class ZmqNode(Node):
         return fully_qualified_name(self.partition, self.namespace, topic)
 
     def advertise(self, topic: str, msg_type: str) -> ZmqPublisher:
-        """Advertise ``topic``; announced at once and re-announced every second."""
-        record = PublisherRecord(
-            self._fqn(topic), self.pub_address, self.process_uuid, self.node_uuid, Scope.ALL,
-            MessagePublisher(msg_type),
-        )  # fmt: skip
-        publisher = ZmqPublisher(self, topic, msg_type, record)
-        self._call(lambda: self._send(self._msg_udp, self._msg.advertise(record)))
+        """Advertise ``topic`` under each spelling of ``msg_type``; re-announced every second."""
+        fqn = self._fqn(topic)
+        names = spellings(msg_type)
+        records = tuple(
+            PublisherRecord(
+                fqn, self.pub_address, self.process_uuid, node, Scope.ALL, MessagePublisher(name)
+            )
+            for name, node in zip(names, (self.node_uuid, self.respelled_node_uuid), strict=False)
+        )
+        cache = WireTypeCache(self.subscriber_book, fqn, names)
+        publisher = ZmqPublisher(self, topic, msg_type, records, cache)
+
+        def command() -> None:
+            for record in records:
+                self._send(self._msg_udp, self._msg.advertise(record))
+
+        self._call(command)
         return publisher
 
     def unadvertise(self, publisher: ZmqPublisher) -> None:
         """Withdraw ``publisher`` (called by its ``close``)."""
 
         def command() -> None:
-            self._send(self._msg_udp, self._msg.unadvertise(publisher.record))
-            self._wire_types[publisher.fqn] = self._msg.subscriber_types(publisher.fqn)
+            for record in publisher.records:
+                self._send(self._msg_udp, self._msg.unadvertise(record))
+            self._update_subscribers(publisher.fqn)
 
         with contextlib.suppress(TransportError):
             self._call(command)
 
-    def publish(self, publisher: ZmqPublisher, payload: bytes | bytearray | memoryview) -> None:
-        """Local delivery, then the wire if a remote subscriber matches (§2.8.1 step 7)."""
+    def publish(
+        self,
+        publisher: ZmqPublisher,
+        payload: bytes | bytearray | memoryview,
+        as_type: str | None = None,
+    ) -> None:
+        """Local delivery, then one message per spelling a remote subscriber needs (§2.8.1
+        step 7, docs/protocol.md §9); ``as_type`` limits both to that spelling."""
         fqn, msg_type = publisher.fqn, publisher.msg_type
-        local = [
-            sub
-            for sub in self._subscriptions.get(fqn, ())
-            if not sub.ignore_local and sub.accepts(msg_type)
-        ]
-        if local:
-            data = payload if isinstance(payload, bytes) else bytes(payload)
-            info = MessageInfo(publisher.topic, msg_type, self.partition, "", intra_process=True)
-            for sub in local:
-                sub.offer(data, info)
-        types = self._wire_types.get(fqn)
-        if not types or not (msg_type in types or GENERIC_TYPE in types):
+        if as_type is None or as_type == msg_type:
+            local = [
+                sub
+                for sub in self._subscriptions.get(fqn, ())
+                if not sub.ignore_local and sub.accepts(msg_type)
+            ]
+            if local:
+                data = payload if isinstance(payload, bytes) else bytes(payload)
+                info = MessageInfo(
+                    publisher.topic, msg_type, self.partition, "", intra_process=True
+                )
+                for sub in local:
+                    sub.offer(data, info)
+        types = publisher.wire_types()
+        if not types:
             return
-        topic, sender, _, type_frame = publisher.wire_frames
         send = self._pub.send
         with self._pub_lock:
             if self._closed:
                 return
-            try:  # frame by frame: much cheaper than send_multipart for small messages
-                send(topic, zmq.SNDMORE)
-                send(sender, zmq.SNDMORE)
-                send(payload, zmq.SNDMORE, copy=not isinstance(payload, bytes))
-                send(type_frame)
-            except zmq.ZMQError as error:
-                self.count("send_failures")
-                _LOG.debug("publish on %s failed: %s", publisher.topic, error)
+            for wire_type in types:
+                if as_type is not None and wire_type != as_type:
+                    continue
+                topic, sender, _, type_frame = publisher.wire_frames[wire_type]
+                try:  # frame by frame: much cheaper than send_multipart for small messages
+                    send(topic, zmq.SNDMORE)
+                    send(sender, zmq.SNDMORE)
+                    send(payload, zmq.SNDMORE, copy=not isinstance(payload, bytes))
+                    send(type_frame)
+                except zmq.ZMQError as error:
+                    self.count("send_failures")
+                    _LOG.debug("publish on %s failed: %s", publisher.topic, error)
 
     def has_connections(self, publisher: ZmqPublisher) -> bool:
         """True if a remote subscriber or a local subscription matches ``publisher``."""
-        types = self._wire_types.get(publisher.fqn, frozenset())
-        if publisher.msg_type in types or GENERIC_TYPE in types:
+        if publisher.wire_types():
             return True
         return any(
             not sub.ignore_local and sub.accepts(publisher.msg_type)
@@ -346,7 +378,7 @@ class ZmqNode(Node):
     def new_reader(
         self,
         fqn: str,
-        accepts: Callable[[str], bool],
+        accepts: Callable[[str, str], bool],
         deliver: Callable[[Frame, MessageInfo], None],
         size: int,
         on_start: Callable[[], None] | None,
@@ -437,7 +469,8 @@ class ZmqNode(Node):
                 _LOG.debug("cannot connect to publisher %r: %s", record.address, error)
                 return
             self._sub_connected.add(record.address)
-        if any(sub.accepts(record.msg_type) for sub in subs):
+        taking = [sub for sub in subs if sub.take(record)]  # every one records what it takes
+        if taking:
             self._send(self._msg_udp, self._msg.connect(record, self.node_uuid))
 
     # --- services ---------------------------------------------------------------------------
@@ -607,10 +640,14 @@ class ZmqNode(Node):
         for _ in range(READ_BATCH):
             received = udp.receive()
             if received is None:
-                return
+                break
             out, events = engine.datagram_received(*received, time.monotonic())
             self._send(udp, out)
             self._handle_events(engine, events)
+        spellings = self._msg.spellings
+        if spellings.version != self._spellings_version:
+            self._spellings_version = spellings.version
+            self.subscriber_book.set_spellings(spellings.snapshot())
 
     def _read_frames(self, sock: Any, handler: Callable[[list[Frame]], None]) -> None:
         for _ in range(READ_BATCH):
@@ -653,7 +690,7 @@ class ZmqNode(Node):
         info = MessageInfo(
             name, message.msg_type, self.partition, message.sender, intra_process=False
         )
-        accepting = tuple(sub for sub in subs if sub.accepts(message.msg_type))
+        accepting = tuple(sub for sub in subs if sub.accepts_from(message.sender, message.msg_type))
         key = (frames[0], frames[1], frames[3])
         if all(isinstance(frame, bytes) for frame in key):
             if len(self._routes) >= ROUTE_CACHE_SIZE:
@@ -680,4 +717,7 @@ class ZmqNode(Node):
             if subs:
                 self._connect_publisher(event.record, subs)
         elif isinstance(event, SubscriberAdded | SubscriberRemoved):
-            self._wire_types[event.topic] = self._msg.subscriber_types(event.topic)
+            self._update_subscribers(event.topic)
+
+    def _update_subscribers(self, fqn: str) -> None:
+        self.subscriber_book.set_subscribers(fqn, self._msg.remote_subscribers(fqn))

@@ -59,7 +59,7 @@ class SubscriptionReader:
         *,
         fqn: str,
         partition: str,
-        accepts: Callable[[str], bool],
+        accepts: Callable[[str, str], bool],
         deliver: Callable[[Frame, MessageInfo], None],
         size: int,
         rcvhwm: int,
@@ -196,7 +196,7 @@ class SubscriptionReader:
             return self._infos[key]
         message = decode_data(frames)
         info = None
-        if message.topic == self.fqn and self._accepts(message.msg_type):
+        if message.topic == self.fqn and self._accepts(message.sender, message.msg_type):
             info = MessageInfo(
                 self._name, message.msg_type, self._partition, message.sender, intra_process=False
             )

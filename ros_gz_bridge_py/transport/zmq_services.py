@@ -18,6 +18,7 @@ from typing import Any
 
 import zmq
 
+from ros_gz_bridge_py.msgs.names import canonical_type, same_message
 from ros_gz_bridge_py.transport.api import ONE_WAY_TYPES, ServiceCall
 from ros_gz_bridge_py.transport.discovery import DiscoveryEngine, Outgoing
 from ros_gz_bridge_py.transport.wire import (
@@ -84,17 +85,18 @@ class ServiceRouter:
     # --- offers -----------------------------------------------------------------------------
 
     def add_offer(self, offer: ZmqServiceOffer) -> None:
-        self._offers[offer.key] = offer
+        self._offers[_offer_key(*offer.key)] = offer
         self._io.announce(self._io.engine.advertise(offer.record))
 
     def remove_offer(self, offer: ZmqServiceOffer) -> None:
-        self._offers.pop(offer.key, None)
+        if self._offers.get(_offer_key(*offer.key)) is offer:
+            del self._offers[_offer_key(*offer.key)]
         self._io.announce(self._io.engine.unadvertise(offer.record))
 
     def on_request(self, frames: list[Frame]) -> None:
         """§2.9.3: look up the handler, run it, answer unless one-way."""
         request = decode_request(frames)
-        key = (request.service, request.request_type, request.response_type)
+        key = _offer_key(request.service, request.request_type, request.response_type)
         offer = self._offers.get(key)
         if offer is None:
             self._count("requests_unhandled")
@@ -124,7 +126,7 @@ class ServiceRouter:
 
     def start_call(self, call: PendingCall) -> None:
         """A local offer answers at once; otherwise send to a known provider or ask for one."""
-        offer = self._offers.get((call.fqn, call.request_type, call.response_type))
+        offer = self._offers.get(_offer_key(call.fqn, call.request_type, call.response_type))
         if offer is not None:
             ok, payload = self._run_handler(offer, call.request)
             self._finish(call, ok, b"" if call.response_type in ONE_WAY_TYPES else payload)
@@ -139,19 +141,21 @@ class ServiceRouter:
             self._dispatch(call)
 
     def _dispatch(self, call: PendingCall) -> bool:
-        """Send ``call`` to the first provider with exactly its types; False if none is known."""
+        """Send ``call`` to the first provider of its types (either spelling: the request
+        carries the provider's); False if none is known."""
         for record in self._io.engine.remote_publishers(call.fqn):
             srv = record.srv
-            if srv is None or (srv.request_type, srv.response_type) != (
-                call.request_type,
-                call.response_type,
+            if (
+                srv is None
+                or not same_message(srv.request_type, call.request_type)
+                or not same_message(srv.response_type, call.response_type)
             ):
                 continue
             requester = self._io.requester
             _connect_once(requester, record.address, self._requester_connected)
             request = ServiceRequest(
                 call.fqn, self._io.response_address, self._io.response_id, self._io.node_uuid,
-                call.request_uuid, call.request, call.request_type, call.response_type,
+                call.request_uuid, call.request, srv.request_type, srv.response_type,
             )  # fmt: skip
             one_way = call.response_type in ONE_WAY_TYPES
             call.dispatched = True
@@ -216,6 +220,11 @@ class ServiceRouter:
                 routed.on_sent()
         for call in [c for c in self._calls.values() if c.deadline <= now]:
             self._finish(call, None, b"")
+
+
+def _offer_key(fqn: str, request_type: str, response_type: str) -> tuple[str, str, str]:
+    """What a request must match to reach an offer (either spelling of each type)."""
+    return fqn, canonical_type(request_type), canonical_type(response_type)
 
 
 def _connect_once(sock: Any, address: str, connected: set[str]) -> None:

@@ -1,11 +1,14 @@
 """The real user configurations bridge every entry, end to end, with real processes.
 
-For each YAML file of ``shared/data/configs`` (used unchanged): ``parameter_bridge --ros-args
--p config_file:=<file>``, one C++ ign-transport 11 peer per Gazebo->ROS entry publishing a
-Harmonic message (``gz.msgs.*`` type on the wire, see ``tests/peer``), an rclpy checker that
-subscribes to every ROS topic and publishes the ROS->Gazebo entry, and a C++ echo of that
-entry. Each arrival is checked field by field against ``e2e_values`` (the conversion spec),
-and traffic against the configured direction must not cross.
+For each YAML file of ``shared/data/configs`` (used unchanged) and each Gazebo line:
+``parameter_bridge --ros-args -p config_file:=<file>``, one C++ ign-transport 11 peer per
+Gazebo->ROS entry, an rclpy checker that subscribes to every ROS topic and publishes the
+ROS->Gazebo entry, and a typed C++ echo of that entry. As Harmonic, the peers put ``gz.msgs.*``
+names and Harmonic layouts on the wire (``--wire-type``, see ``tests/peer``); as Fortress, they
+are what they are: ``ignition.msgs.*`` publishers and typed ``ignition.msgs.*`` subscribers
+(as the DiffDrive system is), with the Fortress IMU layout. Each arrival is checked field by
+field against ``e2e_values`` (the conversion spec), and traffic against the configured
+direction must not cross.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from typing import Any
 
 import pytest
 
+from ros_gz_bridge_py.msgs.names import Spelling, respell
 from tests.bridge.e2e_harness import (
     RUN_TIMEOUT,
     ConfigEntry,
@@ -30,8 +34,10 @@ from tests.bridge.e2e_harness import (
 )
 from tests.bridge.e2e_values import (
     CLOCK_FROM_ROS,
+    IMU_FORTRESS,
     TWIST_FROM_GZ_NOT_BRIDGED,
     TWIST_TO_GZ,
+    GzSample,
     mismatches,
     sample_for,
 )
@@ -43,6 +49,21 @@ CONFIG_DIR = Path("/work/shared/data/configs")
 ROS_SAMPLES = {"gz.msgs.Twist": TWIST_TO_GZ}
 #: How long reverse-direction publishers keep going after everything expected arrived.
 REVERSE_DWELL = 2.0
+#: The Gazebo lines the peers play.
+HARMONIC = "harmonic"
+FORTRESS = "fortress"
+
+
+def line_sample(line: str, entry: ConfigEntry) -> GzSample:
+    """What a simulator of ``line`` publishes for ``entry`` (Fortress: its own IMU layout)."""
+    if line == FORTRESS and entry.gz_type == "gz.msgs.IMU":
+        return IMU_FORTRESS
+    return sample_for(entry.gz_type, entry.gz_topic)
+
+
+def line_type(line: str, gz_type: str) -> str:
+    """The type name a process of ``line`` uses for ``gz_type``."""
+    return respell(gz_type, Spelling.IGNITION) if line == FORTRESS else gz_type
 
 
 @dataclass
@@ -50,6 +71,7 @@ class ConfigRun:
     """One bridge on one configuration file, with everything that arrived."""
 
     path: Path
+    line: str
     entries: list[ConfigEntry]
     group: ProcessGroup
     checker: RosChecker
@@ -63,12 +85,12 @@ def _gz_sample(entry: ConfigEntry) -> Any:
     return parse_gz(sample.gz_type_name, sample.gz_text)
 
 
-def _ros_arrived(checker: RosChecker, entry: ConfigEntry) -> bool:
-    expected = sample_for(entry.gz_type, entry.gz_topic).ros
+def _ros_arrived(checker: RosChecker, line: str, entry: ConfigEntry) -> bool:
+    expected = line_sample(line, entry).ros
     return any(not mismatches(expected, msg) for msg in checker.messages(entry.ros_topic))
 
 
-def start_config_run(name: str) -> ConfigRun:
+def start_config_run(name: str, line: str) -> ConfigRun:
     """The bridge with Gazebo publishers, echoes and a ROS checker, after the Gazebo->ROS phase.
 
     ROS publishers of the ROS->Gazebo entries start later, in their own test, so a bridge that
@@ -81,25 +103,33 @@ def start_config_run(name: str) -> ConfigRun:
         bridge = group.bridge("--ros-args", "-p", f"config_file:={path}")
         echoes: dict[str, GzEcho] = {}
         reverse: list[tuple[str, str, dict[str, Any]]] = []
+        # Harmonic names go on the wire with --wire-type; Fortress peers need none.
+        wire_type = (lambda gz_type: gz_type) if line == HARMONIC else (lambda _: None)
         for entry in entries:
             if entry.direction == "GZ_TO_ROS":
-                sample = sample_for(entry.gz_type, entry.gz_topic)
-                group.peer(*sample.peer_pub_args(entry.gz_topic, entry.gz_type))
+                sample = line_sample(line, entry)
+                group.peer(*sample.peer_pub_args(entry.gz_topic, wire_type(entry.gz_type)))
             if entry.direction == "ROS_TO_GZ":
                 type_name = ROS_SAMPLES[entry.gz_type].gz_type_name
                 echoes[entry.gz_topic] = GzEcho.peer(
-                    group, entry.gz_topic, type_name, entry.gz_type
+                    group, entry.gz_topic, type_name, line_type(line, entry.gz_type)
                 )
                 # Against the direction: a Gazebo publisher on the same topic.
-                group.peer(*TWIST_FROM_GZ_NOT_BRIDGED.peer_pub_args(entry.gz_topic, entry.gz_type))
+                group.peer(
+                    *TWIST_FROM_GZ_NOT_BRIDGED.peer_pub_args(
+                        entry.gz_topic, wire_type(entry.gz_type)
+                    )
+                )
             if entry.gz_type == "gz.msgs.Clock":
-                echoes[entry.gz_topic] = GzEcho.peer(group, entry.gz_topic, "Clock", entry.gz_type)
+                echoes[entry.gz_topic] = GzEcho.peer(
+                    group, entry.gz_topic, "Clock", line_type(line, entry.gz_type)
+                )
                 reverse.append((entry.ros_topic, entry.ros_type, CLOCK_FROM_ROS))
         checker = RosChecker(
             group, [(entry.ros_topic, entry.ros_type) for entry in entries], reverse
         )
         checks = {
-            entry.ros_topic: lambda e=entry: _ros_arrived(checker, e)
+            entry.ros_topic: lambda e=entry: _ros_arrived(checker, line, e)
             for entry in entries
             if entry.direction == "GZ_TO_ROS"
         }
@@ -108,7 +138,7 @@ def start_config_run(name: str) -> ConfigRun:
     except BaseException:
         group.stop()
         raise
-    return ConfigRun(path, entries, group, checker, echoes, bridge)
+    return ConfigRun(path, line, entries, group, checker, echoes, bridge)
 
 
 #: The configuration entries each test method runs for, by direction.
@@ -131,21 +161,23 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
 
 
 class ConfigE2E:
-    """The end-to-end tests of one configuration file (``CONFIG``); one run for the class."""
+    """The end-to-end tests of one configuration file (``CONFIG``) against peers of one Gazebo
+    line (``LINE``); one run for the class."""
 
     CONFIG = ""
+    LINE = HARMONIC
 
     @pytest.fixture(scope="class")
     @classmethod
     def run(cls) -> Iterator[ConfigRun]:
-        started = start_config_run(cls.CONFIG)
+        started = start_config_run(cls.CONFIG, cls.LINE)
         yield started
         started.group.stop()
 
     def test_gazebo_to_ros_entry_arrives_converted(
         self, run: ConfigRun, entry: ConfigEntry
     ) -> None:
-        expected = sample_for(entry.gz_type, entry.gz_topic).ros
+        expected = line_sample(run.line, entry).ros
         arrived = run.checker.messages(entry.ros_topic)
         assert arrived, f"nothing arrived on {entry.ros_topic}; bridge output:\n" + (
             run.bridge.output()
@@ -190,5 +222,17 @@ class TestTurtlebot3Waffle(ConfigE2E):
     CONFIG = "turtlebot3_waffle_bridge.yaml"
 
 
+class TestTurtlebot3WaffleOnFortress(ConfigE2E):
+    """The TurtleBot3 migration tutorial's pairing: this file, unchanged, on Fortress."""
+
+    CONFIG = "turtlebot3_waffle_bridge.yaml"
+    LINE = FORTRESS
+
+
 class TestDiffCar(ConfigE2E):
     CONFIG = "diff_car_bridge.yaml"
+
+
+class TestDiffCarOnFortress(ConfigE2E):
+    CONFIG = "diff_car_bridge.yaml"
+    LINE = FORTRESS

@@ -286,6 +286,29 @@ def test_fortress_type_name_frame_override_and_sigint(
     assert process.wait(WAIT) == 0, process.output()
 
 
+def test_no_type_parameter_takes_publishers_of_every_gazebo_line(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    """No ``gz_type``: a Fortress camera (``ignition.msgs.Image``) and a Harmonic one
+    (``gz.msgs.Image`` on the wire) both arrive, each frame intact."""
+    require_peer()
+    fortress, harmonic = unique_name("img_fortress_cam"), unique_name("img_harmonic_cam")
+    process = start_process(image_bridge_command(fortress, harmonic))
+    started.append(process)
+    wait_for_line(process, rf"Creating GZ->ROS .*{harmonic}", timeout=30)
+    inboxes = {topic: _subscribe(ros_side, Image, topic)[0] for topic in (fortress, harmonic)}
+    for topic, wire_type in ((fortress, "ignition.msgs.Image"), (harmonic, GZ_IMAGE)):
+        peer = start_peer(
+            "pub", topic, "ignition.msgs.Image", "20", "0",
+            rgb_text_proto(WIDTH, HEIGHT, "cam"),
+            "--bytes", str(WIDTH * HEIGHT * 3), "--wait", str(WAIT), "--wire-type", wire_type,
+        )  # fmt: skip
+        started.append(peer)
+    for inbox in inboxes.values():
+        inbox.wait_for_count(1, WAIT)
+        _assert_pattern_image(inbox.items()[0][0], "cam")
+
+
 def _run(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         image_bridge_command(*args), capture_output=True, text=True, timeout=60, check=False

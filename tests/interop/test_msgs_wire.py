@@ -18,7 +18,8 @@ from typing import Any
 import pytest
 from google.protobuf import descriptor_pb2
 
-from ros_gz_bridge_py.msgs import pool, regen
+from ros_gz_bridge_py.msgs import regen
+from ros_gz_bridge_py.msgs.names import Spelling, respell
 
 pytestmark = pytest.mark.peer
 
@@ -110,9 +111,7 @@ COMPARED = sorted(
 
 
 def _fortress_name(ours: str) -> str:
-    if ours.startswith(pool.IGNITION_PREFIX):
-        return ours
-    return pool.IGNITION_PREFIX + ours.removeprefix(pool.GZ_PREFIX)
+    return respell(ours, Spelling.IGNITION)
 
 
 def test_harmonic_only_types_are_absent_from_fortress(

@@ -21,6 +21,7 @@ from ros_gz_bridge_py.transport.wire import (
     decode_discovery,
     encode_discovery,
 )
+from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber
 
 ME = "11111111-1111-1111-1111-111111111111"
 PEER = "22222222-2222-2222-2222-222222222222"
@@ -171,7 +172,9 @@ def test_remote_subscribers_from_new_and_end_connection() -> None:
         datagram(DiscoveryType.NEW_CONNECTION, pub=theirs), "127.0.0.1", 0.0
     )[1]
     assert events == [SubscriberAdded(TOPIC, PEER, PEER_NODE, "gz.msgs.StringMsg")]
-    assert engine.subscriber_types(TOPIC) == {"gz.msgs.StringMsg"}
+    assert engine.remote_subscribers(TOPIC) == (
+        RemoteSubscriber(PEER, PEER_NODE, frozenset({"gz.msgs.StringMsg"})),
+    )
     not_mine = PublisherRecord(
         TOPIC, "a", PEER, "n2", Scope.ALL, MessagePublisher("t", ctrl="someone")
     )
@@ -188,7 +191,7 @@ def test_remote_subscribers_from_new_and_end_connection() -> None:
     events = engine.datagram_received(ends[0].data, "127.0.0.1", 0.1)[1]
     assert events == [SubscriberRemoved(TOPIC, PEER, PEER_NODE)]
     assert engine.datagram_received(ends[1].data, "127.0.0.1", 0.1)[1] == []
-    assert engine.subscriber_types(TOPIC) == frozenset()
+    assert engine.remote_subscribers(TOPIC) == ()
 
 
 def test_own_and_foreign_versions_and_garbage_are_dropped() -> None:

@@ -69,7 +69,7 @@ def test_pub_sub_both_type_families(nodes: tuple[ZmqNode, ZmqNode], msg_type: st
     assert {t[0] for t in typed} == {"hello", "raw"}
     info = typed[0][1]
     assert (info.topic, info.msg_type, info.intra_process) == (topic, msg_type, False)
-    assert info.publisher_address == pub.record.address
+    assert info.publisher_address == pub.records[0].address
     assert raw[0] == StringMsg(data="hello").SerializeToString()
 
 
@@ -78,12 +78,45 @@ def test_type_mismatch_is_not_delivered(nodes: tuple[ZmqNode, ZmqNode]) -> None:
     topic = unique("typed")
     wrong: list[bytes] = []
     right: list[bytes] = []
-    b.subscribe(topic, lambda d, _: wrong.append(d), "gz.msgs.StringMsg")
+    b.subscribe(topic, lambda d, _: wrong.append(d), "gz.msgs.Int32")
     b.subscribe(topic, lambda d, _: right.append(d), "ignition.msgs.StringMsg")
     pub = a.advertise(topic, "ignition.msgs.StringMsg")
     assert wait_until(pub.has_connections)
     assert publish_until(lambda: pub.publish(StringMsg(data="x")), lambda: bool(right))
     assert wrong == []
+
+
+@pytest.mark.parametrize(
+    ("published", "subscribed"),
+    [
+        ("gz.msgs.StringMsg", "ignition.msgs.StringMsg"),
+        ("ignition.msgs.StringMsg", "gz.msgs.StringMsg"),
+    ],
+)
+def test_either_spelling_reaches_subscribers_of_both_once(
+    nodes: tuple[ZmqNode, ZmqNode], published: str, subscribed: str
+) -> None:
+    """Subscribers of either spelling and a generic one each get every message once."""
+    a, b = nodes
+    topic = unique("spelled")
+    same: list[tuple[bytes, str]] = []
+    other: list[tuple[bytes, str]] = []
+    generic: list[tuple[bytes, str]] = []
+    b.subscribe(topic, lambda d, i: same.append((d, i.msg_type)), published)
+    b.subscribe(topic, lambda d, i: other.append((d, i.msg_type)), subscribed)
+    b.subscribe(topic, lambda d, i: generic.append((d, i.msg_type)))
+    pub = a.advertise(topic, published)
+    assert wait_until(pub.has_connections)
+    payload = StringMsg(data="once").SerializeToString()
+    assert publish_until(lambda: pub.publish_raw(payload), lambda: bool(same and other))
+    first = len(same)
+    for _ in range(5):
+        pub.publish_raw(payload)
+    assert wait_until(lambda: len(same) == first + 5 and len(other) == len(same))
+    time.sleep(0.2)
+    assert len(same) == len(other) == len(generic) == first + 5
+    assert {(d, t) for d, t in same} == {(payload, published)}
+    assert {(d, t) for d, t in other} == {(payload, published)}
 
 
 def test_subscriptions_added_and_closed_while_messages_flow(
@@ -115,8 +148,10 @@ def test_no_wire_traffic_without_subscribers_and_listing(nodes: tuple[ZmqNode, Z
     pub = a.advertise(topic, "gz.msgs.StringMsg")
     assert not pub.has_connections()
     found = b.wait_for_publishers(topic, 10.0)
-    assert [(i.topic, i.msg_type, i.process_uuid) for i in found] == [
-        (topic, "gz.msgs.StringMsg", a.process_uuid)
+    # Announced under both spellings, from one address.
+    assert sorted((i.topic, i.msg_type, i.process_uuid, i.address) for i in found) == [
+        (topic, "gz.msgs.StringMsg", a.process_uuid, a.pub_address),
+        (topic, "ignition.msgs.StringMsg", a.process_uuid, a.pub_address),
     ]
     assert topic in b.topic_list()
     assert b.topic_info(topic) == found
@@ -279,9 +314,13 @@ def test_services(nodes: tuple[ZmqNode, ZmqNode]) -> None:
     assert echo in b.service_list()
     (info,) = b.service_info(echo)
     assert (info.msg_type, info.request_type, info.response_type) == (f"{t}&{t}", t, t)
-    # Type strings must match exactly: no handler, no reply, a timeout.
+    # Either spelling of a type reaches the provider; another type gets no reply.
+    assert b.request(echo, b"\x12\x01y", "ignition.msgs.StringMsg", t, 10.0) == (
+        True,
+        b"\x12\x01y!",
+    )
     with pytest.raises(TransportTimeoutError):
-        b.request(echo, b"", "ignition.msgs.StringMsg", t, 0.5)
+        b.request(echo, b"", "gz.msgs.Int32", t, 0.5)
     # Async with a callback, and a local service of the same node.
     replies: list[tuple[bool | None, bytes]] = []
     a.request_async(echo, b"L", t, t, 5.0, lambda ok, data: replies.append((ok, data)))
