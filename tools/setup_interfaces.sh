@@ -37,8 +37,9 @@ BUILD_WHEELS=(
   "catkin-pkg==1.1.1"
 )
 # Dependency order; each depends only on the common interfaces (tf2_msgs also on
-# action_msgs, which ros-jazzy-rclpy brings).
-DEFAULT_PACKAGES=(tf2_msgs ros_gz_interfaces vision_msgs gps_msgs actuator_msgs)
+# action_msgs, which ros-jazzy-rclpy brings; marine_acoustic_msgs on std_msgs and
+# geometry_msgs), none on another package of this list.
+DEFAULT_PACKAGES=(tf2_msgs ros_gz_interfaces vision_msgs gps_msgs actuator_msgs marine_acoustic_msgs)
 
 die() { echo "setup_interfaces: $*" >&2; exit 1; }
 

@@ -46,6 +46,7 @@ BUILTIN_MODULES: tuple[str, ...] = (
     "actuator_msgs",
     "gps_msgs",
     "vision_msgs",
+    "marine_acoustic_msgs",
     "rcl_interfaces",
     "ros_gz_interfaces",
 )

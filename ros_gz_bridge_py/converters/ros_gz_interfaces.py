@@ -1,6 +1,7 @@
 """ros_gz_interfaces: the message pairs (conversions.md §3.13) and the four bridged services.
 
-The message conversions are in ``ros_gz_interfaces_messages``. The services (§3.14, plus the
+The message conversions are in ``ros_gz_interfaces_messages``, AirSpeed and LogicalCameraImage
+in ``ros_gz_interfaces_sensors``. The services (§3.14, plus the
 ones ros_gz_bridge 1.0.11+ added) each send one gz request and answer
 ``success = reply.data``; a failed or timed-out gz request answers ``success = false``.
 
@@ -18,6 +19,7 @@ from __future__ import annotations
 from typing import Any
 
 from ros_gz_interfaces.msg import (
+    AirSpeed,
     Altimeter,
     Contact,
     Contacts,
@@ -28,6 +30,8 @@ from ros_gz_interfaces.msg import (
     GuiCamera,
     JointWrench,
     Light,
+    LogicalCameraImage,
+    LogPlaybackStatistics,
     MaterialColor,
     ParamVec,
     SensorNoise,
@@ -39,6 +43,7 @@ from ros_gz_interfaces.msg import (
 from ros_gz_interfaces.srv import ControlWorld, DeleteEntity, SetEntityPose, SpawnEntity
 
 from ros_gz_bridge_py.converters import ros_gz_interfaces_messages as m
+from ros_gz_bridge_py.converters import ros_gz_interfaces_sensors as sensors
 from ros_gz_bridge_py.converters.builtin_interfaces import fill_gz_time
 from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_pose
 from ros_gz_bridge_py.converters.registry import Pair, ServicePair
@@ -58,6 +63,7 @@ def _pair(ros_class: type[Any], gz_type: str, to_gz: Any, to_ros: Any) -> Pair:
 
 
 PAIRS = (
+    _pair(AirSpeed, "gz.msgs.AirSpeed", sensors.air_speed_to_gz, sensors.air_speed_to_ros),
     _pair(Altimeter, "gz.msgs.Altimeter", m.altimeter_to_gz, m.altimeter_to_ros),
     _pair(Contact, "gz.msgs.Contact", m.contact_to_gz, m.contact_to_ros),
     _pair(Contacts, "gz.msgs.Contacts", m.contacts_to_gz, m.contacts_to_ros),
@@ -68,6 +74,18 @@ PAIRS = (
     _pair(GuiCamera, "gz.msgs.GUICamera", m.gui_camera_to_gz, m.gui_camera_to_ros),
     _pair(JointWrench, "gz.msgs.JointWrench", m.joint_wrench_to_gz, m.joint_wrench_to_ros),
     _pair(Light, "gz.msgs.Light", m.light_to_gz, m.light_to_ros),
+    _pair(
+        LogicalCameraImage,
+        "gz.msgs.LogicalCameraImage",
+        sensors.logical_camera_image_to_gz,
+        sensors.logical_camera_image_to_ros,
+    ),
+    _pair(
+        LogPlaybackStatistics,
+        "gz.msgs.LogPlaybackStatistics",
+        m.log_playback_statistics_to_gz,
+        m.log_playback_statistics_to_ros,
+    ),
     _pair(MaterialColor, "gz.msgs.MaterialColor", m.material_color_to_gz, m.material_color_to_ros),
     _pair(ParamVec, "gz.msgs.Param", m.param_vec_to_gz_param, m.param_vec_from_gz_param),
     _pair(ParamVec, "gz.msgs.Param_V", m.param_vec_to_gz_param_v, m.param_vec_from_gz_param_v),

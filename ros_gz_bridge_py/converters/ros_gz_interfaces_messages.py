@@ -11,8 +11,9 @@ Differences from ros_gz_bridge:
 - Unknown enum values (Entity type, MaterialColor entity_match) fall back to 0 like the
   reference, but without printing an error; so does an unparsable Dataframe ``rssi`` entry,
   which keeps the previous value.
-- WorldStatistics is converted field by field by name (times copied as in §1.2); the
-  reference revision this port follows has no such pair, so there is nothing to match.
+- WorldStatistics and LogPlaybackStatistics are converted field by field by name (times
+  copied as in §1.2), as ros_gz PR #841 describes them; its converter code was not available
+  to compare with. R→G always sends every Time submessage, even a zero one.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from ros_gz_interfaces.msg import (
     GuiCamera,
     JointWrench,
     Light,
+    LogPlaybackStatistics,
     MaterialColor,
     ParamVec,
     SensorNoise,
@@ -73,6 +75,7 @@ _GzFloatV = message_class("gz.msgs.Float_V")
 _GzGuiCamera = message_class("gz.msgs.GUICamera")
 _GzJointWrench = message_class("gz.msgs.JointWrench")
 _GzLight = message_class("gz.msgs.Light")
+_GzLogPlaybackStatistics = message_class("gz.msgs.LogPlaybackStatistics")
 _GzMaterialColor = message_class("gz.msgs.MaterialColor")
 _GzParam = message_class("gz.msgs.Param")
 _GzParamV = message_class("gz.msgs.Param_V")
@@ -631,7 +634,39 @@ def param_vec_from_gz_param_v(gz: Any) -> Any:
     return ros
 
 
-# --- WorldStatistics ------------------------------------------------------------------------
+# --- LogPlaybackStatistics, WorldStatistics -------------------------------------------------
+
+
+def _fill_gz_present_time(ros_time: Any, gz_time: Any) -> None:
+    """A gz Time that is serialized even when it is zero."""
+    gz_time.SetInParent()
+    fill_gz_time(ros_time, gz_time)
+
+
+def fill_gz_log_playback_stats(ros: Any, gz: Any) -> None:
+    """Header, start_time and end_time; all three submessages are present."""
+    fill_gz_header(ros.header, gz.header)
+    _fill_gz_present_time(ros.start_time, gz.start_time)
+    _fill_gz_present_time(ros.end_time, gz.end_time)
+
+
+def fill_ros_log_playback_stats(gz: Any, ros: Any) -> None:
+    fill_ros_header(gz.header, ros.header)
+    fill_ros_time(gz.start_time, ros.start_time)
+    fill_ros_time(gz.end_time, ros.end_time)
+
+
+def log_playback_statistics_to_gz(ros: Any) -> Any:
+    gz = _GzLogPlaybackStatistics()
+    fill_gz_log_playback_stats(ros, gz)
+    return gz
+
+
+def log_playback_statistics_to_ros(gz: Any) -> Any:
+    ros = LogPlaybackStatistics()
+    fill_ros_log_playback_stats(gz, ros)
+    return ros
+
 
 _STATS_TIMES = ("sim_time", "pause_time", "real_time", "step_size")
 
@@ -641,18 +676,11 @@ def world_statistics_to_gz(ros: Any) -> Any:
     gz = _GzWorldStatistics()
     fill_gz_header(ros.header, gz.header)
     for name in _STATS_TIMES:
-        gz_time = getattr(gz, name)
-        gz_time.SetInParent()
-        fill_gz_time(getattr(ros, name), gz_time)
+        _fill_gz_present_time(getattr(ros, name), getattr(gz, name))
     gz.paused = ros.paused
     gz.iterations = ros.iterations
     gz.model_count = ros.model_count
-    ros_log, gz_log = ros.log_playback_statistics, gz.log_playback_stats
-    fill_gz_header(ros_log.header, gz_log.header)
-    gz_log.start_time.SetInParent()
-    fill_gz_time(ros_log.start_time, gz_log.start_time)
-    gz_log.end_time.SetInParent()
-    fill_gz_time(ros_log.end_time, gz_log.end_time)
+    fill_gz_log_playback_stats(ros.log_playback_statistics, gz.log_playback_stats)
     gz.real_time_factor = ros.real_time_factor
     gz.stepping = ros.stepping
     return gz
@@ -666,10 +694,7 @@ def world_statistics_to_ros(gz: Any) -> Any:
     ros.paused = gz.paused
     ros.iterations = gz.iterations
     ros.model_count = gz.model_count
-    gz_log, ros_log = gz.log_playback_stats, ros.log_playback_statistics
-    fill_ros_header(gz_log.header, ros_log.header)
-    fill_ros_time(gz_log.start_time, ros_log.start_time)
-    fill_ros_time(gz_log.end_time, ros_log.end_time)
+    fill_ros_log_playback_stats(gz.log_playback_stats, ros.log_playback_statistics)
     ros.real_time_factor = gz.real_time_factor
     ros.stepping = gz.stepping
     return ros

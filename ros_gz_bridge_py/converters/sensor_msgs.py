@@ -1,5 +1,6 @@
 """sensor_msgs pairs (conversions.md §3.5); Image/CameraInfo and LaserScan/Range/PointCloud2
-live in sensor_msgs_image.py and sensor_msgs_scan.py.
+live in sensor_msgs_image.py and sensor_msgs_scan.py, NavSatFix <-> NavSatWithCovariance (Jetty,
+not in the C++ bridge) in sensor_msgs_navsat.py.
 
 ``sensor_msgs/msg/Imu`` has two Gazebo layouts (gz-msgs-versions.md): ``gz.msgs.IMU`` is the
 Harmonic layout with covariances; ``ignition.msgs.IMU`` is the Fortress layout, whose field
@@ -48,6 +49,10 @@ from ros_gz_bridge_py.converters.sensor_msgs_image import (
     camera_info_to_ros,
     image_to_gz,
     image_to_ros,
+)
+from ros_gz_bridge_py.converters.sensor_msgs_navsat import (
+    nav_sat_fix_from_gz_nav_sat_with_covariance,
+    nav_sat_fix_to_gz_nav_sat_with_covariance,
 )
 from ros_gz_bridge_py.converters.sensor_msgs_scan import (
     POINT_CLOUD2_BULK,
@@ -266,6 +271,12 @@ PAIRS = (
     _pair(LaserScan, "gz.msgs.LaserScan", laser_scan_to_gz, laser_scan_to_ros),
     _pair(MagneticField, "gz.msgs.Magnetometer", magnetic_field_to_gz, magnetic_field_to_ros),
     _pair(NavSatFix, "gz.msgs.NavSat", nav_sat_fix_to_gz, nav_sat_fix_to_ros),
+    _pair(
+        NavSatFix,
+        "gz.msgs.NavSatWithCovariance",
+        nav_sat_fix_to_gz_nav_sat_with_covariance,
+        nav_sat_fix_from_gz_nav_sat_with_covariance,
+    ),
     _pair(
         PointCloud2,
         "gz.msgs.PointCloudPacked",

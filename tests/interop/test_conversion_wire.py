@@ -9,6 +9,10 @@ checked against ``/work/shared/spec/conversions.md`` (section numbers in the che
 prints the SHA-256 of what it serialized, so each case also proves that the bytes we converted
 are exactly the C++ ones.
 
+Of the pairs added for issue 16, LogicalCameraImage and LogPlaybackStatistics are checked here
+both ways. AirSpeed, DVLVelocityTracking (Harmonic+) and NavSatWithCovariance (Jetty) are not:
+ign-msgs 8 has no such types, so the Fortress peer can neither build nor decode them.
+
 ROS to Gazebo: for a few pairs, our ``to_gz`` output is serialized, published by our ZmqNode
 under ``ignition.msgs.X`` and printed by the C++ peer's ``echo`` mode (decoded with the Fortress
 schema compiled into ign-msgs 8); the printed text is checked for the expected fields and parsed
@@ -39,7 +43,17 @@ from google.protobuf import text_format
 from gps_msgs.msg import GPSFix, GPSStatus
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterType, ParameterValue
-from ros_gz_interfaces.msg import Contacts, Entity, Float32Array, Light, ParamVec, StringVec
+from ros_gz_interfaces.msg import (
+    Contacts,
+    Entity,
+    Float32Array,
+    Light,
+    LogicalCameraImage,
+    LogicalCameraImageModel,
+    LogPlaybackStatistics,
+    ParamVec,
+    StringVec,
+)
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import (
     BatteryState,
@@ -513,6 +527,35 @@ def check_float_v(ros: Any) -> None:
     assert list(ros.data) == [1.5, -2.25, 1024.0, f32(0.1)]
 
 
+LOGICAL_CAMERA_TEXT = (
+    header("robot::camera")
+    + " pose { position { x: 1.5 y: -2.5 z: 0.75 } orientation { x: 0 y: 0 z: 0.6 w: 0.8 } }"
+    ' model { name: "cone::yellow" pose { position { x: 4 y: 5 z: 6 } orientation { w: 1 } } }'
+    ' model { name: "box" pose { position { x: -7 } } }'
+)
+
+
+def check_logical_camera(ros: Any) -> None:
+    assert isinstance(ros, LogicalCameraImage)
+    assert_header(ros, "robot/camera")
+    assert xyz(ros.pose.position) == (1.5, -2.5, 0.75)
+    assert xyzw(ros.pose.orientation) == (0.0, 0.0, 0.6, 0.8)
+    # Model names are names, not frames: `::` stays.
+    assert [model.name for model in ros.model] == ["cone::yellow", "box"]
+    assert xyz(ros.model[0].pose.position) == (4.0, 5.0, 6.0)
+    assert xyzw(ros.model[0].pose.orientation) == (0.0, 0.0, 0.0, 1.0)
+    assert xyz(ros.model[1].pose.position) == (-7.0, 0.0, 0.0)
+    # No orientation on the wire: proto3 w defaults to 0 (§1.4 pitfall).
+    assert xyzw(ros.model[1].pose.orientation) == (0.0, 0.0, 0.0, 0.0)
+
+
+def check_log_playback(ros: Any) -> None:
+    assert isinstance(ros, LogPlaybackStatistics)
+    assert_header(ros, "log")
+    assert (ros.start_time.sec, ros.start_time.nanosec) == (1_700_000_000, 5)
+    assert (ros.end_time.sec, ros.end_time.nanosec) == (1_700_000_360, 999_999_999)
+
+
 # --- vision, gps, actuators, trajectory, rcl (§3.6, §3.9-§3.12) ----------------------------------
 
 
@@ -648,6 +691,12 @@ CASES = (
          header("strings") + ' data: ["first", "b::c", "", "ünïcode"]', check_string_v),
     Case("float_v", "ignition.msgs.Float_V", "ros_gz_interfaces/msg/Float32Array",
          header("ignored") + " data: [1.5, -2.25, 1024, 0.1]", check_float_v),
+    Case("logical_camera", "ignition.msgs.LogicalCameraImage",
+         "ros_gz_interfaces/msg/LogicalCameraImage", LOGICAL_CAMERA_TEXT, check_logical_camera),
+    Case("log_playback", "ignition.msgs.LogPlaybackStatistics",
+         "ros_gz_interfaces/msg/LogPlaybackStatistics",
+         header("log") + " start_time { sec: 1700000000 nsec: 5 }"
+         " end_time { sec: 1700000360 nsec: 999999999 }", check_log_playback),
     Case("detection_2d", "ignition.msgs.AnnotatedAxisAligned2DBox",
          "vision_msgs/msg/Detection2D",
          header("camera") + " box { min_corner { x: 2 y: 2 } max_corner { x: 4 y: 6 } }"
@@ -849,6 +898,24 @@ def ros_joint_state() -> Any:
     return state
 
 
+def ros_logical_camera() -> Any:
+    image = stamp(LogicalCameraImage(), "camera")
+    image.pose.position.x = 1.5
+    box = LogicalCameraImageModel(name="box")
+    box.pose.position.y = -2.5
+    box.pose.orientation.z, box.pose.orientation.w = 1.0, 0.0
+    shelf = LogicalCameraImageModel(name="shelf::top")
+    shelf.pose.position.z = 3.25
+    image.model = [box, shelf]
+    return image
+
+
+def ros_log_playback() -> Any:
+    log = stamp(LogPlaybackStatistics(), "log", 31, 32)
+    log.start_time = Time(sec=100, nanosec=200)
+    return log
+
+
 @dataclass(frozen=True)
 class Reverse:
     """One ROS -> Gazebo conversion checked on the C++ side."""
@@ -898,6 +965,20 @@ REVERSES = (
         # The oneof member is set even for false (§1.6), so the text names it.
         "type: BOOLEAN bool_value: false",
     ), ("header",)),
+    Reverse("logical_camera", "ros_gz_interfaces/msg/LogicalCameraImage",
+            "ignition.msgs.LogicalCameraImage", ros_logical_camera, (
+        'header { stamp { sec: 21 nsec: 22 } data { key: "frame_id" value: "camera" } }',
+        "pose { position { x: 1.5 } orientation { w: 1 } }",
+        'model { name: "box" pose { position { y: -2.5 } orientation { z: 1 } } }',
+        'model { name: "shelf::top" pose { position { z: 3.25 } orientation { w: 1 } } }',
+    )),
+    Reverse("log_playback", "ros_gz_interfaces/msg/LogPlaybackStatistics",
+            "ignition.msgs.LogPlaybackStatistics", ros_log_playback, (
+        'header { stamp { sec: 31 nsec: 32 } data { key: "frame_id" value: "log" } }',
+        "start_time { sec: 100 nsec: 200 }",
+        # A zero end time is still sent.
+        "end_time { }",
+    )),
     Reverse("joint_state", "sensor_msgs/msg/JointState", "ignition.msgs.Model",
             ros_joint_state, (
         'joint { name: "wrist" axis1 { position: 0.5 velocity: -0.25 force: 3.5 } }',

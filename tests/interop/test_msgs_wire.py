@@ -98,10 +98,14 @@ OURS = _ours()
 # gz.msgs.IMU is renumbered since Fortress; ignition.msgs.IMU stands for the Fortress layout.
 SKIPPED = {"gz.msgs.IMU"}
 # Top-level types added after Fortress (gz-msgs-versions.md); their nested types go with them.
+# NavSatWithCovariance is newer still (Jetty).
 HARMONIC_ONLY = {
     "gz.msgs.Dataframe", "gz.msgs.EntityWrench", "gz.msgs.MaterialColor",
     "gz.msgs.OdometryWithCovariance", "gz.msgs.PoseWithCovariance",
     "gz.msgs.TwistWithCovariance", "gz.msgs.SphericalCoordinatesType",
+    "gz.msgs.AirSpeed", "gz.msgs.DVLBeamState", "gz.msgs.DVLKinematicEstimate",
+    "gz.msgs.DVLRangeEstimate", "gz.msgs.DVLTrackingTarget", "gz.msgs.DVLVelocityTracking",
+    "gz.msgs.NavSatWithCovariance",
 }  # fmt: skip
 COMPARED = sorted(
     name

@@ -80,6 +80,12 @@ BRIDGED_TYPES = (
     "WorldStatistics",
     "Joint",
     "Axis",
+    # Added for issue 16: pairs of later ros_gz releases, and Jetty's NavSatWithCovariance.
+    "AirSpeed",
+    "DVLVelocityTracking",
+    "LogicalCameraImage",
+    "LogPlaybackStatistics",
+    "NavSatWithCovariance",
 )
 
 # Whole UDP datagrams sent by ign-transport 11.0.0 (/work/shared/reference/discovery_dump.txt,

@@ -20,6 +20,7 @@ from ros_gz_interfaces.msg import (
     GuiCamera,
     JointWrench,
     Light,
+    LogPlaybackStatistics,
     MaterialColor,
     ParamVec,
     SensorNoise,
@@ -50,6 +51,7 @@ GzBoolean = message_class("gz.msgs.Boolean")
 GzDataframe = message_class("gz.msgs.Dataframe")
 GzEntity = message_class("gz.msgs.Entity")
 GzLight = message_class("gz.msgs.Light")
+GzLogPlaybackStatistics = message_class("gz.msgs.LogPlaybackStatistics")
 GzMaterialColor = message_class("gz.msgs.MaterialColor")
 GzParam = message_class("gz.msgs.Param")
 GzParamV = message_class("gz.msgs.Param_V")
@@ -847,3 +849,39 @@ def test_default_world_statistics_has_every_submessage() -> None:
     assert log.HasField("header")
     assert log.HasField("start_time")
     assert log.HasField("end_time")
+
+
+# --- LogPlaybackStatistics ------------------------------------------------------------------
+
+
+def test_log_playback_statistics_to_gz_keeps_start_and_end_apart() -> None:
+    ros = LogPlaybackStatistics(header=header(61, "log"))
+    ros.start_time.sec, ros.start_time.nanosec = 1_700_000_000, 250
+    ros.end_time.sec, ros.end_time.nanosec = 1_700_000_360, 4_000_000_000
+    gz = m.log_playback_statistics_to_gz(ros)
+    assert_stamped(gz.header, sec=61, frame="log")
+    assert (gz.start_time.sec, gz.start_time.nsec) == (1_700_000_000, 250)
+    # nanosec is reinterpreted as int32 (conversions.md §1.2).
+    assert (gz.end_time.sec, gz.end_time.nsec) == (1_700_000_360, 4_000_000_000 - 2**32)
+    assert m.log_playback_statistics_to_ros(gz) == ros
+
+
+def test_log_playback_statistics_to_ros_keeps_start_and_end_apart() -> None:
+    gz = GzLogPlaybackStatistics()
+    gz.header.stamp.sec, gz.header.stamp.nsec = 71, 72
+    gz.header.data.add(key="frame_id", value=["world::log"])
+    gz.start_time.sec, gz.start_time.nsec = -5, 6
+    gz.end_time.sec, gz.end_time.nsec = 2**31 + 7, -8
+    ros = m.log_playback_statistics_to_ros(gz)
+    assert isinstance(ros, LogPlaybackStatistics)
+    assert (ros.header.stamp.sec, ros.header.stamp.nanosec) == (71, 72)
+    assert ros.header.frame_id == "world/log"
+    assert (ros.start_time.sec, ros.start_time.nanosec) == (-5, 6)
+    # sec narrows to int32 and a negative nsec wraps to uint32, without normalising (§1.2).
+    assert (ros.end_time.sec, ros.end_time.nanosec) == (-(2**31) + 7, 2**32 - 8)
+
+
+def test_default_log_playback_statistics_sends_both_times() -> None:
+    gz = m.log_playback_statistics_to_gz(LogPlaybackStatistics())
+    for field in ("header", "start_time", "end_time"):
+        assert gz.HasField(field)

@@ -36,7 +36,12 @@ def test_pairs_are_listed_in_index_order_with_laser_scan_before_range() -> None:
     )
     assert ("Imu", "gz.msgs.IMU") in names
     assert ("Imu", "ignition.msgs.IMU") in names
-    assert len(names) == 13
+    assert ("NavSatFix", "gz.msgs.NavSatWithCovariance") in names
+    # NavSat stays the default gz type of NavSatFix.
+    assert names.index(("NavSatFix", "gz.msgs.NavSat")) < names.index(
+        ("NavSatFix", "gz.msgs.NavSatWithCovariance")
+    )
+    assert len(names) == 14
 
 
 def sample_imu() -> Any:
