@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.msgs.names import spellings
 from tests.gzpeer import (
     IGN_TOPIC,
     Inbox,
@@ -135,12 +136,12 @@ def test_cli_lists_our_publisher_with_type_and_address(ign_peer: Path, gz_node: 
     info = ign_topic("-i", "-t", topic, timeout=10)
 
     assert topic in listing.stdout.split()
+    # Announced under both spellings of its type (docs/protocol.md §9), from one address.
     rows = re.findall(rf"^\s+({LOOPBACK_ADDRESS}), (\S+)$", info.stdout, re.MULTILINE)
-    assert len(rows) == 1, info.stdout
-    address, msg_type = rows[0]
-    assert msg_type == STRING
+    assert sorted(msg_type for _, msg_type in rows) == sorted(spellings(STRING)), info.stdout
+    (address,) = {address for address, _ in rows}
     ours = [row.address for row in gz_node.topic_info(topic)]
-    assert ours == [address]
+    assert ours == [address, address]
 
 
 def test_round_trip_through_the_cpp_relay(ign_peer: Path, gz_node: Any) -> None:
