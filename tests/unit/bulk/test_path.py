@@ -151,3 +151,29 @@ def test_other_encapsulation_returns_none_for_the_object_path() -> None:
     cdr[1] = 0x07
     assert IMAGE.bulk is not None
     assert ros_cdr_to_gz(IMAGE.bulk, Image, bytes(cdr)) is None
+
+
+class _CountedHash(bytes):
+    """bytes whose hashing is counted: a memoryview hashes its exporter whole."""
+
+    hashed = 0
+
+    def __hash__(self) -> int:
+        type(self).hashed += 1
+        return super().__hash__()
+
+
+def test_neither_direction_hashes_the_message() -> None:
+    assert IMAGE.bulk is not None
+    _CountedHash.hashed = 0
+    hash(memoryview(_CountedHash(b"\x00\x01\x02\x03"))[:2])  # the trap works
+    assert _CountedHash.hashed == 1
+    _CountedHash.hashed = 0
+    ros = _ros_image(12)
+    payload = ros_cdr_to_gz(IMAGE.bulk, Image, _CountedHash(serialize_message(ros)))
+    assert payload is not None
+    assert GzImage.FromString(payload) == IMAGE.to_gz(ros)
+    gz = _gz_image(45)
+    cdr = gz_to_ros_cdr(IMAGE.bulk, GzImage, memoryview(_CountedHash(gz.SerializeToString())))
+    assert deserialize_message(cdr, Image) == IMAGE.to_ros(gz)
+    assert _CountedHash.hashed == 0
