@@ -12,5 +12,9 @@ megabytes about six times and holds the GIL through the DDS write. The bulk path
 - the other way, walks the serialized ROS message to the bulk field, converts the small rest,
   and appends the bulk bytes to the small protobuf payload: one copy.
 
+The pair's converter of the small fields is told the bulk field's length: it checks the sizes
+against it (the object path calls the same converter) and says what the output takes of the
+bulk bytes, a prefix or rows without their padding (:class:`.path.Rows`).
+
 :class:`BulkPath` (in :mod:`.path`) holds what one pair needs; the pair's module declares it.
 """

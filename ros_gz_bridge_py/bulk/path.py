@@ -14,11 +14,44 @@ from ros_gz_bridge_py.bulk.cdr import Layout, locate_bulk
 from ros_gz_bridge_py.bulk.protowire import bytes_field_prefix, split_bytes_field
 from ros_gz_bridge_py.errors import ConversionError
 
-#: Converts a message without its bulk field, given the bulk field's length; returns the other
-#: side's message without its bulk field and how many bulk bytes it takes (a prefix).
-#: Raises ConversionError when the bulk field is too short for the metadata.
-MetaConverter = Callable[[Any, int], tuple[Any, int]]
 _EMPTY_SEQUENCE = b"\0\0\0\0"
+
+
+@dataclass(frozen=True)
+class Rows:
+    """``count`` rows of ``size`` bytes, one every ``stride`` bytes from the bulk field's start.
+
+    What an output takes of row-padded data (``stride`` > ``size``): the padding is left out.
+    """
+
+    count: int
+    size: int
+    stride: int
+
+
+#: What an output takes of the bulk field: a prefix of that many bytes, or rows.
+Take = int | Rows
+
+#: Converts a message without its bulk field, given the bulk field's length; returns the other
+#: side's message without its bulk field and what it takes of the bulk bytes.
+#: Raises ConversionError when the metadata does not match the bulk field's length.
+MetaConverter = Callable[[Any, int], tuple[Any, Take]]
+
+
+def taken(bulk: memoryview, take: Take) -> tuple[list[memoryview], int]:
+    """The views of ``bulk`` that ``take`` selects, and their total size (joining them is the
+    one copy)."""
+    if isinstance(take, int):
+        end, size = take, take
+    else:
+        end, size = (take.count - 1) * take.stride + take.size, take.count * take.size
+    if end > len(bulk):  # the meta converter checked the sizes: a bug if it happens
+        msg = f"{take} takes bytes past the {len(bulk)} of the bulk field"
+        raise ValueError(msg)
+    if isinstance(take, int):
+        return [bulk[:take]], size
+    starts = range(0, take.count * take.stride, take.stride)
+    return [bulk[start : start + take.size] for start in starts], size
 
 
 @dataclass(frozen=True)
@@ -54,7 +87,7 @@ def gz_to_ros_cdr(
     except DecodeError as err:
         msg = f"{gz_class.DESCRIPTOR.full_name} payload is not a valid message: {err}"
         raise ConversionError(msg) from err
-    ros, used = path.gz_meta_to_ros(small, len(bulk))
+    ros, take = path.gz_meta_to_ros(small, len(bulk))
     if finish is not None:
         finish(ros)
     cdr = memoryview(serialize_message(ros))
@@ -62,8 +95,9 @@ def gz_to_ros_cdr(
     if where is None:  # rclpy always writes plain CDR; kept total for the type checker
         msg = "rclpy produced a serialized message that is not plain CDR"
         raise ConversionError(msg)
-    length = struct.pack("<I" if where.little_endian else ">I", used)
-    return b"".join((cdr[: where.length_at], length, bulk[:used], cdr[where.end :]))
+    pieces, size = taken(bulk, take)
+    length = struct.pack("<I" if where.little_endian else ">I", size)
+    return b"".join((cdr[: where.length_at], length, *pieces, cdr[where.end :]))
 
 
 def ros_cdr_to_gz(path: BulkPath, ros_class: type[Any], cdr: bytes) -> bytes | None:
@@ -79,6 +113,7 @@ def ros_cdr_to_gz(path: BulkPath, ros_class: type[Any], cdr: bytes) -> bytes | N
     ros = deserialize_message(
         b"".join((view[: where.length_at], _EMPTY_SEQUENCE, view[where.end :])), ros_class
     )
-    gz, used = path.ros_meta_to_gz(ros, where.end - where.start)
-    prefix = bytes_field_prefix(path.gz_field, used)
-    return b"".join((gz.SerializeToString(), prefix, view[where.start : where.start + used]))
+    gz, take = path.ros_meta_to_gz(ros, where.end - where.start)
+    pieces, size = taken(view[where.start : where.end], take)
+    prefix = bytes_field_prefix(path.gz_field, size)
+    return b"".join((gz.SerializeToString(), prefix, *pieces))

@@ -2,16 +2,21 @@
 
 Image data is copied once, as ``bytes``; on the bulk path (``IMAGE_BULK``) the channel converts
 only the other fields with the ``*_meta_*`` halves and copies the data once into the output.
-The ROS ``step`` (row padding) and ``is_bigendian`` are ignored, as in the reference: ``step``
-is recomputed from width and encoding.
+Both paths check the sizes with the same ``*_meta_*`` code, so they reject the same messages
+with the same text. The output always has step = width * bytes per pixel and exactly
+height * step bytes of data; ``is_bigendian`` is ignored, as in the reference.
 
 Differences from ros_gz_bridge:
 - Image R→G with an unknown encoding raises ConversionError (C++ prints and publishes an
   image with format UNKNOWN_PIXEL_FORMAT and no data).
-- Image R→G with data shorter than height*step raises ConversionError (C++ over-reads).
+- Image R→G checks the ROS ``step``: less than width * bytes per pixel, or data shorter than
+  height * step, raises ConversionError (C++ over-reads); a longer step is row padding, which
+  is left out row by row (C++ ignores the step and shifts every row after the first).
 - Image G→R with an unsupported format raises ConversionError (C++ prints and publishes an
-  empty image); data shorter than step*height raises ConversionError (C++ publishes the
-  frame zero-padded); longer gz data is truncated to step*height (C++ overruns).
+  empty image); the gz ``step`` is ignored, as in C++; data shorter than height * width *
+  bytes per pixel raises ConversionError (C++ publishes the frame zero-padded), and so does a
+  width whose row does not fit the uint32 ROS ``step``.
+- Longer data is truncated to height * step, both ways (C++ overruns G→R).
 - CameraInfo G→R truncates gz arrays longer than the ROS k (9), p (12), r (9) arrays
   (C++ writes out of bounds).
 """
@@ -23,7 +28,7 @@ from typing import Any
 from sensor_msgs.msg import CameraInfo, Image
 
 from ros_gz_bridge_py.bulk.cdr import layout_until
-from ros_gz_bridge_py.bulk.path import BulkPath
+from ros_gz_bridge_py.bulk.path import BulkPath, Rows, Take, taken
 from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
@@ -53,8 +58,17 @@ DISTORTION_MODELS: dict[str, int] = {"plumb_bob": 0, "rational_polynomial": 1, "
 _DISTORTION_NAMES = {value: name for name, value in DISTORTION_MODELS.items()}
 
 
-def image_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
-    """Every field but ``data``; returns the gz Image and how many data bytes it takes."""
+#: The largest value of a uint32 field (``step`` on both sides).
+UINT32_MAX = 2**32 - 1
+
+
+def image_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, Take]:
+    """Every field but ``data``; returns the gz Image and what it takes of the data.
+
+    Raises:
+        ConversionError: unknown encoding; ``step`` less than width * bytes per pixel; data
+            shorter than height * step.
+    """
     entry = ENCODINGS.get(ros.encoding)
     if entry is None:
         msg = (
@@ -63,51 +77,75 @@ def image_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
         )
         raise ConversionError(msg)
     pixel_format, channels, depth = entry
-    gz = GzImage()
-    fill_gz_header(ros.header, gz.header)
-    gz.width = ros.width
-    gz.height = ros.height
-    gz.pixel_format_type = pixel_format
-    gz.step = ros.width * channels * depth
-    size = gz.step * ros.height
-    if data_size < size:
+    width, height, step = ros.width, ros.height, ros.step
+    bytes_per_pixel = channels * depth
+    row = width * bytes_per_pixel
+    shape = f"{width}x{height} {ros.encoding}"
+    if step < row:
         msg = (
-            f"sensor_msgs/msg/Image data has {data_size} bytes, fewer than "
-            f"height*width*bytes_per_pixel = {size} for {ros.width}x{ros.height} {ros.encoding}"
+            f"sensor_msgs/msg/Image step is {step}, less than width*bytes_per_pixel = "
+            f"{width}*{bytes_per_pixel} = {row} for {shape}"
         )
         raise ConversionError(msg)
-    return gz, size
+    if data_size < height * step:
+        msg = (
+            f"sensor_msgs/msg/Image data has {data_size} bytes, fewer than height*step = "
+            f"{height}*{step} = {height * step} for {shape}"
+        )
+        raise ConversionError(msg)
+    gz = GzImage()
+    fill_gz_header(ros.header, gz.header)
+    gz.width = width
+    gz.height = height
+    gz.pixel_format_type = pixel_format
+    gz.step = row
+    return gz, (height * row if step == row or height <= 1 else Rows(height, row, step))
 
 
 def image_to_gz(ros: Any) -> Any:
-    data = ros.data
-    gz, size = image_meta_to_gz(ros, len(data))
-    gz.data = bytes(memoryview(data)[:size])
+    data = memoryview(ros.data)
+    gz, take = image_meta_to_gz(ros, len(data))
+    pieces, _ = taken(data, take)
+    gz.data = b"".join(pieces)
     return gz
 
 
 def image_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
-    """Every field but ``data``; returns the ROS Image and how many data bytes it takes."""
+    """Every field but ``data``; returns the ROS Image and how many data bytes it takes.
+
+    Raises:
+        ConversionError: unsupported pixel format; a row (width * bytes per pixel) wider than
+            a uint32 ``step``; data shorter than height * that row.
+    """
     entry = PIXEL_FORMATS.get(gz.pixel_format_type)
     if entry is None:
         msg = f"gz.msgs.Image pixel_format_type {gz.pixel_format_type} has no ROS encoding"
         raise ConversionError(msg)
     encoding, bytes_per_pixel = entry
-    ros = Image()
-    fill_ros_header(gz.header, ros.header)
-    ros.height = gz.height
-    ros.width = gz.width
-    ros.encoding = encoding
-    ros.is_bigendian = 0
-    ros.step = gz.width * bytes_per_pixel
-    size = ros.step * gz.height
-    if data_size < size:
+    width, height = gz.width, gz.height
+    step = width * bytes_per_pixel
+    shape = f"{width}x{height} {encoding}"
+    if step > UINT32_MAX:
         msg = (
-            f"gz.msgs.Image data has {data_size} bytes, fewer than height*step = {size} "
-            f"for {gz.width}x{gz.height} {encoding}"
+            f"gz.msgs.Image width*bytes_per_pixel = {width}*{bytes_per_pixel} = {step} for "
+            f"{shape} does not fit the uint32 step of sensor_msgs/msg/Image"
         )
         raise ConversionError(msg)
-    return ros, size
+    if data_size < height * step:
+        msg = (
+            f"gz.msgs.Image data has {data_size} bytes, fewer than height*step = "
+            f"{height}*{step} = {height * step} for {shape} (step = width*bytes_per_pixel; "
+            "the gz step is ignored)"
+        )
+        raise ConversionError(msg)
+    ros = Image()
+    fill_ros_header(gz.header, ros.header)
+    ros.height = height
+    ros.width = width
+    ros.encoding = encoding
+    ros.is_bigendian = 0
+    ros.step = step
+    return ros, height * step
 
 
 def image_to_ros(gz: Any) -> Any:

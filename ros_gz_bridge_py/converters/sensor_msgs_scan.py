@@ -17,12 +17,16 @@ Differences from ros_gz_bridge:
   a finite non-negative number (UB in C++).
 - LaserScan G→R pads gz ranges/intensities shorter than the selected row with 0.0.
 - Range G→R raises ConversionError for a scan with no ranges.
+- PointCloud2, both ways, raises ConversionError when the sizes do not describe the data
+  (see :func:`check_cloud_sizes`; C++ forwards the message, and a consumer that trusts the
+  sizes reads out of bounds).
 """
 
 from __future__ import annotations
 
 import math
 from array import array
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -42,6 +46,17 @@ _GZ_INT8 = 0
 _ROS_INT8 = PointField.INT8
 _DATATYPE_OFFSET = PointField.INT8 - _GZ_INT8
 _ROS_DATATYPES = range(PointField.INT8, PointField.FLOAT64 + 1)
+#: PointField datatypes in order (ROS 1..8, gz 0..7): (name, bytes per element).
+_DATATYPES = (
+    ("INT8", 1),
+    ("UINT8", 1),
+    ("INT16", 2),
+    ("UINT16", 2),
+    ("INT32", 4),
+    ("UINT32", 4),
+    ("FLOAT32", 4),
+    ("FLOAT64", 8),
+)
 
 
 def scan_count(angle_min: float, angle_max: float, angle_increment: float) -> int:
@@ -132,9 +147,71 @@ def range_to_ros(gz: Any) -> Any:
     return ros
 
 
+@dataclass(frozen=True)
+class CloudSizes:
+    """The size fields of a point cloud, as the sender wrote them (same names on both sides)."""
+
+    height: int
+    width: int
+    point_step: int
+    row_step: int
+    #: (name, offset, count, datatype) of each field, datatype in the sender's numbering.
+    fields: list[tuple[str, int, int, int]]
+    #: The sender's value for INT8 (ROS 1, gz 0).
+    int8: int
+
+
+def check_cloud_sizes(type_name: str, fields_name: str, sizes: CloudSizes, data_size: int) -> None:
+    """Raise ConversionError unless the sizes describe ``data_size`` bytes of data exactly.
+
+    What a consumer that trusts the sizes needs: every field (count elements of its datatype,
+    an unknown datatype counting as the INT8 it becomes) inside ``point_step``; a row of
+    ``width`` points inside ``row_step`` (longer is row padding); and exactly ``height`` rows
+    of ``row_step`` bytes (PCL copies all of ``data`` into a width x height cloud). The
+    products are Python ints, exact: 4294967295*16 is not wrapped as in uint32 arithmetic.
+    The error names every size that is wrong, its value and what it should be.
+    """
+    height, width = sizes.height, sizes.width
+    point_step, row_step = sizes.point_step, sizes.row_step
+    problems = []
+    for index, (name, offset, count, datatype) in enumerate(sizes.fields):
+        number = datatype - sizes.int8
+        if 0 <= number < len(_DATATYPES):
+            kind, size = _DATATYPES[number]
+        else:
+            kind, size = f"datatype {datatype} taken as INT8", 1
+        end = offset + count * size
+        if end > point_step:
+            problems.append(
+                f"{fields_name}[{index}] {name!r} ({count} x {kind}) ends at "
+                f"offset+count*size = {offset}+{count}*{size} = {end}, past point_step = "
+                f"{point_step}"
+            )
+    if row_step < width * point_step:
+        problems.append(
+            f"row_step is {row_step}, less than width*point_step = {width}*{point_step} = "
+            f"{width * point_step}"
+        )
+    if data_size != height * row_step:
+        problems.append(
+            f"data has {data_size} bytes, not height*row_step = {height}*{row_step} = "
+            f"{height * row_step}"
+        )
+    if problems:
+        msg = f"{type_name} sizes do not match its data: {'; '.join(problems)}"
+        raise ConversionError(msg)
+
+
 def point_cloud2_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
     """Every field but ``data`` (all of which is taken). An unknown ROS datatype becomes gz
-    INT8, silently, as in C++."""
+    INT8, silently, as in C++.
+
+    Raises:
+        ConversionError: the sizes do not describe the data (:func:`check_cloud_sizes`).
+    """
+    fields = [(f.name, f.offset, f.count, f.datatype) for f in ros.fields]
+    sizes = CloudSizes(ros.height, ros.width, ros.point_step, ros.row_step, fields, _ROS_INT8)
+    check_cloud_sizes("sensor_msgs/msg/PointCloud2", "fields", sizes, data_size)
     gz = GzPointCloudPacked()
     fill_gz_header(ros.header, gz.header)
     gz.height = ros.height
@@ -143,26 +220,33 @@ def point_cloud2_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
     gz.point_step = ros.point_step
     gz.row_step = ros.row_step
     gz.is_dense = ros.is_dense
-    for field in ros.fields:
-        datatype = field.datatype
+    for name, offset, count, datatype in fields:
         gz.field.add(
-            name=field.name,
-            offset=field.offset,
-            count=field.count,
+            name=name,
+            offset=offset,
+            count=count,
             datatype=datatype - _DATATYPE_OFFSET if datatype in _ROS_DATATYPES else _GZ_INT8,
         )
     return gz, data_size
 
 
 def point_cloud2_to_gz(ros: Any) -> Any:
-    gz, _ = point_cloud2_meta_to_gz(ros, 0)
-    gz.data = bytes(ros.data)
+    data = ros.data
+    gz, _ = point_cloud2_meta_to_gz(ros, len(data))
+    gz.data = bytes(data)
     return gz
 
 
 def point_cloud2_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
     """Every field but ``data`` (all of which is taken). An unknown gz datatype becomes ROS
-    INT8, silently, as in C++."""
+    INT8, silently, as in C++.
+
+    Raises:
+        ConversionError: the sizes do not describe the data (:func:`check_cloud_sizes`).
+    """
+    fields = [(f.name, f.offset, f.count, f.datatype) for f in gz.field]
+    sizes = CloudSizes(gz.height, gz.width, gz.point_step, gz.row_step, fields, _GZ_INT8)
+    check_cloud_sizes("gz.msgs.PointCloudPacked", "field", sizes, data_size)
     ros = PointCloud2()
     fill_ros_header(gz.header, ros.header)
     ros.height = gz.height
@@ -171,24 +255,22 @@ def point_cloud2_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
     ros.point_step = gz.point_step
     ros.row_step = gz.row_step
     ros.is_dense = gz.is_dense
-    fields = []
-    for field in gz.field:
-        datatype = field.datatype + _DATATYPE_OFFSET
-        fields.append(
-            PointField(
-                name=field.name,
-                offset=field.offset,
-                count=field.count,
-                datatype=datatype if datatype in _ROS_DATATYPES else _ROS_INT8,
-            )
-        )
-    ros.fields = fields
+    ros.fields = [
+        PointField(name=name, offset=offset, count=count, datatype=_ros_datatype(datatype))
+        for name, offset, count, datatype in fields
+    ]
     return ros, data_size
 
 
+def _ros_datatype(gz_datatype: int) -> int:
+    datatype = gz_datatype + _DATATYPE_OFFSET
+    return datatype if datatype in _ROS_DATATYPES else int(_ROS_INT8)
+
+
 def point_cloud2_to_ros(gz: Any) -> Any:
-    ros, _ = point_cloud2_meta_to_ros(gz, 0)
-    ros.data = gz.data
+    data = gz.data
+    ros, _ = point_cloud2_meta_to_ros(gz, len(data))
+    ros.data = data
     return ros
 
 

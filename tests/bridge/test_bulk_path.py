@@ -23,6 +23,8 @@ from sensor_msgs.msg import Image, PointCloud2, PointField
 from ros_gz_bridge_py.bridge import BULK_PATH_ENV as BULK_ENV
 from ros_gz_bridge_py.channel import BULK_THREAD_NICE
 from ros_gz_bridge_py.converters.registry import default_registry
+from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import Node as GzNode
 from tests.bridge.behaviour_harness import (
     WAIT,
@@ -34,7 +36,7 @@ from tests.bridge.behaviour_harness import (
     started,
 )
 from tests.bridge.e2e_harness import parse_gz
-from tests.bridge.image_frames import pattern_bytes, rgb_text_proto
+from tests.bridge.image_frames import pattern_bytes, rgb_frame, rgb_text_proto
 from tests.gzpeer import (
     PeerProcess,
     require_peer,
@@ -138,16 +140,20 @@ def ros_cloud(index: int) -> PointCloud2:
     return msg
 
 
-def _echo(topic: str, type_name: str) -> PeerProcess:
-    echo = start_peer("echo", topic, f"ignition.msgs.{type_name}", "30", "--count", "1",
+def _echo(topic: str, type_name: str, count: int = 1) -> PeerProcess:
+    echo = start_peer("echo", topic, f"ignition.msgs.{type_name}", "30", "--count", str(count),
                       "--wire-type", f"gz.msgs.{type_name}")  # fmt: skip
     wait_for_line(echo, "READY", timeout=WAIT)
     return echo
 
 
+def _messages(echo: PeerProcess, type_name: str) -> list[Any]:
+    lines = [x for x in echo.output().splitlines() if x.startswith("MSG ")]
+    return [parse_gz(type_name, line.split(" ", 2)[2]) for line in lines]
+
+
 def _first_message(echo: PeerProcess, type_name: str) -> Any:
-    line = next(x for x in echo.output().splitlines() if x.startswith("MSG "))
-    return parse_gz(type_name, line.split(" ", 2)[2])
+    return _messages(echo, type_name)[0]
 
 
 @pytest.mark.parametrize(
@@ -192,6 +198,12 @@ def test_ros_to_gazebo(  # noqa: PLR0917 - one parametrized case per message kin
         assert got.pixel_format_type == 8  # BGR_INT8
         assert got.step == WIDTH * 3
         assert len(got.data) == HEIGHT * WIDTH * 3
+        # The two bytes of row padding of each ROS row are left out, row by row.
+        step, row = WIDTH * 3 + 2, WIDTH * 3
+        sent_data = [bytes(getattr(msg, "data", b"")) for msg in sent]
+        assert got.data in [
+            b"".join(data[r * step : r * step + row] for r in range(HEIGHT)) for data in sent_data
+        ]
     elif kind == "cloud":
         assert [f.datatype for f in got.field] == [6, 3]
         assert got.is_dense
@@ -249,3 +261,109 @@ def test_gazebo_to_ros_cloud(bridge: RunningBridge, ros_side: RosSide, gz_node: 
     publisher = gz_node.advertise(topic, GZ_CLOUD)
     publish_until(lambda _i: publisher.publish_raw(payload), lambda: bool(inbox.items()), "cloud")
     assert inbox.items()[0][0] == ros_cloud(5)
+
+
+def bad_ros_image(index: int) -> Image:
+    """Rows that overlap: a step one byte short of width * 3."""
+    msg = ros_image(index)
+    msg.step = WIDTH * 3 - 1
+    return msg
+
+
+def bad_ros_cloud(index: int) -> PointCloud2:
+    """The cloud of issue 14: width 4294967295 over 30 bytes of data."""
+    msg = ros_cloud(index)
+    msg.width = 4_294_967_295
+    return msg
+
+
+#: What the bridge logs for each bad message, on every path.
+BAD_ROS_ERRORS = {
+    "image": "sensor_msgs/msg/Image step is 17, less than width*bytes_per_pixel = 6*3 = 18 "
+    "for 6x4 bgr8",
+    "cloud": "sensor_msgs/msg/PointCloud2 sizes do not match its data: row_step is 30, less "
+    "than width*point_step = 4294967295*6 = 25769803770",
+}
+
+
+@pytest.mark.parametrize("kind", ["image", "cloud"])
+def test_ros_to_gazebo_inconsistent_sizes_are_never_forwarded(
+    bridge: RunningBridge, ros_side: RosSide, started: list[PeerProcess], kind: str
+) -> None:
+    """Bad and good messages alternate; the echo gets only good ones, the log names the bad."""
+    good, bad, type_name, ros_type, gz_type, topic = {
+        "image": (ros_image, bad_ros_image, "Image", "sensor_msgs/msg/Image", GZ_IMAGE,
+                  bridge.topics.image_to_gz),
+        "cloud": (ros_cloud, bad_ros_cloud, "PointCloudPacked", "sensor_msgs/msg/PointCloud2",
+                  GZ_CLOUD, bridge.topics.cloud_to_gz),
+    }[kind]  # fmt: skip
+    pair = default_registry().get(ros_type, gz_type)
+    with pytest.raises(ConversionError) as object_error:
+        pair.to_gz(bad(0))
+    assert str(object_error.value) == BAD_ROS_ERRORS[kind]
+    echo = _echo(topic, type_name, count=3)
+    started.append(echo)
+    publisher = ros_side.run(lambda: ros_side.node.create_publisher(type(good(0)), topic, 10))
+    sent: list[Any] = []
+
+    def publish(index: int) -> None:
+        sent.append(good(100 + index))
+        ros_side.run(lambda: (publisher.publish(bad(index)), publisher.publish(sent[-1])))
+
+    publish_until(publish, lambda: len(_messages(echo, type_name)) >= 3, f"3 good {kind}s")
+    expected = [pair.to_gz(msg) for msg in sent]
+    assert all(got in expected for got in _messages(echo, type_name))
+    wait_until(lambda: BAD_ROS_ERRORS[kind] in bridge.process.output(), WAIT, "the error logged")
+
+
+def bad_gz_payload(kind: str, index: int) -> bytes:
+    """A Gazebo image one byte short, or a cloud 4294967295 points wide."""
+    if kind == "image":
+        frame = rgb_frame(WIDTH, HEIGHT, data=bytes(WIDTH * HEIGHT * 3 - 1))
+        frame.header.stamp.sec = index
+        return bytes(frame.SerializeToString())
+    cloud = default_registry().get("sensor_msgs/msg/PointCloud2", GZ_CLOUD).to_gz(ros_cloud(index))
+    cloud.width = 4_294_967_295
+    return bytes(cloud.SerializeToString())
+
+
+BAD_GZ_ERRORS = {
+    "image": "gz.msgs.Image data has 71 bytes, fewer than height*step = 4*18 = 72 for 6x4 "
+    "rgb8 (step = width*bytes_per_pixel; the gz step is ignored)",
+    "cloud": "gz.msgs.PointCloudPacked sizes do not match its data: row_step is 30, less "
+    "than width*point_step = 4294967295*6 = 25769803770",
+}
+
+
+@pytest.mark.parametrize("kind", ["image", "cloud"])
+def test_gazebo_to_ros_inconsistent_sizes_are_never_forwarded(
+    bridge: RunningBridge, ros_side: RosSide, gz_node: GzNode, kind: str
+) -> None:
+    """Bad and good messages alternate; rclpy gets only good ones, the log names the bad."""
+    msg_type, ros_type, gz_type, topic = {
+        "image": (Image, "sensor_msgs/msg/Image", GZ_IMAGE, bridge.topics.image_to_ros),
+        "cloud": (PointCloud2, "sensor_msgs/msg/PointCloud2", GZ_CLOUD,
+                  bridge.topics.cloud_to_ros),
+    }[kind]  # fmt: skip
+    pair = default_registry().get(ros_type, gz_type)
+    gz_class = message_class(gz_type)
+    with pytest.raises(ConversionError) as object_error:
+        pair.to_ros(gz_class.FromString(bad_gz_payload(kind, 0)))
+    assert str(object_error.value) == BAD_GZ_ERRORS[kind]
+    wait_until(lambda: ros_side.count_publishers(topic) >= 1, WAIT, f"a publisher on {topic}")
+    inbox, _ = ros_side.subscribe(msg_type, topic)
+    publisher = gz_node.advertise(topic, gz_type)
+    sent: list[Any] = []
+
+    def publish(index: int) -> None:
+        if kind == "image":
+            sent.append(rgb_frame(WIDTH, HEIGHT, frame_id=f"cam{index}"))
+        else:
+            sent.append(pair.to_gz(ros_cloud(100 + index)))
+        publisher.publish_raw(bad_gz_payload(kind, index))
+        publisher.publish_raw(sent[-1].SerializeToString())
+
+    publish_until(publish, lambda: len(inbox.items()) >= 3, f"3 good {kind}s in rclpy")
+    expected = [pair.to_ros(msg) for msg in sent]
+    assert all(got in expected for got, _ in inbox.items())
+    wait_until(lambda: BAD_GZ_ERRORS[kind] in bridge.process.output(), WAIT, "the error logged")

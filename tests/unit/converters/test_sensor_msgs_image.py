@@ -35,26 +35,41 @@ def test_every_encoding_round_trips(encoding: str) -> None:
     assert image_to_ros(image_to_gz(ros)) == ros
 
 
-def test_ros_row_padding_is_dropped_and_step_recomputed() -> None:
-    ros = Image(width=2, height=1, encoding="mono8", step=8, data=b"ab" + b"\0" * 6)
+def test_ros_row_padding_is_left_out_row_by_row_and_step_recomputed() -> None:
+    ros = Image(width=2, height=3, encoding="mono8", step=5, data=b"ab...cd,,,ef;;;tail")
     gz = image_to_gz(ros)
-    assert (gz.step, gz.data) == (2, b"ab")
+    assert (gz.step, gz.data) == (2, b"abcdef")
+    back = image_to_ros(gz)
+    assert (back.step, bytes(back.data)) == (2, b"abcdef")
 
 
 def test_unknown_encoding_and_short_data_are_rejected() -> None:
     with pytest.raises(ConversionError, match="yuv422"):
         image_to_gz(Image(width=1, height=1, encoding="yuv422", data=b"ab"))
-    with pytest.raises(ConversionError, match="fewer"):
-        image_to_gz(Image(width=2, height=2, encoding="mono8", data=b"abc"))
+    with pytest.raises(
+        ConversionError, match=r"data has 3 bytes, fewer than height\*step = 2\*2 = 4 for 2x2"
+    ):
+        image_to_gz(Image(width=2, height=2, encoding="mono8", step=2, data=b"abc"))
     with pytest.raises(ConversionError, match="pixel_format_type 7"):
         image_to_ros(GzImage(width=1, height=1, pixel_format_type=7))
+
+
+def test_ros_step_shorter_than_a_row_is_rejected() -> None:
+    """Rows that overlap: the step the ROS publisher wrote contradicts width and encoding."""
+    ros = Image(width=2, height=2, encoding="rgb16", step=11, data=bytes(24))
+    with pytest.raises(
+        ConversionError, match=r"step is 11, less than width\*bytes_per_pixel = 2\*6 = 12"
+    ):
+        image_to_gz(ros)
 
 
 def test_long_gz_data_is_truncated_and_short_data_rejected() -> None:
     long_gz = GzImage(width=2, height=1, pixel_format_type=1, data=b"abcdef")
     assert bytes(image_to_ros(long_gz).data) == b"ab"
+    long_ros = Image(width=2, height=1, encoding="mono8", step=2, data=b"abcdef")
+    assert image_to_gz(long_ros).data == b"ab"
     short_gz = GzImage(width=2, height=2, pixel_format_type=1, data=b"abc")
-    with pytest.raises(ConversionError, match="3 bytes, fewer than height\\*step = 4"):
+    with pytest.raises(ConversionError, match=r"3 bytes, fewer than height\*step = 2\*2 = 4"):
         image_to_ros(short_gz)
 
 

@@ -21,6 +21,7 @@ from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 
 GzLaserScan = message_class("gz.msgs.LaserScan")
+GzPointCloudPacked = message_class("gz.msgs.PointCloudPacked")
 
 
 def test_upstream_fixture_count_is_100() -> None:
@@ -93,6 +94,40 @@ def test_point_cloud_upstream_fixture_round_trips() -> None:
     assert gz.field[0].datatype == 6  # gz FLOAT32
     assert gz.data == ros.data.tobytes()
     assert point_cloud2_to_ros(gz) == ros
+
+
+def test_point_cloud_row_padding_and_empty_fields_are_consistent() -> None:
+    ros = PointCloud2(height=2, width=2, point_step=6, row_step=13, is_dense=False)
+    ros.fields = [
+        PointField(name="x", offset=0, datatype=PointField.FLOAT32, count=1),
+        PointField(name="i", offset=4, datatype=PointField.UINT16, count=1),
+        PointField(name="pad", offset=6, datatype=PointField.FLOAT64, count=0),
+    ]
+    ros.data = bytes(range(26))
+    gz = point_cloud2_to_gz(ros)
+    assert (gz.row_step, gz.data) == (13, bytes(range(26)))
+    assert point_cloud2_to_ros(gz) == ros
+
+
+def test_point_cloud_sizes_that_do_not_describe_the_data_are_rejected() -> None:
+    """The cloud of issue 14: a consumer that trusts width reads 64 GiB from 16 bytes."""
+    ros = PointCloud2(height=1, width=4_294_967_295, point_step=16, row_step=16, data=bytes(16))
+    ros.fields = [PointField(name="x", offset=0, datatype=PointField.FLOAT32, count=1)]
+    with pytest.raises(ConversionError) as error:
+        point_cloud2_to_gz(ros)
+    assert str(error.value) == (
+        "sensor_msgs/msg/PointCloud2 sizes do not match its data: row_step is 16, less than "
+        "width*point_step = 4294967295*16 = 68719476720"
+    )
+    gz = GzPointCloudPacked(height=2, width=1, point_step=4, row_step=4, data=bytes(9))
+    gz.field.add(name="x", offset=2, datatype=2, count=2)  # INT16 x 2 from byte 2: 6 > 4
+    with pytest.raises(ConversionError) as error:
+        point_cloud2_to_ros(gz)
+    assert str(error.value) == (
+        "gz.msgs.PointCloudPacked sizes do not match its data: field[0] 'x' (2 x INT16) ends "
+        "at offset+count*size = 2+2*2 = 6, past point_step = 4; data has 9 bytes, not "
+        "height*row_step = 2*4 = 8"
+    )
 
 
 def test_point_cloud_unknown_datatypes_fall_back_to_int8() -> None:
