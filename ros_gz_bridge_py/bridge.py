@@ -46,6 +46,7 @@ from ros_gz_bridge_py.config import (
 )
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
+from ros_gz_bridge_py.explain import EXPLAIN_PERIOD, Explainer
 from ros_gz_bridge_py.gz_version import GARDEN
 from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT, ServiceBridge
@@ -88,6 +89,8 @@ class BridgeOptions:
     #: The simulator's Gazebo line when the user names it (``gz_version``, ``GZ_VERSION``);
     #: only ``garden`` changes anything: its ``gz.msgs.*`` have Fortress layouts and names.
     gz_version: str = ""
+    #: Evaluate every channel and log why it carries nothing (``explain.py``).
+    explain: bool = True
 
     @property
     def garden(self) -> bool:
@@ -136,9 +139,15 @@ class Bridge:
         self._lock = threading.RLock()
         self._handles: list[BridgeHandle] = []
         self._closed = False
-        self._timer = ros_node.create_timer(
-            self.options.heartbeat, self.heartbeat, clock=Clock(clock_type=ClockType.STEADY_TIME)
-        )
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self._timer = ros_node.create_timer(self.options.heartbeat, self.heartbeat, clock=steady)
+        self._explainer: Explainer | None = None
+        self._explain_timer: Any = None
+        if self.options.explain:
+            self._explainer = Explainer(
+                self.gz_node, self.registry, self._ctx.own_nodes, self._logger.warning
+            )
+            self._explain_timer = ros_node.create_timer(EXPLAIN_PERIOD, self.explain, clock=steady)
 
     @property
     def handles(self) -> list[BridgeHandle]:
@@ -200,6 +209,15 @@ class Bridge:
                 except Exception as err:
                     self._logger.error(f"{channel.describe()}: lazy check failed: {err}")
 
+    def explain(self) -> None:
+        """Set every channel's flow state and causes, logging new causes (the bridge's timer)."""
+        if self._explainer is None:
+            return
+        try:
+            self._explainer.evaluate(self.channels)
+        except Exception as err:
+            self._logger.error(f"explaining the channels failed: {err!r}")
+
     def close(self) -> None:
         """Close every bridge, the heartbeat timer and the Gazebo node if the bridge made it."""
         with self._lock:
@@ -208,6 +226,8 @@ class Bridge:
             self._closed = True
             handles, self._handles = self._handles, []
         self.ros_node.destroy_timer(self._timer)
+        if self._explain_timer is not None:
+            self.ros_node.destroy_timer(self._explain_timer)
         for handle in reversed(handles):
             _close_handle(handle)
         if self._side is not None:

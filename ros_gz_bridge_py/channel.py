@@ -37,6 +37,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
 
 from ros_gz_bridge_py import ros_cdr
@@ -44,6 +45,7 @@ from ros_gz_bridge_py.bulk.path import BulkPath, gz_to_ros_cdr, ros_cdr_to_gz
 from ros_gz_bridge_py.bulk.serialized_publisher import SerializedPublisher
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.diagnosis import Finding, Flow
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.loop_guard import OwnPublications
 from ros_gz_bridge_py.msgs import message_class
@@ -149,6 +151,9 @@ class Channel(abc.ABC):
         self.lazy = lazy
         self.state = ChannelState.CREATED
         self.stats = ChannelStats()
+        #: What the bridge's explainer last made of the channel (``explain.py``).
+        self.flow: Flow | None = None
+        self.findings: list[Finding] = []
         self.ros_topic = ctx.resolve(spec.ros_topic)
         self._logger = ctx.ros_node.get_logger()
         self._last_error_log = 0.0
@@ -206,6 +211,11 @@ class Channel(abc.ABC):
     @abc.abstractmethod
     def describe(self) -> str: ...
 
+    @property
+    @abc.abstractmethod
+    def qos(self) -> QoSProfile:
+        """The QoS of the channel's ROS endpoint."""
+
     @abc.abstractmethod
     def _open_output(self) -> None: ...
 
@@ -260,6 +270,10 @@ class GzToRosChannel(Channel):
     @property
     def dropped(self) -> int:
         return self._subscription.dropped if self._subscription is not None else 0
+
+    @property
+    def qos(self) -> QoSProfile:
+        return self._qos
 
     def _make_finisher(self) -> Callable[[Any], None] | None:
         """The per-message header rewrite the node options ask for, bound once."""
@@ -429,6 +443,14 @@ class RosToGzChannel(Channel):
         if self._subscription is not None:
             self._subscription_node.destroy_subscription(self._subscription)
             self._subscription = None
+
+    @property
+    def qos(self) -> QoSProfile:
+        return self._qos
+
+    def gazebo_subscribed(self) -> bool:
+        """True while some remote Gazebo subscriber takes this channel's messages."""
+        return self._gz_publisher is not None and bool(self._gz_publisher.wire_types())
 
     def _output_has_subscribers(self) -> bool:
         return self._gz_publisher is not None and self._gz_publisher.has_connections()

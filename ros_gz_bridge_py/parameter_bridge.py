@@ -24,6 +24,8 @@ from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
 from ros_gz_bridge_py.bridge import Bridge, BridgeOptions
+from ros_gz_bridge_py.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
+from ros_gz_bridge_py.check import Sides, run_check
 from ros_gz_bridge_py.config import (
     USAGE,
     BridgeSpec,
@@ -35,15 +37,18 @@ from ros_gz_bridge_py.config import (
     parse_parameter_bridges,
     read_yaml_file,
 )
+from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.gz_version import GZ_VERSION_ENV, check_gz_version
-from ros_gz_bridge_py.runtime import apply_speed_settings
+from ros_gz_bridge_py.runtime import apply_speed_settings, make_executor
 from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.stop_signal import StopSignal
-from ros_gz_bridge_py.transport import NodeOptions
+from ros_gz_bridge_py.transport import NodeOptions, create_node
 
 NODE_NAME = "ros_gz_bridge"
+#: ``parameter_bridge --check [SECONDS]``: report on the entries instead of bridging them.
+CHECK_OPTION = "--check"
 #: Exit status for bad arguments, as the C++ bridge (``return -1``).
 USAGE_EXIT = 255
 BRIDGE_PARAMETER_KEYS = (
@@ -135,6 +140,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         print(USAGE)
         return USAGE_EXIT
     try:
+        check_seconds, positional = split_check_option(positional)
         cli = parse_cli_args(positional)
     except UsageError as err:
         print(USAGE)
@@ -155,6 +161,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             params = declare_parameters(node)
             if stop.requested:
                 return 0
+            if check_seconds is not None:
+                return check(node, cli, params, check_seconds)
             bridge = build_bridge(node, cli, params)
             diagnostics = start_diagnostics(node, bridge, params["status_period"])
             serve(node, bridge, stop)
@@ -168,8 +176,32 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
     return 0
 
 
-def build_bridge(node: Node, cli: ParseResult, params: dict[str, Any]) -> Bridge:
-    """Collect every configuration source, report its problems, and create the bridges."""
+def split_check_option(args: Sequence[str]) -> tuple[float | None, list[str]]:
+    """(``--check`` seconds or None, the other arguments): ``--check [SECONDS]`` anywhere.
+
+    Raises:
+        UsageError: the seconds are not a positive number.
+    """
+    rest = list(args)
+    if CHECK_OPTION not in rest:
+        return None, rest
+    index = rest.index(CHECK_OPTION)
+    del rest[index]
+    seconds = DEFAULT_CHECK_SECONDS
+    if index < len(rest) and not rest[index].startswith("/") and "@" not in rest[index]:
+        text = rest.pop(index)
+        try:
+            seconds = float(text)
+        except ValueError:
+            seconds = -1.0
+        if not seconds > 0:
+            msg = f"--check takes a number of seconds > 0 to listen for, not {text!r}"
+            raise UsageError(msg, f"argument '{CHECK_OPTION} {text}'")
+    return seconds, rest
+
+
+def collect_sources(node: Node, cli: ParseResult, params: dict[str, Any]) -> list[ParseResult]:
+    """Every configuration source, its problems reported."""
     sources = [cli]
     if params["config_file"]:
         sources.append(expand_if(read_yaml_file(params["config_file"]), node, params))
@@ -179,6 +211,31 @@ def build_bridge(node: Node, cli: ParseResult, params: dict[str, Any]) -> Bridge
         )
     for source in sources:
         report(node, source)
+    return sources
+
+
+def check(node: Node, cli: ParseResult, params: dict[str, Any], seconds: float) -> int:
+    """``--check``: report on every entry without bridging (see :mod:`ros_gz_bridge_py.check`)."""
+    sources = collect_sources(node, cli, params)
+    specs = [spec for source in sources for spec in source.specs]
+    errors = sum(len(source.errors) for source in sources)
+    if not specs and not errors:
+        print("parameter_bridge --check: no entries to check (give topics or config_file)")
+        return USAGE_EXIT
+    options = NodeOptions(implementation=params["gz_transport_implementation"] or None)
+    executor = make_executor()
+    executor.add_node(node)
+    with create_node(options) as gz_node:
+        sides = Sides(node, gz_node, default_registry())
+        status = run_check(sides, specs, seconds, out=sys.stdout, spin_once=executor.spin_once)
+    if errors:
+        print(f"{errors} configuration entries could not be read (see the errors above)")
+    return 1 if errors else status
+
+
+def build_bridge(node: Node, cli: ParseResult, params: dict[str, Any]) -> Bridge:
+    """Collect every configuration source, report its problems, and create the bridges."""
+    sources = collect_sources(node, cli, params)
     try:
         gz_version = check_gz_version(params["gz_version"])
     except ConfigError as err:

@@ -7,8 +7,12 @@ errors of the period since the tracker's previous snapshot. Each consumer has it
 so the ``/diagnostics`` publisher and the table printed on SIGUSR1 never shorten each other's
 periods.
 
-Levels: STALE for a lazy channel whose input side is closed (nobody reads its output), WARN when
-conversion errors, queue drops or failed service calls happened in the period, OK otherwise.
+Each channel also shows its flow state (waiting for Gazebo, waiting for ROS, flowing, stalled)
+and, when something keeps it from carrying messages, why (``explain.py``).
+
+Levels: WARN when the channel has a cause to explain, or when conversion errors, queue drops or
+failed service calls happened in the period; STALE for a lazy channel whose input side is closed
+(nobody reads its output); OK otherwise.
 
 :func:`serve` is how both executables run a built bridge: spinning, with the table on SIGUSR1.
 """
@@ -67,6 +71,10 @@ class ChannelStatus:
     #: Errors plus drops during the period.
     new_problems: int
     last_error: str = ""
+    #: The explainer's flow state ("" before its first evaluation, and for services).
+    flow: str = ""
+    #: Why the channel carries nothing, one cause per line ("" when nothing is wrong).
+    why: str = ""
 
     @property
     def name(self) -> str:
@@ -74,10 +82,10 @@ class ChannelStatus:
 
     @property
     def level(self) -> bytes:
+        if self.why or self.new_problems:
+            return WARN
         if self.state == ChannelState.LAZY_IDLE.value:
             return STALE
-        if self.new_problems:
-            return WARN
         return OK
 
     @property
@@ -85,6 +93,8 @@ class ChannelStatus:
         return _LEVEL_NAMES[self.level]
 
     def message(self) -> str:
+        if self.why:
+            return f"{self.flow}: {self.why}"
         if self.level == STALE:
             return "lazy: no subscribers, input side closed"
         if self.level == WARN:
@@ -107,6 +117,8 @@ class ChannelStatus:
             "dropped": str(self.dropped),
             "rate_hz": f"{self.rate:.2f}",
             "last_error": self.last_error,
+            "flow": self.flow,
+            "why": self.why,
         }
 
 
@@ -169,6 +181,8 @@ def channel_status(channel: Channel) -> ChannelStatus:
         rate=0.0,
         new_problems=0,
         last_error=stats.last_error,
+        flow=channel.flow.value if channel.flow is not None else "",
+        why="\n".join(finding.text for finding in channel.findings),
     )
 
 
@@ -216,6 +230,7 @@ _COLUMNS = (
     ("ERRORS", lambda s: str(s.errors)),
     ("DROPPED", lambda s: str(s.dropped)),
     ("RATE/s", lambda s: f"{s.rate:.1f}"),
+    ("FLOW", lambda s: s.flow),
 )
 
 
@@ -230,6 +245,10 @@ def format_table(statuses: list[ChannelStatus]) -> str:
     ]
     if not statuses:
         lines.append("(no bridges)")
+    for status in statuses:
+        lines += [
+            f"why {status.direction} {status.ros_name}: {why}" for why in status.why.splitlines()
+        ]
     return "\n".join(lines)
 
 

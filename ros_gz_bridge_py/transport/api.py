@@ -75,6 +75,33 @@ class TopicInfo:
     response_type: str = ""
 
 
+@dataclass(frozen=True, slots=True)
+class GraphEndpoint:
+    """A publisher or subscriber of a topic that discovery saw, in any partition.
+
+    What explanations and ``parameter_bridge --check`` tell a user about the Gazebo side.
+    """
+
+    #: ``"publisher"`` or ``"subscriber"``.
+    role: str
+    #: The partition as users write it (no leading ``/``).
+    partition: str
+    #: The topic name without the partition, e.g. ``/cmd_vel``.
+    topic: str
+    #: The type name, or ``""`` where the protocol does not tell (the subscribers of
+    #: gz-transport 11/12 processes, which announce only the topic).
+    msg_type: str
+    process_uuid: str
+    #: Where the endpoint lives: a ZeroMQ address, a host, or ``""``.
+    location: str
+    #: A subscriber that registered with one of our publishers of this topic.
+    registered: bool = False
+
+
+PUBLISHER = "publisher"
+SUBSCRIBER = "subscriber"
+
+
 @dataclass
 class TransportStats:
     """Counters of a node; every bad input from the network lands in one of them."""
@@ -333,6 +360,24 @@ class Node(abc.ABC):
     @abc.abstractmethod
     def service_info(self, service: str) -> list[TopicInfo]:
         """Providers of ``service``."""
+
+    @abc.abstractmethod
+    def observe(self, topic: str) -> list[GraphEndpoint]:
+        """Every publisher and subscriber of ``topic`` (resolved as our own would be) that
+        other processes have, in every partition discovery reaches."""
+
+    @abc.abstractmethod
+    def peer_processes(self) -> int:
+        """How many other Gazebo Transport processes this node hears."""
+
+    @abc.abstractmethod
+    def listening(self) -> str:
+        """Where this node looks for peers (backend, partition, addresses), for users."""
+
+    @abc.abstractmethod
+    def ask_subscribers(self) -> None:
+        """Ask peers to list their subscriptions where the protocol can (ZeroMQ, when every
+        peer is gz-transport 13 or later); the answers show in :meth:`observe`."""
 
     @abc.abstractmethod
     def wait_for_publishers(

@@ -112,8 +112,10 @@ class DiscoveryEngine:
         self._activity: dict[str, float] = {}
         # topic -> {(process, node): the type names it registered for}
         self._subscribers: dict[str, dict[tuple[str, str], frozenset[str]]] = {}
-        # topic -> process -> when it last sent SUBSCRIBE for it
-        self._subscribe_seen: dict[str, dict[str, float]] = {}
+        # topic -> process -> (source IP) of its SUBSCRIBE, for explanations
+        self._subscribe_seen: dict[str, dict[str, str]] = {}
+        # topic -> (process, node) -> the record of a SUBSCRIBERS_REP (gz-transport 13+)
+        self._listed: dict[str, dict[tuple[str, str], PublisherRecord]] = {}
         #: What each peer process calls its message types (docs/protocol.md §9).
         self.spellings = PeerSpellings(legacy_spelling)
         self._next_heartbeat = now
@@ -143,9 +145,18 @@ class DiscoveryEngine:
             for (process, node), types in self._subscribers.get(topic, {}).items()
         )
 
-    def subscribe_sightings(self) -> dict[str, dict[str, float]]:
-        """FQN -> process -> when that process last sent SUBSCRIBE for it (any partition)."""
+    def subscribe_sightings(self) -> dict[str, dict[str, str]]:
+        """FQN -> process -> source IP, for every SUBSCRIBE heard (any partition)."""
         return {topic: dict(seen) for topic, seen in self._subscribe_seen.items()}
+
+    def listed_subscribers(self) -> list[PublisherRecord]:
+        """The subscriptions peers listed in SUBSCRIBERS_REP (gz-transport 13+, any partition)."""
+        return [record for by_node in self._listed.values() for record in by_node.values()]
+
+    def subscribers_request(self) -> list[Outgoing]:
+        """SUBSCRIBERS_REQ: ask gz-transport 13+ peers to list their subscriptions (11 and 12
+        print an error for it, so send it only when every peer is newer)."""
+        return self._send(DiscoveryType.SUBSCRIBERS_REQ)
 
     def processes(self) -> list[str]:
         """Every peer process heard from and not yet expired."""
@@ -311,6 +322,11 @@ class DiscoveryEngine:
             self.spellings.saw_heartbeat(message.process_uuid, message.pub is not None)
             return [], []
         if kind == DiscoveryType.SUBSCRIBERS_REP:
+            pub = message.pub
+            if pub is not None and pub.topic:
+                key = (pub.process_uuid, pub.node_uuid)
+                self._listed.setdefault(pub.topic, {})[key] = pub
+                self.spellings.saw_type(pub.process_uuid, pub.msg_type)
             return [], []
         if kind == DiscoveryType.BYE:
             return [], self._forget_process(message.process_uuid)
@@ -319,7 +335,7 @@ class DiscoveryEngine:
                 msg = "SUBSCRIBE without a topic"
                 raise RemoteProtocolError(msg)
             seen = self._subscribe_seen.setdefault(message.topic, {})
-            seen[message.process_uuid] = now
+            seen[message.process_uuid] = source_ip
             return self._answer_subscribe(message.topic, source_ip), []
         if kind == DiscoveryType.SUBSCRIBERS_REQ:
             out: list[Outgoing] = []
@@ -386,6 +402,12 @@ class DiscoveryEngine:
             self._subscribe_seen[topic].pop(process, None)
             if not self._subscribe_seen[topic]:
                 del self._subscribe_seen[topic]
+        for topic in list(self._listed):
+            by_node = self._listed[topic]
+            for key in [key for key in by_node if key[0] == process]:
+                del by_node[key]
+            if not by_node:
+                del self._listed[topic]
         events: list[Event] = []
         for topic in list(self._remote):
             records = self._remote[topic].pop(process, [])

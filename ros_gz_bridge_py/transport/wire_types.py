@@ -64,6 +64,9 @@ class PeerSpellings:
         self.version = 0
         self._typed: dict[str, set[Spelling]] = {}
         self._by_heartbeat: dict[str, Spelling] = {}
+        #: Processes whose heartbeats carry a record (gz-transport 13+), and those without.
+        self.modern: set[str] = set()
+        self.legacy_processes: set[str] = set()
 
     def saw_type(self, process_uuid: str, type_name: str) -> None:
         """Note a type name ``process_uuid`` advertised or subscribed."""
@@ -77,12 +80,15 @@ class PeerSpellings:
         """Note a ZeroMQ heartbeat, with or without a publisher record in it."""
         before = self.of(process_uuid)
         self._by_heartbeat[process_uuid] = Spelling.GZ if with_record else self.legacy
+        (self.modern if with_record else self.legacy_processes).add(process_uuid)
         self._changed(before, process_uuid)
 
     def forget(self, process_uuid: str) -> None:
         before = self.of(process_uuid)
         self._typed.pop(process_uuid, None)
         self._by_heartbeat.pop(process_uuid, None)
+        self.modern.discard(process_uuid)
+        self.legacy_processes.discard(process_uuid)
         self._changed(before, process_uuid)
 
     def _changed(self, before: Spelling | None, process_uuid: str) -> None:

@@ -51,6 +51,9 @@ from ros_gz_bridge_py.errors import LocalProtocolError, TransportError
 from ros_gz_bridge_py.msgs.names import Spelling, canonical_type, same_message
 from ros_gz_bridge_py.transport.api import (
     ONE_WAY_TYPES,
+    PUBLISHER,
+    SUBSCRIBER,
+    GraphEndpoint,
     MessageInfo,
     Node,
     ReplyCallback,
@@ -100,6 +103,24 @@ class _Call(ServiceCall):
             and same_message(token.request_type, self.request_type)
             and same_message(token.response_type, self.response_type)
         )
+
+
+def _describe_session(config: zenoh.Config) -> str:
+    """``Zenoh peer, connect [...], listen [...], multicast scouting on`` for users."""
+
+    def value(key: str) -> str:
+        try:
+            return str(config.get_json(key))
+        except zenoh.ZError:
+            return "?"
+
+    mode = value("mode").strip('"')
+    mode = "peer" if mode in ("null", "?") else mode
+    scouting = "off" if value("scouting/multicast/enabled") == "false" else "on"
+    return (
+        f"Zenoh {mode}, connect {value('connect/endpoints')}, listen "
+        f"{value('listen/endpoints')}, multicast scouting {scouting}"
+    )
 
 
 def _offer_key(fqn: str, request_type: str, response_type: str) -> tuple[str, str, str]:
@@ -155,8 +176,10 @@ class ZenohNode(Node):
         self._calls: list[_Call] = []
         self._local_calls: collections.deque[_Call] = collections.deque()
         self._closed = False
+        chosen = session_config(config, config_overrides)
+        self._where = _describe_session(chosen)
         try:
-            self._session = zenoh.open(session_config(config, config_overrides))
+            self._session = zenoh.open(chosen)
         except zenoh.ZError as error:
             msg = f"cannot open the Zenoh session: {error}"
             raise TransportError(msg) from error
@@ -587,6 +610,32 @@ class ZenohNode(Node):
     def service_info(self, service: str) -> list[TopicInfo]:
         """Providers of ``service``; ``msg_type`` is ``"<request type>&<response type>"``."""
         return self._infos(EntityKind.SERVICE, service)
+
+    def observe(self, topic: str) -> list[GraphEndpoint]:
+        """Publishers (MP) and subscribers (MS) of ``topic`` in other processes, from their
+        liveliness tokens, in every partition."""
+        name = (decompose(self._fqn(topic)) or ("", topic))[1]
+        roles: dict[str, str] = {EntityKind.PUBLISHER: PUBLISHER, EntityKind.SUBSCRIBER: SUBSCRIBER}
+        with self._lock:
+            tokens = list(self._graph.values())
+        return [
+            GraphEndpoint(roles[t.kind], t.partition.removeprefix("/"), name, t.msg_type,
+                          t.process_uuid, "")
+            for t in tokens
+            if t.kind in roles and t.topic == name and t.process_uuid != self.process_uuid
+        ]  # fmt: skip
+
+    def ask_subscribers(self) -> None:
+        """Nothing to ask: subscription tokens carry their types."""
+
+    def peer_processes(self) -> int:
+        """Other processes holding liveliness tokens."""
+        with self._lock:
+            return len({t.process_uuid for t in self._graph.values()} - {self.process_uuid})
+
+    def listening(self) -> str:
+        """The session's mode and endpoints, and the partition."""
+        return f"{self._where}, partition '{self.partition}'"
 
     def wait_for_publishers(
         self, topic: str, timeout: float, msg_type: str | None = None

@@ -44,8 +44,11 @@ from typing import Any, TypeVar
 import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError
-from ros_gz_bridge_py.msgs.names import spellings
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, spellings
 from ros_gz_bridge_py.transport.api import (
+    PUBLISHER,
+    SUBSCRIBER,
+    GraphEndpoint,
     MessageInfo,
     Node,
     ReplyCallback,
@@ -564,6 +567,77 @@ class ZmqNode(Node):
         """Providers of ``service``; ``msg_type`` is ``"<request type>&<response type>"``."""
         self._wait_for_init()
         return self._call(lambda: self._infos(self._srv, service))
+
+    def observe(self, topic: str) -> list[GraphEndpoint]:
+        """Publishers (ADVERTISE) and subscribers (SUBSCRIBE, SUBSCRIBERS_REP, NEW_CONNECTION
+        to our publishers) of ``topic`` in other processes, in every partition."""
+        fqn = self._fqn(topic)
+        return self._call(lambda: self._observe(fqn))
+
+    def _observe(self, fqn: str) -> list[GraphEndpoint]:
+        own_partition, name = decompose(fqn) or ("", fqn)
+
+        def partition_of(other: str) -> str | None:
+            parts = decompose(other)
+            return parts[0].removeprefix("/") if parts is not None and parts[1] == name else None
+
+        found = [
+            GraphEndpoint(PUBLISHER, partition, name, record.msg_type, record.process_uuid,
+                          record.address)
+            for record in self._msg.all_publishers()
+            if record.msg is not None
+            and record.process_uuid != self.process_uuid
+            and (partition := partition_of(record.topic)) is not None
+        ]  # fmt: skip
+        # Per (partition, process), the best we know: SUBSCRIBE (no type), then a listing
+        # (its type), then a registration with our publisher (the spellings it took).
+        subscribers: dict[tuple[str, str], GraphEndpoint] = {}
+        for topic, seen in self._msg.subscribe_sightings().items():
+            if (partition := partition_of(topic)) is not None:
+                for process, ip in seen.items():
+                    subscribers[partition, process] = GraphEndpoint(
+                        SUBSCRIBER, partition, name, "", process, ip
+                    )
+        for record in self._msg.listed_subscribers():
+            if (partition := partition_of(record.topic)) is not None:
+                subscribers[partition, record.process_uuid] = GraphEndpoint(
+                    SUBSCRIBER, partition, name, record.msg_type, record.process_uuid,
+                    record.address,
+                )  # fmt: skip
+        own_partition = own_partition.removeprefix("/")
+        for remote in self._msg.remote_subscribers(fqn):
+            msg_type = next(iter(remote.types)) if len(remote.types) == 1 else GENERIC_TYPE
+            known = subscribers.get((own_partition, remote.process_uuid))
+            subscribers[own_partition, remote.process_uuid] = GraphEndpoint(
+                SUBSCRIBER, own_partition, name, msg_type, remote.process_uuid,
+                known.location if known else "", registered=True,
+            )  # fmt: skip
+        found += [sub for sub in subscribers.values() if sub.process_uuid != self.process_uuid]
+        return found
+
+    def peer_processes(self) -> int:
+        """Other processes heard on either discovery port and not yet expired."""
+        return self._call(lambda: len({*self._msg.processes(), *self._srv.processes()}))
+
+    def listening(self) -> str:
+        """Backend, partition, discovery group and ports, the interface and any relays."""
+        relays = f", relays {', '.join(self.settings.relays)}" if self.settings.relays else ""
+        return (
+            f"ZeroMQ discovery on {self.settings.multicast_ip} ports {self.settings.msg_port} "
+            f"(topics) and {self.settings.srv_port} (services) via {self.host}{relays}, "
+            f"partition '{self.partition}'"
+        )
+
+    def ask_subscribers(self) -> None:
+        """SUBSCRIBERS_REQ, if every peer is gz-transport 13+ (11/12 print an error for it)."""
+
+        def command() -> None:
+            spellings = self._msg.spellings
+            if spellings.modern and not spellings.legacy_processes:
+                self._send(self._msg_udp, self._msg.subscribers_request())
+
+        with contextlib.suppress(TransportError):
+            self._post(command)
 
     def wait_for_publishers(
         self, topic: str, timeout: float, msg_type: str | None = None

@@ -1,0 +1,212 @@
+"""``parameter_bridge --check``: would each configured entry carry messages, and if not, why.
+
+It takes the same arguments, ``--ros-args`` and configuration as a normal run, bridges nothing,
+listens to Gazebo discovery (every partition) and the ROS graph for a few seconds, and prints
+per entry what each side shows and the fix for every cause that keeps it from working
+(``diagnosis.py``). ROS->Gazebo entries are announced to Gazebo (nothing is published), so that
+Gazebo subscribers show whether they take the type. Exit status 1 when an entry cannot work.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, TextIO
+
+from rclpy.qos import QoSProfile
+
+from ros_gz_bridge_py.config import BridgeSpec, Direction, ServiceBridgeSpec, TopicBridgeSpec
+from ros_gz_bridge_py.converters.registry import Registry
+from ros_gz_bridge_py.diagnosis import Finding, RosEndpoint, Situation, findings
+from ros_gz_bridge_py.errors import ConfigError, UnsupportedTypeError
+from ros_gz_bridge_py.explain import gazebo_name, ros_endpoints, type_hints
+from ros_gz_bridge_py.msgs.names import same_message
+from ros_gz_bridge_py.qos import endpoint_qos, gz_to_ros_publisher_qos
+from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import Publisher
+from ros_gz_bridge_py.transport.api import GraphEndpoint
+
+#: Seconds ``--check`` listens by default: discovery re-announces every second, the ROS graph
+#: settles within about two.
+DEFAULT_SECONDS = 5.0
+#: Step of the ROS spinning while listening.
+_SPIN_STEP = 0.1
+
+
+@dataclass(frozen=True)
+class Sides:
+    """The two ends the check looks at, and the converter registry for the fixes."""
+
+    ros_node: Any
+    gz_node: GzNode
+    registry: Registry
+
+
+@dataclass(frozen=True)
+class EntryReport:
+    """What ``--check`` found for one direction of one entry (or a service entry)."""
+
+    title: str
+    seen: tuple[str, ...]
+    problems: tuple[str, ...]
+
+
+def run_check(
+    sides: Sides, specs: Sequence[BridgeSpec], seconds: float, *, out: TextIO, spin_once: Any
+) -> int:
+    """Listen for ``seconds`` (spinning the ROS node with ``spin_once``), then print one
+    report per entry to ``out``; 1 if any cannot work."""
+    gz_node = sides.gz_node
+    probes: dict[int, Publisher] = {}
+    for index, spec in enumerate(specs):
+        if isinstance(spec, TopicBridgeSpec) and spec.direction is not Direction.GZ_TO_ROS:
+            try:
+                probes[index] = gz_node.advertise(spec.gz_topic, spec.gz_type)
+            except Exception as err:  # a bad name: reported with the entry below
+                print(f"cannot announce {spec.gz_topic}: {err}", file=out)
+    print(
+        f"Listening for {seconds:g} s: Gazebo ({gz_node.listening()}) and the ROS graph ...",
+        file=out,
+        flush=True,
+    )
+    deadline = time.monotonic() + seconds
+    asked = False
+    while time.monotonic() < deadline:
+        spin_once(timeout_sec=_SPIN_STEP)
+        if not asked and time.monotonic() > deadline - seconds / 2:
+            gz_node.ask_subscribers()
+            asked = True
+    reports: list[EntryReport] = []
+    for index, spec in enumerate(specs):
+        if isinstance(spec, ServiceBridgeSpec):
+            reports.append(_service_report(gz_node, sides.registry, spec))
+        else:
+            reports += _topic_reports(sides, spec, probes.get(index))
+    for probe in probes.values():
+        probe.close()
+    for report in reports:
+        _print_report(report, out)
+    failing = sum(1 for report in reports if report.problems)
+    print(
+        f"{len(reports) - failing} of {len(reports)} checked can carry messages"
+        + (f"; {failing} cannot (see PROBLEM lines)" if failing else ""),
+        file=out,
+    )
+    return 1 if failing else 0
+
+
+def _print_report(report: EntryReport, out: TextIO) -> None:
+    print(report.title, file=out)
+    for line in report.seen:
+        print(f"  {line}", file=out)
+    for problem in report.problems:
+        print(f"  PROBLEM: {problem}", file=out)
+    if not report.problems:
+        print("  ok: messages can flow", file=out)
+
+
+def _topic_reports(
+    sides: Sides, spec: TopicBridgeSpec, probe: Publisher | None
+) -> list[EntryReport]:
+    ros_node, gz_node, registry = sides.ros_node, sides.gz_node, sides.registry
+    own = {(ros_node.get_name(), ros_node.get_namespace())}
+    where = f" ({spec.source})" if spec.source else ""
+    try:
+        registry.layouts(spec.ros_type, spec.gz_type)
+    except UnsupportedTypeError as err:
+        title = f"{spec.ros_topic} <-> {spec.gz_topic}{where}"
+        return [EntryReport(title, (), (str(err.message),))]
+    directions = [
+        d
+        for d in (Direction.GZ_TO_ROS, Direction.ROS_TO_GZ)
+        if spec.direction in (d, Direction.BIDIRECTIONAL)
+    ]
+    ros_topic = str(ros_node.resolve_topic_name(spec.ros_topic))
+    partition, name = gazebo_name(gz_node, spec.gz_topic)
+    gz_endpoints = gz_node.observe(spec.gz_topic)
+    reports = []
+    for direction in directions:
+        qos = _entry_qos(spec, direction, ros_topic)
+        ros_side = ros_endpoints(ros_node, direction, ros_topic, qos, own)
+        situation = Situation(
+            direction=direction,
+            ros_topic=ros_topic,
+            ros_type=spec.ros_type,
+            gz_topic=name,
+            gz_type=spec.gz_type,
+            partition=partition,
+            gz_endpoints=gz_endpoints,
+            ros_endpoints=ros_side,
+            gz_peers=gz_node.peer_processes(),
+            listening=gz_node.listening(),
+            gz_subscriber_registered=probe is not None and bool(probe.wire_types()),
+            gz_topics=gz_node.topic_list(),
+        )
+        arrow = (
+            f"Gazebo {name} ({spec.gz_type}) -> ROS {ros_topic} ({spec.ros_type})"
+            if direction is Direction.GZ_TO_ROS
+            else f"ROS {ros_topic} ({spec.ros_type}) -> Gazebo {name} ({spec.gz_type})"
+        )
+        found: list[Finding] = findings(situation, type_hints(registry))
+        seen = (
+            *_gazebo_lines(situation, direction),
+            *_ros_lines(ros_side, direction),
+        )
+        reports.append(EntryReport(f"{arrow}{where}", seen, tuple(f.text for f in found)))
+    return reports
+
+
+def _entry_qos(spec: TopicBridgeSpec, direction: Direction, ros_topic: str) -> QoSProfile:
+    if direction is Direction.GZ_TO_ROS:
+        return gz_to_ros_publisher_qos(ros_topic, spec.qos_profile, spec.publisher_queue)
+    return endpoint_qos(spec.qos_profile, spec.subscriber_queue)
+
+
+def _gazebo_lines(situation: Situation, direction: Direction) -> list[str]:
+    role = "publisher" if direction is Direction.GZ_TO_ROS else "subscriber"
+    relevant = [e for e in situation.gz_endpoints if e.role == role]
+    if not relevant:
+        return [f"Gazebo: no {role} of {situation.gz_topic} in any partition"]
+    return [f"Gazebo: {_describe_gz(e)}" for e in relevant]
+
+
+def _describe_gz(endpoint: GraphEndpoint) -> str:
+    kind = endpoint.msg_type or "type not announced"
+    taken = ", takes ours" if endpoint.registered else ""
+    where = f" at {endpoint.location}" if endpoint.location else ""
+    return (
+        f"{endpoint.role} ({kind}{taken}), partition '{endpoint.partition}', "
+        f"process {endpoint.process_uuid[:8]}{where}"
+    )
+
+
+def _ros_lines(endpoints: Sequence[RosEndpoint], direction: Direction) -> list[str]:
+    role = "subscriber" if direction is Direction.GZ_TO_ROS else "publisher"
+    if not endpoints:
+        return [f"ROS:    no {role} yet"]
+    return [f"ROS:    {role} {e.node} ({e.msg_type}, {e.qos})" for e in endpoints]
+
+
+def _service_report(gz_node: GzNode, registry: Registry, spec: ServiceBridgeSpec) -> EntryReport:
+    where = f" ({spec.source})" if spec.source else ""
+    title = f"service {spec.service} ({spec.ros_type}){where}"
+    try:
+        pair = registry.get_service(spec.ros_type)
+    except ConfigError as err:
+        return EntryReport(title, (), (str(err.message),))
+    request = spec.gz_req_type or pair.gz_req_type
+    response = spec.gz_rep_type or pair.gz_rep_type
+    providers = gz_node.service_info(spec.service)
+    seen = tuple(f"Gazebo: provider of {p.request_type} -> {p.response_type}" for p in providers)
+    if any(
+        same_message(p.request_type, request) and same_message(p.response_type, response)
+        for p in providers
+    ):
+        return EntryReport(title, seen, ())
+    problem = (
+        f"no Gazebo provider of {spec.service} with {request} -> {response} in partition "
+        f"'{getattr(gz_node, 'partition', '')}'; calls are answered success=false until one "
+        "appears"
+    )
+    return EntryReport(title, seen or ("Gazebo: no provider",), (problem,))

@@ -1,0 +1,303 @@
+"""Why a topic carries nothing: a channel's flow state and the causes, in words to act on.
+
+"The topics appear but no data comes" is the most common support question about the C++
+bridge: a wrong type, a wrong partition, another Gazebo line, incompatible QoS, and the bridge
+says nothing. Here the facts about one channel (what discovery and the ROS graph show, its own
+counters) go in as a :class:`Situation`; its :class:`Flow` and the :class:`Finding` for each
+cause come out, each naming the topic, what was expected, what was seen, and the fix. Pure
+functions: the bridge gathers the facts (``explain.py``) and decides what to log.
+"""
+
+from __future__ import annotations
+
+import difflib
+import enum
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from ros_gz_bridge_py.config import Direction
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling, respell, same_message, spelling_of
+from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER, GraphEndpoint
+
+#: A channel that passed a message this recently is flowing (at least; see :func:`flow`).
+FLOWING_WINDOW = 5.0
+#: How many similar Gazebo topic names a finding suggests.
+SUGGESTIONS = 3
+
+
+class Flow(enum.Enum):
+    """What a channel is doing, as users see it."""
+
+    WAITING_GAZEBO = "waiting for Gazebo"
+    WAITING_ROS = "waiting for ROS"
+    FLOWING = "flowing"
+    STALLED = "stalled"
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One reason a channel carries nothing (or carries to nobody)."""
+
+    #: Stable while the cause lasts: what "once per cause" is counted by.
+    key: str
+    text: str
+
+
+@dataclass(frozen=True)
+class RosEndpoint:
+    """A ROS publisher or subscriber at the other end of a channel (not the bridge's own)."""
+
+    node: str
+    msg_type: str
+    #: Why its QoS cannot match the bridge's ("" when it can).
+    qos_problem: str = ""
+    #: Its QoS in a few words ("reliable, volatile, depth 10").
+    qos: str = ""
+
+
+@dataclass(frozen=True)
+class TypeHints:
+    """What the converter registry says about types, for the fixes a finding proposes."""
+
+    #: (ROS type, Gazebo type) -> True when a pair converts them.
+    pairs: Callable[[str, str], bool]
+    #: Gazebo type -> the ROS types it pairs with.
+    ros_types_for: Callable[[str], list[str]]
+    #: ROS type -> the Gazebo types it pairs with.
+    gz_types_for: Callable[[str], list[str]]
+
+
+@dataclass(frozen=True)
+class Situation:
+    """Everything known about one channel (or one ``--check`` entry) at one moment."""
+
+    direction: Direction
+    ros_topic: str
+    ros_type: str
+    #: The Gazebo topic name as discovery shows it (without the partition).
+    gz_topic: str
+    gz_type: str
+    partition: str
+    #: Every Gazebo endpoint of the topic in other processes, any partition.
+    gz_endpoints: Sequence[GraphEndpoint]
+    #: The ROS endpoints at the channel's other end: subscribers of a Gazebo->ROS channel,
+    #: publishers of a ROS->Gazebo one.
+    ros_endpoints: Sequence[RosEndpoint]
+    #: Other Gazebo Transport processes heard at all.
+    gz_peers: int
+    #: Where the bridge looks for them (backend, partition, addresses).
+    listening: str
+    #: A Gazebo subscriber takes our messages (ROS->Gazebo; from NEW_CONNECTION or tokens).
+    gz_subscriber_registered: bool = False
+    #: Topic names with publishers in our partition, for "did you mean".
+    gz_topics: Sequence[str] = ()
+    #: The channel's input side is open (a lazy channel without readers closes it).
+    input_open: bool = True
+    #: Seconds since the channel last passed a message; None if it never did.
+    since_message: float | None = None
+    #: The channel's usual time between messages, when known.
+    interval: float | None = None
+
+
+def flow(situation: Situation) -> Flow:
+    """The channel's state: flowing if it passed a message lately, else which side it waits
+    for (Gazebo first: nothing can come from ROS to a Gazebo side that is not there).
+
+    A channel whose Gazebo side is not there is waiting for it whatever it passed lately: a
+    ROS->Gazebo channel's messages go nowhere without a Gazebo subscriber that takes them, and
+    nothing more comes from a Gazebo publisher that left.
+    """
+    recent = max(FLOWING_WINDOW, 3 * (situation.interval or 0.0))
+    if not _gazebo_side_ready(situation):
+        return Flow.WAITING_GAZEBO
+    if situation.since_message is not None and situation.since_message <= recent:
+        return Flow.FLOWING
+    if not situation.input_open or not _ros_side_ready(situation):
+        return Flow.WAITING_ROS
+    return Flow.STALLED
+
+
+def findings(situation: Situation, hints: TypeHints) -> list[Finding]:
+    """Every cause that keeps ``situation``'s channel from carrying messages."""
+    found = [*_ros_findings(situation, hints)]
+    if not _gazebo_side_ready(situation):
+        found += _gazebo_findings(situation, hints)
+    return found
+
+
+# --- the Gazebo side -------------------------------------------------------------------------
+
+
+def _wanted_role(situation: Situation) -> str:
+    """The Gazebo endpoints a channel needs: publishers to read, or subscribers to write to."""
+    return PUBLISHER if situation.direction is Direction.GZ_TO_ROS else SUBSCRIBER
+
+
+def _takes_ours(endpoint: GraphEndpoint, gz_type: str) -> bool:
+    return (
+        endpoint.registered
+        or endpoint.msg_type == GENERIC_TYPE
+        or (bool(endpoint.msg_type) and same_message(endpoint.msg_type, gz_type))
+    )
+
+
+def _gazebo_side_ready(situation: Situation) -> bool:
+    if situation.direction is Direction.ROS_TO_GZ:
+        return situation.gz_subscriber_registered
+    return any(
+        e.role == PUBLISHER and e.partition == situation.partition
+        and same_message(e.msg_type, situation.gz_type)
+        for e in situation.gz_endpoints
+    )  # fmt: skip
+
+
+def _ros_side_ready(situation: Situation) -> bool:
+    """ROS->Gazebo needs a ROS publisher of the type; a Gazebo->ROS channel needs nothing."""
+    if situation.direction is Direction.GZ_TO_ROS:
+        return True
+    return any(e.msg_type == situation.ros_type for e in situation.ros_endpoints)
+
+
+def _where(endpoint: GraphEndpoint) -> str:
+    where = f"process {endpoint.process_uuid[:8]}"
+    return f"{where} at {endpoint.location}" if endpoint.location else where
+
+
+def _gazebo_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
+    role = _wanted_role(situation)
+    mine = [
+        e for e in situation.gz_endpoints if e.role == role and e.partition == situation.partition
+    ]
+    found = [_type_finding(situation, hints, e) for e in mine if _other_type(e, situation)]
+    if role == SUBSCRIBER:
+        found += [
+            _declined_finding(situation, e) for e in mine if not e.msg_type and not e.registered
+        ]
+    if mine:
+        return found
+    elsewhere = [e for e in situation.gz_endpoints if e.partition != situation.partition]
+    if elsewhere:
+        return [_partition_finding(situation, elsewhere)]
+    if situation.gz_peers == 0:
+        return [_no_peer_finding(situation)]
+    return [_absent_finding(situation, role)]
+
+
+def _other_type(endpoint: GraphEndpoint, situation: Situation) -> bool:
+    return bool(endpoint.msg_type) and not _takes_ours(endpoint, situation.gz_type)
+
+
+def _type_finding(situation: Situation, hints: TypeHints, endpoint: GraphEndpoint) -> Finding:
+    seen = endpoint.msg_type
+    verb = "publishes" if endpoint.role == PUBLISHER else "subscribes"
+    # Either spelling works; propose the one the configuration already uses.
+    written = respell(seen, spelling_of(situation.gz_type) or Spelling.GZ)
+    if hints.pairs(situation.ros_type, seen):
+        fix = f"set the Gazebo type (gz_type_name) to {written}"
+    else:
+        ros_types = hints.ros_types_for(seen)
+        fix = (
+            f"{written} pairs with {', '.join(ros_types)}: set the Gazebo type to {written} and "
+            "the ROS type to one of those"
+            if ros_types
+            else f"no converter takes {seen} (bridge_types --print-pairs lists the pairs)"
+        )
+    return Finding(
+        f"gz-type:{endpoint.role}:{seen}",
+        f"the Gazebo {endpoint.role} of {situation.gz_topic} ({_where(endpoint)}) {verb} "
+        f"{seen}, but the bridge is configured with {situation.gz_type}; {fix}",
+    )
+
+
+def _declined_finding(situation: Situation, endpoint: GraphEndpoint) -> Finding:
+    return Finding(
+        f"gz-declined:{endpoint.process_uuid}",
+        f"a Gazebo subscriber of {situation.gz_topic} ({_where(endpoint)}) did not take "
+        f"{situation.gz_type} under either spelling: it expects another message type; check "
+        f"the type of the system or plugin that subscribes (gz topic -i -t {situation.gz_topic} "
+        "on Harmonic and later shows it) and set the Gazebo type to it",
+    )
+
+
+def _partition_finding(situation: Situation, elsewhere: Sequence[GraphEndpoint]) -> Finding:
+    partitions = sorted({e.partition for e in elsewhere})
+    seen = "; ".join(
+        f"'{p}': "
+        + ", ".join(sorted({f"{e.role} {e.msg_type or '(type not announced)'}" for e in elsewhere
+                            if e.partition == p}))
+        for p in partitions
+    )  # fmt: skip
+    first = partitions[0]
+    return Finding(
+        f"partition:{','.join(partitions)}",
+        f"the Gazebo topic {situation.gz_topic} is alive in another partition ({seen}), but "
+        f"the bridge uses partition '{situation.partition}'; start the bridge with "
+        f"GZ_PARTITION={first} (and IGN_PARTITION={first} for Fortress), or give the "
+        "simulator the bridge's partition",
+    )
+
+
+def _no_peer_finding(situation: Situation) -> Finding:
+    return Finding(
+        "no-peer",
+        f"no Gazebo Transport process is heard at all; the bridge listens with "
+        f"{situation.listening}. Compare with the simulator's environment: the same "
+        "GZ_PARTITION (IGN_PARTITION on Fortress), GZ_IP/IGN_IP on a network both reach, and "
+        "the same GZ_TRANSPORT_IMPLEMENTATION (zeromq or zenoh)",
+    )
+
+
+def _absent_finding(situation: Situation, role: str) -> Finding:
+    similar = _similar_topics(situation.gz_topic, situation.gz_topics)
+    hint = f"; similar topics: {', '.join(similar)}" if similar else ""
+    return Finding(
+        f"gz-absent:{role}",
+        f"no Gazebo {role} of {situation.gz_topic} in partition '{situation.partition}' "
+        f"({situation.gz_peers} Gazebo processes heard){hint}",
+    )
+
+
+def _similar_topics(topic: str, topics: Sequence[str]) -> list[str]:
+    """Topics ending like ``topic`` (a relative name in the wrong place), then close spellings."""
+    tail = "/" + topic.strip("/").rsplit("/", 1)[-1]
+    ending = [t for t in topics if t != topic and t.endswith(tail)]
+    close = difflib.get_close_matches(topic, [t for t in topics if t != topic], SUGGESTIONS)
+    return list(dict.fromkeys(ending + close))[:SUGGESTIONS]
+
+
+# --- the ROS side ----------------------------------------------------------------------------
+
+
+def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
+    role = "subscriber" if situation.direction is Direction.GZ_TO_ROS else "publisher"
+    found = []
+    for endpoint in situation.ros_endpoints:
+        if endpoint.msg_type != situation.ros_type:
+            others = hints.gz_types_for(endpoint.msg_type)
+            if hints.pairs(endpoint.msg_type, situation.gz_type):
+                fix = f"set the ROS type (ros_type_name) to {endpoint.msg_type}"
+            elif others:
+                fix = (
+                    f"{endpoint.msg_type} pairs with {', '.join(others)}: set the ROS and "
+                    "Gazebo types to such a pair"
+                )
+            else:
+                fix = f"no converter takes {endpoint.msg_type}"
+            found.append(
+                Finding(
+                    f"ros-type:{endpoint.node}:{endpoint.msg_type}",
+                    f"the ROS {role} {endpoint.node} of {situation.ros_topic} uses "
+                    f"{endpoint.msg_type}, but the bridge is configured with "
+                    f"{situation.ros_type}; {fix}",
+                )
+            )
+        elif endpoint.qos_problem:
+            found.append(
+                Finding(
+                    f"ros-qos:{endpoint.node}",
+                    f"the ROS {role} {endpoint.node} of {situation.ros_topic} cannot match the "
+                    f"bridge's QoS: {endpoint.qos_problem}; set the entry's qos_profile (or "
+                    f"qos_overrides.{situation.ros_topic}.*) to what it uses",
+                )
+            )
+    return found

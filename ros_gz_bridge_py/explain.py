@@ -1,0 +1,242 @@
+"""The bridge explains its channels: gathers what discovery and the ROS graph show, sets each
+channel's flow state and causes (``diagnosis.py``), and logs each cause once.
+
+A cause is logged once it has lasted two evaluations (discovery needs a moment to see
+everything), at most once a minute while it comes and goes, and again only after it went
+away. "No Gazebo peer at all" concerns every channel, so it is said once for the bridge.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from rclpy.duration import Infinite
+from rclpy.qos import LivelinessPolicy, QoSCompatibility, QoSProfile, qos_check_compatible
+
+from ros_gz_bridge_py.channel import Channel, ChannelState, RosToGzChannel
+from ros_gz_bridge_py.config import Direction
+from ros_gz_bridge_py.converters.registry import Registry
+from ros_gz_bridge_py.diagnosis import (
+    Finding,
+    RosEndpoint,
+    Situation,
+    TypeHints,
+    findings,
+    flow,
+)
+from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
+
+#: Seconds between two evaluations of every channel.
+EXPLAIN_PERIOD = 2.0
+#: A channel is not judged before it is this old: discovery hears every peer within ~3 s.
+WARM_UP = 3.0
+#: A cause is logged once it was seen in two evaluations, this far apart at least.
+CONFIRM_AFTER = EXPLAIN_PERIOD / 2
+#: A cause that went away and came back is logged again after this long at the earliest.
+RELOG_AFTER = 60.0
+#: How often the bridge may ask Gazebo peers to list their subscriptions.
+ASK_SUBSCRIBERS_EVERY = 10.0
+#: Causes that concern the whole bridge rather than one channel (logged once).
+BRIDGE_WIDE = frozenset({"no-peer"})
+
+
+def type_hints(registry: Registry) -> TypeHints:
+    """The registry's answers about types, as the findings' fixes need them."""
+    return TypeHints(
+        pairs=lambda ros_type, gz_type: registry.find(ros_type, gz_type) is not None,
+        ros_types_for=registry.ros_types_for,
+        gz_types_for=registry.gz_types_for,
+    )
+
+
+def ros_endpoints(
+    ros_node: Any,
+    direction: Direction,
+    ros_topic: str,
+    our_qos: QoSProfile,
+    own_nodes: Iterable[tuple[str, str]],
+) -> list[RosEndpoint]:
+    """The ROS endpoints at the far end of a channel: the subscribers a Gazebo->ROS channel
+    publishes to, or the publishers a ROS->Gazebo channel reads; the bridge's own left out."""
+    own = set(own_nodes)
+    to_ros = direction is Direction.GZ_TO_ROS
+    our_qos = as_the_graph_shows(our_qos)
+    infos = (
+        ros_node.get_subscriptions_info_by_topic(ros_topic)
+        if to_ros
+        else ros_node.get_publishers_info_by_topic(ros_topic)
+    )
+    found = []
+    for info in infos:
+        if (info.node_name, info.node_namespace) in own:
+            continue
+        namespace = info.node_namespace.rstrip("/")
+        node = f"{namespace}/{info.node_name}"
+        publisher, subscription = (
+            (our_qos, info.qos_profile) if to_ros else (info.qos_profile, our_qos)
+        )
+        compatibility, reason = qos_check_compatible(publisher, subscription)
+        problem = reason.strip() if compatibility == QoSCompatibility.ERROR else ""
+        found.append(RosEndpoint(node, info.topic_type, problem, describe_qos(info.qos_profile)))
+    return found
+
+
+def as_the_graph_shows(profile: QoSProfile) -> QoSProfile:
+    """``profile`` with its "default" durations and liveliness as the graph reports them for
+    a live endpoint (infinite, automatic); compared as they are, a default deadline reads as
+    "none" against an infinite one and every pair looks incompatible."""
+    shown = copy.copy(profile)
+    for name in ("deadline", "lifespan", "liveliness_lease_duration"):
+        if getattr(shown, name).nanoseconds == 0:
+            setattr(shown, name, Infinite)
+    if shown.liveliness == LivelinessPolicy.SYSTEM_DEFAULT:
+        shown.liveliness = LivelinessPolicy.AUTOMATIC
+    return shown
+
+
+def describe_qos(profile: QoSProfile) -> str:
+    """``reliable, volatile, depth 10`` (keep-all histories say so)."""
+    history = f"depth {profile.depth}" if profile.history.name == "KEEP_LAST" else "keep all"
+    return f"{profile.reliability.name.lower()}, {profile.durability.name.lower()}, {history}"
+
+
+def gazebo_name(gz_node: GzNode, topic: str) -> tuple[str, str]:
+    """(partition, topic name) as discovery shows ``topic`` of ``gz_node``."""
+    partition = getattr(gz_node, "partition", "")
+    namespace = getattr(gz_node, "namespace", "")
+    fqn = fully_qualified_name(partition, namespace, topic)
+    _, name = decompose(fqn) or ("", topic)
+    return partition, name
+
+
+@dataclass
+class _Seen:
+    """What the explainer remembers of one channel between evaluations."""
+
+    started: float
+    count: int = 0
+    changed: float | None = None
+    interval: float | None = None
+    #: Finding key -> when it was first seen in the current run of evaluations.
+    present: dict[str, float] = field(default_factory=dict)
+    #: Finding key -> when it was last logged.
+    logged: dict[str, float] = field(default_factory=dict)
+    #: Keys logged during their current presence.
+    announced: set[str] = field(default_factory=set)
+
+
+class Explainer:
+    """Evaluates channels and logs their causes; one per bridge."""
+
+    def __init__(
+        self,
+        gz_node: GzNode,
+        registry: Registry,
+        own_nodes: Iterable[tuple[str, str]],
+        log: Callable[[str], None],
+        now: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._gz = gz_node
+        self._hints = type_hints(registry)
+        self._own = frozenset(own_nodes)
+        self._log = log
+        self._now = now
+        self._seen: dict[int, _Seen] = {}
+        self._bridge_announced: set[str] = set()
+        self._asked = float("-inf")
+
+    def evaluate(self, channels: Sequence[Channel]) -> None:
+        """Set every channel's ``flow`` and ``findings``; log the causes that are new."""
+        now = self._now()
+        alive = {id(channel) for channel in channels}
+        self._seen = {key: seen for key, seen in self._seen.items() if key in alive}
+        if not channels:
+            return
+        self._bridge_announced &= {
+            f.key for channel in channels for f in channel.findings if f.key in BRIDGE_WIDE
+        }
+        peers = self._gz.peer_processes()
+        listening = self._gz.listening()
+        topics: list[str] | None = None
+        for channel in channels:
+            seen = self._seen.setdefault(id(channel), _Seen(now, channel.stats.received))
+            self._count(seen, channel, now)
+            situation = self._situation(channel, seen, now, peers, listening)
+            if (
+                situation.direction is Direction.ROS_TO_GZ
+                and not situation.gz_subscriber_registered
+            ):
+                self._ask_subscribers(now)
+            found = findings(situation, self._hints)
+            if any(f.key.startswith("gz-absent") for f in found):
+                topics = self._gz.topic_list() if topics is None else topics
+                situation = dataclasses.replace(situation, gz_topics=topics)
+                found = findings(situation, self._hints)
+            channel.flow = flow(situation)
+            channel.findings = found
+            if now - seen.started >= WARM_UP:
+                self._report(channel, seen, found, now)
+
+    def _count(self, seen: _Seen, channel: Channel, now: float) -> None:
+        count = channel.stats.received
+        if count != seen.count:
+            if seen.changed is not None:
+                seen.interval = (now - seen.changed) / (count - seen.count)
+            seen.count, seen.changed = count, now
+
+    def _situation(
+        self, channel: Channel, seen: _Seen, now: float, peers: int, listening: str
+    ) -> Situation:
+        spec = channel.spec
+        partition, name = gazebo_name(self._gz, spec.gz_topic)
+        registered = isinstance(channel, RosToGzChannel) and channel.gazebo_subscribed()
+        return Situation(
+            direction=channel.direction,
+            ros_topic=channel.ros_topic,
+            ros_type=spec.ros_type,
+            gz_topic=name,
+            gz_type=spec.gz_type,
+            partition=partition,
+            gz_endpoints=self._gz.observe(spec.gz_topic),
+            ros_endpoints=ros_endpoints(
+                channel.ctx.ros_node, channel.direction, channel.ros_topic, channel.qos, self._own
+            ),
+            gz_peers=peers,
+            listening=listening,
+            gz_subscriber_registered=registered,
+            input_open=channel.state is ChannelState.ACTIVE,
+            since_message=None if seen.changed is None else now - seen.changed,
+            interval=seen.interval,
+        )
+
+    def _ask_subscribers(self, now: float) -> None:
+        if now - self._asked >= ASK_SUBSCRIBERS_EVERY:
+            self._asked = now
+            self._gz.ask_subscribers()
+
+    def _report(self, channel: Channel, seen: _Seen, found: list[Finding], now: float) -> None:
+        keys = {finding.key for finding in found}
+        seen.present = {key: seen.present.get(key, now) for key in keys}
+        seen.announced &= keys
+        for finding in found:
+            key = finding.key
+            if key in seen.announced or now - seen.present[key] < CONFIRM_AFTER:
+                continue
+            if key in BRIDGE_WIDE:
+                seen.announced.add(key)
+                if key not in self._bridge_announced:
+                    self._bridge_announced.add(key)
+                    self._log(f"Nothing can flow: {finding.text}")
+                continue
+            if now - seen.logged.get(key, float("-inf")) < RELOG_AFTER:
+                continue  # it came and went lately: said already
+            seen.logged[key] = now
+            seen.announced.add(key)
+            state = channel.flow.value if channel.flow is not None else "starting"
+            self._log(f"{channel.describe()}: {state}: {finding.text}")

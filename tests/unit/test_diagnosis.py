@@ -1,0 +1,129 @@
+"""The rules that explain a channel, on situations written by hand (no processes)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from ros_gz_bridge_py.config import Direction
+from ros_gz_bridge_py.converters.registry import default_registry
+from ros_gz_bridge_py.diagnosis import Finding, Flow, RosEndpoint, Situation, findings, flow
+from ros_gz_bridge_py.explain import type_hints
+from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER, GraphEndpoint
+
+HINTS = type_hints(default_registry())
+PART = "sim"
+PROCESS = "0123456789abcdef"
+
+
+def situation(direction: Direction, **changes: object) -> Situation:
+    base = Situation(
+        direction=direction,
+        ros_topic="/odom",
+        ros_type="nav_msgs/msg/Odometry",
+        gz_topic="/odom",
+        gz_type="gz.msgs.Odometry",
+        partition=PART,
+        gz_endpoints=(),
+        ros_endpoints=(),
+        gz_peers=1,
+        listening="ZeroMQ somewhere",
+    )
+    return dataclasses.replace(base, **changes)  # type: ignore[arg-type]
+
+
+def endpoint(role: str, msg_type: str, partition: str = PART, **more: object) -> GraphEndpoint:
+    return GraphEndpoint(role, partition, "/odom", msg_type, PROCESS, "tcp://10.0.0.5:4000", **more)  # type: ignore[arg-type]
+
+
+def keys(found: list[Finding]) -> list[str]:
+    return [f.key for f in found]
+
+
+def test_a_publisher_of_either_spelling_is_the_gazebo_side() -> None:
+    for seen in ("gz.msgs.Odometry", "ignition.msgs.Odometry"):
+        ready = situation(Direction.GZ_TO_ROS, gz_endpoints=[endpoint(PUBLISHER, seen)])
+        assert findings(ready, HINTS) == []
+        assert flow(ready) is Flow.STALLED
+        assert flow(dataclasses.replace(ready, since_message=1.0)) is Flow.FLOWING
+
+
+def test_publisher_of_another_type_names_it_and_the_fix_in_the_configured_spelling() -> None:
+    wrong = situation(Direction.GZ_TO_ROS, gz_endpoints=[endpoint(PUBLISHER, "ignition.msgs.Pose")])
+    (finding,) = findings(wrong, HINTS)
+    assert finding.key == "gz-type:publisher:ignition.msgs.Pose"
+    assert "process 01234567 at tcp://10.0.0.5:4000" in finding.text
+    assert "publishes ignition.msgs.Pose, but the bridge is configured with gz.msgs.Odometry" in (
+        finding.text
+    )
+    assert "gz.msgs.Pose pairs with geometry_msgs/msg/Pose" in finding.text
+    assert flow(wrong) is Flow.WAITING_GAZEBO
+
+
+def test_a_pairing_type_is_proposed_alone() -> None:
+    wrong = situation(
+        Direction.GZ_TO_ROS,
+        gz_type="ignition.msgs.OdometryWithCovariance",
+        gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Odometry")],
+    )
+    (finding,) = findings(wrong, HINTS)
+    assert "set the Gazebo type (gz_type_name) to ignition.msgs.Odometry" in finding.text
+
+
+def test_other_partition_no_peer_and_absent_are_told_apart() -> None:
+    elsewhere = situation(
+        Direction.GZ_TO_ROS, gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Odometry", "vm:root")]
+    )
+    (finding,) = findings(elsewhere, HINTS)
+    assert finding.key == "partition:vm:root"
+    assert "'vm:root': publisher gz.msgs.Odometry" in finding.text
+    assert "GZ_PARTITION=vm:root" in finding.text
+    assert "IGN_PARTITION=vm:root" in finding.text
+    alone = situation(Direction.GZ_TO_ROS, gz_peers=0)
+    assert keys(findings(alone, HINTS)) == ["no-peer"]
+    assert "ZeroMQ somewhere" in findings(alone, HINTS)[0].text
+    absent = situation(Direction.GZ_TO_ROS, gz_topics=["/model/robot/odom", "/clock", "/odometry"])
+    (finding,) = findings(absent, HINTS)
+    assert finding.key == "gz-absent:publisher"
+    assert "similar topics: /model/robot/odom, /odometry" in finding.text
+
+
+def test_ros_to_gazebo_waits_for_a_registered_subscriber() -> None:
+    typed_fortress = endpoint(SUBSCRIBER, "ignition.msgs.Twist")
+    cmd = situation(
+        Direction.ROS_TO_GZ,
+        ros_type="geometry_msgs/msg/Twist",
+        gz_type="gz.msgs.Twist",
+        gz_endpoints=[endpoint(SUBSCRIBER, "")],
+        since_message=0.1,
+    )
+    assert flow(cmd) is Flow.WAITING_GAZEBO  # messages go nowhere
+    (declined,) = findings(cmd, HINTS)
+    assert declined.key == f"gz-declined:{PROCESS}"
+    assert "did not take gz.msgs.Twist under either spelling" in declined.text
+    ok = dataclasses.replace(cmd, gz_endpoints=[typed_fortress], gz_subscriber_registered=True)
+    assert findings(ok, HINTS) == []
+    assert flow(ok) is Flow.FLOWING
+    assert flow(dataclasses.replace(ok, since_message=None)) is Flow.WAITING_ROS
+    other = dataclasses.replace(cmd, gz_endpoints=[endpoint(SUBSCRIBER, "gz.msgs.Vector3d")])
+    assert keys(findings(other, HINTS)) == ["gz-type:subscriber:gz.msgs.Vector3d"]
+
+
+def test_ros_endpoints_of_another_type_or_qos_are_named_even_while_flowing() -> None:
+    flowing = situation(
+        Direction.GZ_TO_ROS,
+        gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Odometry")],
+        since_message=0.5,
+        ros_endpoints=[
+            RosEndpoint("/nav/amcl", "geometry_msgs/msg/PoseStamped"),
+            RosEndpoint("/rviz", "nav_msgs/msg/Odometry", "ERROR: Best effort publisher"),
+            RosEndpoint("/ok", "nav_msgs/msg/Odometry"),
+        ],
+    )
+    found = findings(flowing, HINTS)
+    assert keys(found) == [
+        "ros-type:/nav/amcl:geometry_msgs/msg/PoseStamped",
+        "ros-qos:/rviz",
+    ]
+    assert "uses geometry_msgs/msg/PoseStamped, but the bridge is configured with " in found[0].text
+    assert "ERROR: Best effort publisher" in found[1].text
+    assert flow(flowing) is Flow.FLOWING
