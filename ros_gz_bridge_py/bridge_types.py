@@ -27,7 +27,10 @@ usage: bridge_types [OPTION [TYPE]]
   --get-gz-to-ros TYPE     print the default ROS type for Gazebo TYPE (gz.msgs.X or ignition.msgs.X)
   --json                   print all pairs and services as one JSON document
 
-Gazebo types are written gz.msgs.X; ignition.msgs.X is accepted as the same type.
+Gazebo types are written gz.msgs.X; ignition.msgs.X names the same message. Either
+spelling, in any configuration, matches Gazebo peers of every line: Fortress publishes and
+subscribes ignition.msgs.X, Garden and later gz.msgs.X, and the bridge puts on the wire the
+spelling each peer takes (IMU messages in that line's layout).
 """
 
 PAIRS_HEADING = "Supported ROS <=> Gazebo message type conversion pairs:"
