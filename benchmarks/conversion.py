@@ -20,10 +20,10 @@ from typing import Any
 
 from benchmarks.payloads import KINDS
 from benchmarks.report import write_section
-from ros_gz_bridge_py import ros_cdr
 from ros_gz_bridge_py.bulk.path import gz_to_ros_cdr, ros_cdr_to_gz
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.runtime import tune_allocator
+from ros_gz_bridge_py.ros import light_reader
+from ros_gz_bridge_py.ros.runtime import tune_allocator
 
 CASES = ("image640", "image1080", "cloud1mb", "scan1440", "tf50", "tf20", "odometry", "twist")
 #: Goal per message and direction, ms (issue 4).
@@ -98,11 +98,11 @@ def measure(name: str, seconds: float) -> Measured:
     )
     bulk = pair.bulk
     if bulk is None:
-        if ros_cdr.reader_for(pair.ros_class) is None:
+        if light_reader.reader_for(pair.ros_class) is None:
             return measured
 
         def light_to_gz() -> Any:
-            return pair.to_gz(ros_cdr.read(cdr, pair.ros_class)).SerializeToString()
+            return pair.to_gz(light_reader.read(cdr, pair.ros_class)).SerializeToString()
 
         return dataclasses.replace(measured, light_to_gz=timing(light_to_gz, seconds))
     gz_class = message_class(kind.gz_type)

@@ -24,7 +24,7 @@ from benchmarks.payloads import KINDS
 from benchmarks.transport import STATS_LINE
 from benchmarks.workers import MATCH_WAIT
 from benchmarks.workers import SETTLE as PUBLISH_SETTLE
-from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
+from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
 from tests.gzpeer import PeerProcess, peer_binary, start_process, stop_processes, wait_for_line
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -46,7 +46,7 @@ ZENOH_CASES = (("image1080", 0.0), ("image1080", 30.0), ("cloud1mb", 0.0))
 
 
 def through_image_bridge(seconds: float, ceiling: Ceilings) -> list[Row]:
-    if importlib.util.find_spec("ros_gz_bridge_py.image_bridge") is None:
+    if importlib.util.find_spec("ros_gz_bridge_py.app.image_bridge") is None:
         return []
     which = backend("zeromq")
     topics = {kind: topic_name(f"ib_{kind}") for kind in ("image640", "image1080")}

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from benchmarks import conversion, images, memory, small_messages, starvation, transport
 from benchmarks.harness import stop_all
 from benchmarks.report import write_section
-from ros_gz_bridge_py.ros_speed import PROFILE
+from ros_gz_bridge_py.ros.speed import PROFILE
 
 
 def steps(quick: bool) -> dict[str, Callable[[], int]]:

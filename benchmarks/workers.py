@@ -23,7 +23,7 @@ from typing import Any
 from benchmarks.payloads import KINDS, GzPayloads, Kind, gz_stamp, now_ns, ros_stamp, stamp_ros
 from benchmarks.transport import stats_line
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
+from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
 from ros_gz_bridge_py.transport import MessageInfo, create_node
 
 #: How long a publisher waits for its first subscriber.
@@ -90,7 +90,7 @@ def _publish_loop(seconds: float, hz: float, send: Callable[[], None]) -> None:
 
 
 def _ros_start() -> Any:
-    from ros_gz_bridge_py.runtime import tune_allocator  # noqa: PLC0415 - loads rclpy
+    from ros_gz_bridge_py.ros.runtime import tune_allocator  # noqa: PLC0415 - loads rclpy
 
     tune_allocator()
     apply_fastdds_profile()
@@ -102,7 +102,7 @@ def _ros_start() -> Any:
 
 
 def _ros_qos(depth: int | None = None) -> Any:
-    from ros_gz_bridge_py.qos import endpoint_qos  # noqa: PLC0415
+    from ros_gz_bridge_py.ros.qos import endpoint_qos  # noqa: PLC0415
 
     return endpoint_qos(None, depth)
 
@@ -138,7 +138,7 @@ def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | 
     rclpy = _ros_start()
     from rclpy.task import Future  # noqa: PLC0415
 
-    from ros_gz_bridge_py.runtime import make_executor  # noqa: PLC0415
+    from ros_gz_bridge_py.ros.runtime import make_executor  # noqa: PLC0415
 
     node = rclpy.create_node(f"bench_sub_{os.getpid()}")
     recorder = Recorder(slow_s)

@@ -12,12 +12,12 @@ __version__ = "0.1.0"
 __all__ = ["Bridge", "__version__"]
 
 if TYPE_CHECKING:
-    from ros_gz_bridge_py.bridge import Bridge
+    from ros_gz_bridge_py.core.bridge import Bridge
 
 
 def __getattr__(name: str) -> Any:
     if name == "Bridge":
-        from ros_gz_bridge_py.bridge import Bridge  # noqa: PLC0415 - keeps `import` free of rclpy
+        from ros_gz_bridge_py.core.bridge import Bridge  # noqa: PLC0415 - keeps `import` free of rclpy
 
         return Bridge
     msg = f"module {__name__!r} has no attribute {name!r}"

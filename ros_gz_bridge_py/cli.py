@@ -4,24 +4,24 @@ from __future__ import annotations
 
 import sys
 
-from ros_gz_bridge_py.stop_signal import StopSignal
+from ros_gz_bridge_py.app.stop_signal import StopSignal
 
 
 def parameter_bridge_main() -> None:
     with StopSignal() as stop:
-        from ros_gz_bridge_py import parameter_bridge  # noqa: PLC0415 - imports rclpy
+        from ros_gz_bridge_py.app import parameter_bridge  # noqa: PLC0415 - imports rclpy
 
         sys.exit(parameter_bridge.main(stop=stop))
 
 
 def bridge_types_main() -> None:
-    from ros_gz_bridge_py import bridge_types  # noqa: PLC0415
+    from ros_gz_bridge_py.app import bridge_types  # noqa: PLC0415
 
     sys.exit(bridge_types.main())
 
 
 def image_bridge_main() -> None:
     with StopSignal() as stop:
-        from ros_gz_bridge_py import image_bridge  # noqa: PLC0415 - imports rclpy
+        from ros_gz_bridge_py.app import image_bridge  # noqa: PLC0415 - imports rclpy
 
         sys.exit(image_bridge.main(stop=stop))

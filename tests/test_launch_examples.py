@@ -24,7 +24,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.utilities import try_shutdown
 
-from ros_gz_bridge_py import image_bridge, parameter_bridge
+from ros_gz_bridge_py.app import image_bridge, parameter_bridge
 from ros_gz_bridge_py.config import read_yaml_file
 
 pytestmark = [pytest.mark.ros]

@@ -91,7 +91,7 @@ def bridge_commands() -> list[BridgeCommand]:
         msg = f"{executable} is missing; run `make setup` (pip install -e .)"
         raise DemoSetupError(msg)
     parameter_bridge = [str(executable), "--ros-args", "-p", f"config_file:={topics.CONFIG_FILE}"]
-    image_bridge = [sys.executable, "-m", "ros_gz_bridge_py.image_bridge", topics.CAMERA_IMAGE]
+    image_bridge = [sys.executable, "-m", "ros_gz_bridge_py.app.image_bridge", topics.CAMERA_IMAGE]
     return [
         BridgeCommand("bridge", parameter_bridge, {}),
         BridgeCommand("image bridge", image_bridge, {}),

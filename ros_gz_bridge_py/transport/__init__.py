@@ -21,7 +21,7 @@ from ros_gz_bridge_py.transport.api import (
     TransportStats,
 )
 from ros_gz_bridge_py.transport.settings import TransportSettings
-from ros_gz_bridge_py.transport.zmq_node import ZmqNode
+from ros_gz_bridge_py.transport.zmq.node import ZmqNode
 
 __all__ = [
     "GENERIC_TYPE",
@@ -52,7 +52,7 @@ def create_node(options: NodeOptions | None = None) -> Node:
     implementation = (options.implementation or settings.implementation).lower()
     if implementation == "zenoh":
         # Imported here so the ZeroMQ path never loads zenoh.
-        from ros_gz_bridge_py.transport.zenoh_node import ZenohNode  # noqa: PLC0415
+        from ros_gz_bridge_py.transport.zenoh.node import ZenohNode  # noqa: PLC0415
 
         return ZenohNode(options.partition, options.namespace, settings)
     if implementation != "zeromq":

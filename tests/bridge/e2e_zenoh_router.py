@@ -12,8 +12,8 @@ import time
 
 import zenoh
 
-from ros_gz_bridge_py.stop_signal import StopSignal
-from ros_gz_bridge_py.transport.zenoh_config import endpoints_config
+from ros_gz_bridge_py.app.stop_signal import StopSignal
+from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
 
 
 def main() -> int:

@@ -9,7 +9,7 @@ from typing import Any
 from ros_gz_bridge_py.msgs import message_class
 
 #: ``python -m`` form, the way the demo starts it (the console script runs the same ``main``).
-IMAGE_BRIDGE = [sys.executable, "-m", "ros_gz_bridge_py.image_bridge"]
+IMAGE_BRIDGE = [sys.executable, "-m", "ros_gz_bridge_py.app.image_bridge"]
 RGB_INT8 = 3
 #: A gz PixelFormatType with no ROS encoding (RGB_INT32).
 UNSUPPORTED_FORMAT = 7

@@ -18,7 +18,7 @@ import pytest
 from rcl_interfaces.srv import ListParameters
 
 from ros_gz_bridge_py.transport import Node as GzNode
-from ros_gz_bridge_py.transport.discovery import SILENCE_INTERVAL
+from ros_gz_bridge_py.transport.zmq.discovery import SILENCE_INTERVAL
 from tests.bridge.behaviour_harness import (
     PARAMETER_BRIDGE,
     STRING,

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from ros_gz_bridge_py.bridge_types import PAIRS_HEADING, SERVICES_HEADING, main
+from ros_gz_bridge_py.app.bridge_types import PAIRS_HEADING, SERVICES_HEADING, main
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

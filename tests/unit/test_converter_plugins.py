@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from std_msgs.msg import UInt8MultiArray
 
-from ros_gz_bridge_py import bridge_types
+from ros_gz_bridge_py.app import bridge_types
 from ros_gz_bridge_py.converters import registry
 from ros_gz_bridge_py.msgs import message_class
 

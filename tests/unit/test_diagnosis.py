@@ -6,8 +6,8 @@ import dataclasses
 
 from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.converters.registry import default_registry
-from ros_gz_bridge_py.diagnosis import Finding, Flow, RosEndpoint, Situation, findings, flow
-from ros_gz_bridge_py.explain import type_hints
+from ros_gz_bridge_py.core.diagnosis import Finding, Flow, RosEndpoint, Situation, findings, flow
+from ros_gz_bridge_py.core.explain import type_hints
 from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER, GraphEndpoint
 
 HINTS = type_hints(default_registry())

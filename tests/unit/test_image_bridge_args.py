@@ -7,16 +7,7 @@ from typing import Any
 
 import pytest
 
-from ros_gz_bridge_py.config import (
-    Direction,
-    ParseResult,
-    ServiceBridgeSpec,
-    TopicBridgeSpec,
-    UsageError,
-    parse_yaml,
-)
-from ros_gz_bridge_py.errors import ConfigError
-from ros_gz_bridge_py.image_bridge_args import (
+from ros_gz_bridge_py.app.image_bridge_args import (
     CAMERA_INFO_ROS_TYPE,
     IMAGE_ROS_TYPE,
     ImageTopic,
@@ -32,6 +23,15 @@ from ros_gz_bridge_py.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
+from ros_gz_bridge_py.config import (
+    Direction,
+    ParseResult,
+    ServiceBridgeSpec,
+    TopicBridgeSpec,
+    UsageError,
+    parse_yaml,
+)
+from ros_gz_bridge_py.errors import ConfigError
 
 
 def _image(ros: str, gz: str, **changes: Any) -> TopicBridgeSpec:

@@ -2,7 +2,7 @@
 
 For every pair of the registry, a message of the pair's ROS type is filled with distinctive
 values (every field different, sequences of several elements, nested messages filled too),
-serialized by rclpy, read back by :mod:`ros_gz_bridge_py.ros_cdr`, and converted to Gazebo
+serialized by rclpy, read back by :mod:`ros_gz_bridge_py.ros.light_reader`, and converted to Gazebo
 both ways: from rclpy's message and from the light tree. The protobuf messages (or the
 conversion errors) must be equal.
 """
@@ -16,9 +16,9 @@ from typing import Any
 import pytest
 from rclpy.serialization import serialize_message
 
-from ros_gz_bridge_py import ros_cdr
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.ros import light_reader
 
 _INT_RANGES = {
     "int8": 127,
@@ -83,7 +83,7 @@ PAIRS = list(default_registry().pairs)
 def test_light_tree_converts_like_rclpy_message(pair: Pair) -> None:
     msg = filled(pair.ros_class)
     cdr = serialize_message(msg)
-    tree = ros_cdr.read(cdr, pair.ros_class)
+    tree = light_reader.read(cdr, pair.ros_class)
     assert tree is not None, f"{pair.ros_type} is not readable"
     assert _to_gz(pair, tree) == _to_gz(pair, msg)
 
@@ -99,7 +99,7 @@ def test_other_encapsulations_are_left_to_rclpy() -> None:
 
     cdr = bytearray(serialize_message(filled(Twist)))
     cdr[1] = 0x00  # big endian
-    assert ros_cdr.read(bytes(cdr), Twist) is None
+    assert light_reader.read(bytes(cdr), Twist) is None
 
 
 def test_truncated_message_is_a_conversion_error() -> None:
@@ -107,14 +107,14 @@ def test_truncated_message_is_a_conversion_error() -> None:
 
     cdr = serialize_message(filled(Odometry))
     with pytest.raises(ConversionError, match="Odometry"):
-        ros_cdr.read(cdr[:40], Odometry)
+        light_reader.read(cdr[:40], Odometry)
 
 
 def test_values_land_on_the_right_attributes() -> None:
     from sensor_msgs.msg import JointState  # noqa: PLC0415
 
     msg = filled(JointState)
-    tree = ros_cdr.read(serialize_message(msg), JointState)
+    tree = light_reader.read(serialize_message(msg), JointState)
     assert tree is not None
     assert tree.header.frame_id == msg.header.frame_id
     assert (tree.header.stamp.sec, tree.header.stamp.nanosec) == (

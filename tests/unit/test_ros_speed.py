@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from ros_gz_bridge_py.ros_speed import PROFILE, apply_fastdds_profile, decide
+from ros_gz_bridge_py.ros.speed import PROFILE, apply_fastdds_profile, decide
 
 NS = {"f": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
 

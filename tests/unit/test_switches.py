@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from ros_gz_bridge_py.switches import switched_off
+from ros_gz_bridge_py.app.switches import switched_off
 
 NAME = "ROS_GZ_BRIDGE_SOMETHING"
 
@@ -33,7 +33,7 @@ class _Logger:
 
 @pytest.mark.parametrize(("value", "nice"), [("", 10), ("0", 0), (" 5 ", 5), ("-3", -3)])
 def test_bulk_nice_values(monkeypatch: pytest.MonkeyPatch, value: str, nice: int) -> None:
-    from ros_gz_bridge_py.bridge import BULK_NICE_ENV, _bulk_nice  # noqa: PLC0415
+    from ros_gz_bridge_py.core.bridge import BULK_NICE_ENV, _bulk_nice  # noqa: PLC0415
 
     monkeypatch.setenv(BULK_NICE_ENV, value)
     logger = _Logger()
@@ -42,7 +42,7 @@ def test_bulk_nice_values(monkeypatch: pytest.MonkeyPatch, value: str, nice: int
 
 
 def test_bulk_nice_that_is_not_a_number_is_reported(monkeypatch: pytest.MonkeyPatch) -> None:
-    from ros_gz_bridge_py.bridge import BULK_NICE_ENV, _bulk_nice  # noqa: PLC0415
+    from ros_gz_bridge_py.core.bridge import BULK_NICE_ENV, _bulk_nice  # noqa: PLC0415
 
     monkeypatch.setenv(BULK_NICE_ENV, "low")
     logger = _Logger()

@@ -14,11 +14,11 @@ import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import Image, PointCloud2, PointField
 
-from ros_gz_bridge_py import ros_cdr
 from ros_gz_bridge_py.bulk.path import Rows, gz_to_ros_cdr, ros_cdr_to_gz, taken
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros import light_reader
 
 GzImage = message_class("gz.msgs.Image")
 GzCloud = message_class("gz.msgs.PointCloudPacked")
@@ -45,7 +45,7 @@ def ros_to_gz_outcomes(pair: Pair, ros: Any) -> dict[str, Outcome]:
     bulk = pair.bulk
     gz_class = message_class(pair.gz_type)
     cdr = serialize_message(ros)
-    tree = ros_cdr.read(cdr, pair.ros_class)
+    tree = light_reader.read(cdr, pair.ros_class)
 
     def on_bulk_path() -> Any:
         payload = ros_cdr_to_gz(bulk, pair.ros_class, cdr)

@@ -11,11 +11,11 @@ from geometry_msgs.msg import Vector3
 from marine_acoustic_msgs.msg import Dvl
 from rclpy.serialization import serialize_message
 
-from ros_gz_bridge_py import ros_cdr
 from ros_gz_bridge_py.converters import default_registry
 from ros_gz_bridge_py.converters import marine_acoustic_msgs as conv
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros import light_reader
 
 GzDvl = message_class("gz.msgs.DVLVelocityTracking")
 GzTarget = message_class("gz.msgs.DVLTrackingTarget")
@@ -195,7 +195,7 @@ def test_to_gz_more_good_beams_than_slots_is_an_error(good_beams: int) -> None:
 def test_light_tree_of_a_valid_dvl_converts_like_the_rclpy_message() -> None:
     # tests/unit/test_ros_cdr.py fills num_good_beams with more than 4: only the error path.
     msg = ros_dvl(good_beams=4)
-    tree = ros_cdr.read(serialize_message(msg), Dvl)
+    tree = light_reader.read(serialize_message(msg), Dvl)
     assert tree is not None
     assert conv.dvl_to_gz(tree) == conv.dvl_to_gz(msg)
 

@@ -8,11 +8,11 @@ import pytest
 from rclpy.serialization import serialize_message
 from sensor_msgs.msg import NavSatFix, NavSatStatus
 
-from ros_gz_bridge_py import ros_cdr
 from ros_gz_bridge_py.converters import default_registry
 from ros_gz_bridge_py.converters import sensor_msgs_navsat as conv
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros import light_reader
 
 GzNavSatWithCovariance = message_class("gz.msgs.NavSatWithCovariance")
 
@@ -92,7 +92,7 @@ def test_default_fix_sends_nine_zeros_of_unknown_type() -> None:
 def test_light_tree_of_a_valid_fix_converts_like_the_rclpy_message() -> None:
     # tests/unit/test_ros_cdr.py fills an invalid covariance type: only the error path.
     msg = ros_fix()
-    tree = ros_cdr.read(serialize_message(msg), NavSatFix)
+    tree = light_reader.read(serialize_message(msg), NavSatFix)
     assert tree is not None
     expected = conv.nav_sat_fix_to_gz_nav_sat_with_covariance(msg)
     assert conv.nav_sat_fix_to_gz_nav_sat_with_covariance(tree) == expected

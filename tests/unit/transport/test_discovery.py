@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from ros_gz_bridge_py.transport.api import Scope
-from ros_gz_bridge_py.transport.discovery import (
+from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber
+from ros_gz_bridge_py.transport.zmq.discovery import (
     HEARTBEAT_INTERVAL,
     SILENCE_INTERVAL,
     DiscoveryEngine,
@@ -13,7 +14,7 @@ from ros_gz_bridge_py.transport.discovery import (
     SubscriberAdded,
     SubscriberRemoved,
 )
-from ros_gz_bridge_py.transport.wire import (
+from ros_gz_bridge_py.transport.zmq.wire import (
     DiscoveryMessage,
     DiscoveryType,
     MessagePublisher,
@@ -21,7 +22,6 @@ from ros_gz_bridge_py.transport.wire import (
     decode_discovery,
     encode_discovery,
 )
-from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber
 
 ME = "11111111-1111-1111-1111-111111111111"
 PEER = "22222222-2222-2222-2222-222222222222"

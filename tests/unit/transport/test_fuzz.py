@@ -15,7 +15,7 @@ import zmq
 
 from ros_gz_bridge_py.transport import TransportSettings, ZmqNode
 from ros_gz_bridge_py.transport.api import Scope
-from ros_gz_bridge_py.transport.wire import (
+from ros_gz_bridge_py.transport.zmq.wire import (
     DiscoveryMessage,
     DiscoveryType,
     MessagePublisher,

@@ -7,7 +7,7 @@ import pytest
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.transport.api import Scope
-from ros_gz_bridge_py.transport.wire import (
+from ros_gz_bridge_py.transport.zmq.wire import (
     UNTHROTTLED,
     DiscoveryMessage,
     DiscoveryType,

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling
-from ros_gz_bridge_py.transport.discovery import DiscoveryEngine
-from ros_gz_bridge_py.transport.wire import DiscoveryMessage, DiscoveryType, encode_discovery
 from ros_gz_bridge_py.transport.wire_types import (
     PeerSpellings,
     RemoteSubscriber,
@@ -12,6 +10,8 @@ from ros_gz_bridge_py.transport.wire_types import (
     WireTypeCache,
     wire_types,
 )
+from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine
+from ros_gz_bridge_py.transport.zmq.wire import DiscoveryMessage, DiscoveryType, encode_discovery
 from tests.unit.transport.test_discovery import record
 
 GZ, IGN = "gz.msgs.Twist", "ignition.msgs.Twist"

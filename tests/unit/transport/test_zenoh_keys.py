@@ -6,7 +6,7 @@ import pytest
 
 from ros_gz_bridge_py.errors import LocalProtocolError
 from ros_gz_bridge_py.transport.names import fully_qualified_name
-from ros_gz_bridge_py.transport.zenoh_keys import (
+from ros_gz_bridge_py.transport.zenoh.keys import (
     EntityKind,
     GraphToken,
     demangle_name,

@@ -24,13 +24,13 @@ import zenoh
 from ros_gz_bridge_py.errors import TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
 from ros_gz_bridge_py.transport.api import MessageInfo
-from ros_gz_bridge_py.transport.zenoh_config import (
+from ros_gz_bridge_py.transport.zenoh.config import (
     OVERRIDE_ENV,
     endpoints_config,
     parse_overrides,
     session_config,
 )
-from ros_gz_bridge_py.transport.zenoh_node import ZenohNode
+from ros_gz_bridge_py.transport.zenoh.node import ZenohNode
 
 PEER_SCRIPT = Path(__file__).with_name("zenoh_peer.py")
 ROOT = PEER_SCRIPT.parents[3]

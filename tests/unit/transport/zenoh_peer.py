@@ -22,9 +22,9 @@ import zenoh
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
 from ros_gz_bridge_py.transport.api import MessageInfo
 from ros_gz_bridge_py.transport.names import fully_qualified_name
-from ros_gz_bridge_py.transport.zenoh_config import endpoints_config
-from ros_gz_bridge_py.transport.zenoh_keys import EntityKind, message_token
-from ros_gz_bridge_py.transport.zenoh_node import ZenohNode
+from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
+from ros_gz_bridge_py.transport.zenoh.keys import EntityKind, message_token
+from ros_gz_bridge_py.transport.zenoh.node import ZenohNode
 
 #: How long a peer waits for a graph condition before reporting failure.
 WAIT_LIMIT = 10.0

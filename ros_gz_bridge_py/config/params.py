@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from ros_gz_bridge_py.config_model import (
+from ros_gz_bridge_py.config.model import (
     QOS_PROFILE_NAMES,
     BridgeSpec,
     Direction,

@@ -1,9 +1,10 @@
 """What ``image_bridge`` is asked to bridge, worked out without rclpy: pure functions on strings.
 
 Topic arguments become Gazebo->ROS ``sensor_msgs/msg/Image`` <-> Gazebo Image
-:class:`TopicBridgeSpec` values; :mod:`ros_gz_bridge_py.image_bridge` hands them to a
-:class:`~ros_gz_bridge_py.bridge.Bridge`. Also here: the ``qos`` and ``gz_type`` parameter values,
-the camera_info topic beside an image topic, and which entries of a ``config_file`` apply.
+:class:`TopicBridgeSpec` values; :mod:`ros_gz_bridge_py.app.image_bridge` hands them to a
+:class:`~ros_gz_bridge_py.core.bridge.Bridge`. Also here: the ``qos`` and ``gz_type``
+parameter values, the camera_info topic beside an image topic, and which entries of a
+``config_file`` apply.
 """
 
 from __future__ import annotations

@@ -57,7 +57,10 @@ from ros_gz_bridge_py.transport.api import (
     TopicInfo,
     TransportStats,
 )
-from ros_gz_bridge_py.transport.discovery import (
+from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
+from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.wire_types import SubscriberBook, WireTypeCache
+from ros_gz_bridge_py.transport.zmq.discovery import (
     INIT_DELAY,
     DiscoveryEngine,
     Event,
@@ -66,10 +69,11 @@ from ros_gz_bridge_py.transport.discovery import (
     SubscriberAdded,
     SubscriberRemoved,
 )
-from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
-from ros_gz_bridge_py.transport.settings import TransportSettings
-from ros_gz_bridge_py.transport.udp import DiscoverySocket, determine_host
-from ros_gz_bridge_py.transport.wire import (
+from ros_gz_bridge_py.transport.zmq.endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
+from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader, receive_message
+from ros_gz_bridge_py.transport.zmq.services import PendingCall, RouterSockets, ServiceRouter
+from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket, determine_host
+from ros_gz_bridge_py.transport.zmq.wire import (
     DATA_FRAMES,
     Frame,
     MessagePublisher,
@@ -77,10 +81,6 @@ from ros_gz_bridge_py.transport.wire import (
     ServicePublisher,
     decode_data,
 )
-from ros_gz_bridge_py.transport.wire_types import SubscriberBook, WireTypeCache
-from ros_gz_bridge_py.transport.zmq_endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
-from ros_gz_bridge_py.transport.zmq_reader import SubscriptionReader, receive_message
-from ros_gz_bridge_py.transport.zmq_services import PendingCall, RouterSockets, ServiceRouter
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 T = TypeVar("T")

@@ -31,7 +31,7 @@ from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.transport.api import MessageInfo
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES, require_queue_size
 from ros_gz_bridge_py.transport.names import decompose
-from ros_gz_bridge_py.transport.wire import DATA_FRAMES, Frame, decode_data
+from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 

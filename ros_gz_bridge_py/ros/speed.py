@@ -20,7 +20,7 @@ from collections.abc import Mapping, MutableMapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ros_gz_bridge_py.switches import switched_off
+from ros_gz_bridge_py.app.switches import switched_off
 
 PROFILE = Path(__file__).resolve().parent / "resources" / "fastdds_shm_profile.xml"
 #: Set to off/0/false/no to keep Fast DDS's own transports.

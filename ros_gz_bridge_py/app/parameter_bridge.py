@@ -23,9 +23,9 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
-from ros_gz_bridge_py.bridge import Bridge, BridgeOptions
-from ros_gz_bridge_py.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
-from ros_gz_bridge_py.check import Sides, run_check
+from ros_gz_bridge_py.app.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
+from ros_gz_bridge_py.app.check import Sides, run_check
+from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.config import (
     USAGE,
     BridgeSpec,
@@ -37,13 +37,13 @@ from ros_gz_bridge_py.config import (
     parse_parameter_bridges,
     read_yaml_file,
 )
+from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV, check_gz_version
 from ros_gz_bridge_py.converters.registry import default_registry
+from ros_gz_bridge_py.core.bridge import Bridge, BridgeOptions
+from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
-from ros_gz_bridge_py.gz_version import GZ_VERSION_ENV, check_gz_version
-from ros_gz_bridge_py.runtime import apply_speed_settings, make_executor
-from ros_gz_bridge_py.services import DEFAULT_TIMEOUT
-from ros_gz_bridge_py.status import DiagnosticsPublisher, serve, start_diagnostics
-from ros_gz_bridge_py.stop_signal import StopSignal
+from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
 from ros_gz_bridge_py.transport import NodeOptions, create_node
 
 NODE_NAME = "ros_gz_bridge"
@@ -215,7 +215,7 @@ def collect_sources(node: Node, cli: ParseResult, params: dict[str, Any]) -> lis
 
 
 def check(node: Node, cli: ParseResult, params: dict[str, Any], seconds: float) -> int:
-    """``--check``: report on every entry without bridging (see :mod:`ros_gz_bridge_py.check`)."""
+    """``--check``: report on every entry without bridging (:mod:`ros_gz_bridge_py.app.check`)."""
     sources = collect_sources(node, cli, params)
     specs = [spec for source in sources for spec in source.specs]
     errors = sum(len(source.errors) for source in sources)

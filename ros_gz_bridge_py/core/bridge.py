@@ -31,27 +31,27 @@ from typing import Any
 
 from rclpy.clock import Clock, ClockType
 
-from ros_gz_bridge_py.channel import (
-    BULK_THREAD_NICE,
-    Channel,
-    ChannelContext,
-    GzToRosChannel,
-    RosToGzChannel,
-)
+from ros_gz_bridge_py.app.switches import switched_off
 from ros_gz_bridge_py.config import (
     BridgeSpec,
     Direction,
     ServiceBridgeSpec,
     TopicBridgeSpec,
 )
+from ros_gz_bridge_py.config.gz_version import GARDEN
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
+from ros_gz_bridge_py.core.channel import (
+    BULK_THREAD_NICE,
+    Channel,
+    ChannelContext,
+    GzToRosChannel,
+    RosToGzChannel,
+)
+from ros_gz_bridge_py.core.explain import EXPLAIN_PERIOD, Explainer
+from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT, ServiceBridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
-from ros_gz_bridge_py.explain import EXPLAIN_PERIOD, Explainer
-from ros_gz_bridge_py.gz_version import GARDEN
 from ros_gz_bridge_py.msgs.names import Spelling
-from ros_gz_bridge_py.services import DEFAULT_TIMEOUT, ServiceBridge
-from ros_gz_bridge_py.side_node import SideNode, side_node_name
-from ros_gz_bridge_py.switches import switched_off
+from ros_gz_bridge_py.ros.side_node import SideNode, side_node_name
 from ros_gz_bridge_py.transport import Node as GzNode
 from ros_gz_bridge_py.transport import NodeOptions, create_node
 

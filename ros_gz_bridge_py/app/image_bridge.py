@@ -1,9 +1,9 @@
 """``image_bridge``: ros_gz_image's executable on the bridge core (Gazebo->ROS camera images).
 
 Each topic argument becomes a Gazebo->ROS ``sensor_msgs/msg/Image`` bridge of a
-:class:`~ros_gz_bridge_py.bridge.Bridge` on the node ``ros_gz_image``; channels, QoS, lazy
+:class:`~ros_gz_bridge_py.core.bridge.Bridge` on the node ``ros_gz_image``; channels, QoS, lazy
 switching and error counting are the bridge's. Run it as ``image_bridge`` or
-``python -m ros_gz_bridge_py.image_bridge``; ``-h`` prints the arguments and parameters.
+``python -m ros_gz_bridge_py.app.image_bridge``; ``-h`` prints the arguments and parameters.
 
 Beyond ros_gz_image (ros_gz issues #701, #778, #752): ``GZ_TOPIC:=ROS_TOPIC`` renames,
 ``config_file`` takes a parameter_bridge YAML (its Image and CameraInfo entries), ``camera_info``
@@ -26,11 +26,7 @@ import rclpy
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
-from ros_gz_bridge_py.bridge import Bridge, BridgeOptions
-from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
-from ros_gz_bridge_py.errors import ConfigError
-from ros_gz_bridge_py.gz_version import GZ_VERSION_ENV, check_gz_version
-from ros_gz_bridge_py.image_bridge_args import (
+from ros_gz_bridge_py.app.image_bridge_args import (
     USAGE,
     ImageTopic,
     check_gz_type,
@@ -43,9 +39,13 @@ from ros_gz_bridge_py.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
-from ros_gz_bridge_py.runtime import apply_speed_settings
-from ros_gz_bridge_py.status import serve
-from ros_gz_bridge_py.stop_signal import StopSignal
+from ros_gz_bridge_py.app.stop_signal import StopSignal
+from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
+from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV, check_gz_version
+from ros_gz_bridge_py.core.bridge import Bridge, BridgeOptions
+from ros_gz_bridge_py.core.status import serve
+from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.ros.runtime import apply_speed_settings
 from ros_gz_bridge_py.transport import NodeOptions
 
 NODE_NAME = "ros_gz_image"

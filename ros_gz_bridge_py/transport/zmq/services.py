@@ -1,4 +1,4 @@
-"""The service side of a :class:`~ros_gz_bridge_py.transport.zmq_node.ZmqNode` (§2.9).
+"""The service side of a :class:`~ros_gz_bridge_py.transport.zmq.node.ZmqNode` (§2.9).
 
 :class:`ServiceRouter` keeps the node's service offers, its calls waiting for a provider, a
 route or a response, and the ROUTER sends retried until their peer is routable. It runs on the
@@ -20,8 +20,9 @@ import zmq
 
 from ros_gz_bridge_py.msgs.names import canonical_type, same_message
 from ros_gz_bridge_py.transport.api import ONE_WAY_TYPES, ServiceCall
-from ros_gz_bridge_py.transport.discovery import DiscoveryEngine, Outgoing
-from ros_gz_bridge_py.transport.wire import (
+from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine, Outgoing
+from ros_gz_bridge_py.transport.zmq.endpoints import ZmqServiceOffer
+from ros_gz_bridge_py.transport.zmq.wire import (
     Frame,
     ServiceRequest,
     ServiceResponse,
@@ -30,7 +31,6 @@ from ros_gz_bridge_py.transport.wire import (
     encode_request,
     encode_response,
 )
-from ros_gz_bridge_py.transport.zmq_endpoints import ZmqServiceOffer
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 

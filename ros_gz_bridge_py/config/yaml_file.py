@@ -16,7 +16,7 @@ from typing import TypeVar, cast
 import yaml
 from yaml.constructor import SafeConstructor
 
-from ros_gz_bridge_py.config_model import (
+from ros_gz_bridge_py.config.model import (
     DEPRECATED_DIRECTIONS,
     QOS_PROFILE_NAMES,
     BridgeSpec,

@@ -18,11 +18,11 @@ from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.config import BridgeSpec, Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Registry
-from ros_gz_bridge_py.diagnosis import Finding, RosEndpoint, Situation, findings
+from ros_gz_bridge_py.core.diagnosis import Finding, RosEndpoint, Situation, findings
+from ros_gz_bridge_py.core.explain import gazebo_name, ros_endpoints, type_hints
 from ros_gz_bridge_py.errors import ConfigError, UnsupportedTypeError
-from ros_gz_bridge_py.explain import gazebo_name, ros_endpoints, type_hints
 from ros_gz_bridge_py.msgs.names import same_message
-from ros_gz_bridge_py.qos import endpoint_qos, gz_to_ros_publisher_qos
+from ros_gz_bridge_py.ros.qos import endpoint_qos, gz_to_ros_publisher_qos
 from ros_gz_bridge_py.transport import Node as GzNode
 from ros_gz_bridge_py.transport import Publisher
 from ros_gz_bridge_py.transport.api import GraphEndpoint

@@ -66,14 +66,14 @@ from ros_gz_bridge_py.transport.delivery import Deliver
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber, SubscriberBook
-from ros_gz_bridge_py.transport.zenoh_config import Overrides, session_config
-from ros_gz_bridge_py.transport.zenoh_endpoints import (
+from ros_gz_bridge_py.transport.zenoh.config import Overrides, session_config
+from ros_gz_bridge_py.transport.zenoh.endpoints import (
     ZenohPublisher,
     ZenohServiceOffer,
     ZenohSubscription,
     undeclare,
 )
-from ros_gz_bridge_py.transport.zenoh_keys import (
+from ros_gz_bridge_py.transport.zenoh.keys import (
     GRAPH_KEY,
     EntityKind,
     GraphToken,

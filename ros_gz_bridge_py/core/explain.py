@@ -18,10 +18,10 @@ from typing import Any
 from rclpy.duration import Infinite
 from rclpy.qos import LivelinessPolicy, QoSCompatibility, QoSProfile, qos_check_compatible
 
-from ros_gz_bridge_py.channel import Channel, ChannelState, RosToGzChannel
 from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.converters.registry import Registry
-from ros_gz_bridge_py.diagnosis import (
+from ros_gz_bridge_py.core.channel import Channel, ChannelState, RosToGzChannel
+from ros_gz_bridge_py.core.diagnosis import (
     Finding,
     RosEndpoint,
     Situation,

@@ -18,7 +18,7 @@ from ros_gz_bridge_py.converters.registry import ServicePair
 from ros_gz_bridge_py.errors import ConfigError, ConversionError, TransportError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import same_message
-from ros_gz_bridge_py.side_node import SideNode
+from ros_gz_bridge_py.ros.side_node import SideNode
 from ros_gz_bridge_py.transport import Node
 
 DEFAULT_TIMEOUT = 5.0

@@ -1,4 +1,4 @@
-"""The handles a :class:`~ros_gz_bridge_py.transport.zmq_node.ZmqNode` gives out.
+"""The handles a :class:`~ros_gz_bridge_py.transport.zmq.node.ZmqNode` gives out.
 
 Each handle keeps what it needs to do its job without registry lookups (the precomputed
 FQN, the type matching rule, the decoder) and closes only itself.
@@ -13,12 +13,12 @@ from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, canonical_type, spellings
 from ros_gz_bridge_py.transport.api import MessageInfo, Publisher, ServiceOffer, Subscription
-from ros_gz_bridge_py.transport.wire import Frame, PublisherRecord, encode_data
 from ros_gz_bridge_py.transport.wire_types import WireTypeCache
+from ros_gz_bridge_py.transport.zmq.wire import Frame, PublisherRecord, encode_data
 
 if TYPE_CHECKING:
-    from ros_gz_bridge_py.transport.zmq_node import ZmqNode
-    from ros_gz_bridge_py.transport.zmq_reader import SubscriptionReader
+    from ros_gz_bridge_py.transport.zmq.node import ZmqNode
+    from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 

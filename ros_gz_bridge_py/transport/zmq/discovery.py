@@ -16,7 +16,8 @@ from dataclasses import dataclass, replace
 from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling
 from ros_gz_bridge_py.transport.api import Scope
-from ros_gz_bridge_py.transport.wire import (
+from ros_gz_bridge_py.transport.wire_types import PeerSpellings, RemoteSubscriber
+from ros_gz_bridge_py.transport.zmq.wire import (
     WIRE_VERSION,
     DiscoveryMessage,
     DiscoveryType,
@@ -26,7 +27,6 @@ from ros_gz_bridge_py.transport.wire import (
     decode_discovery,
     encode_discovery,
 )
-from ros_gz_bridge_py.transport.wire_types import PeerSpellings, RemoteSubscriber
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 

@@ -1,9 +1,10 @@
 """Live status of a running bridge: counters per channel, on ``/diagnostics`` and as a table.
 
-A :class:`StatusTracker` turns the cumulative counters of a :class:`~ros_gz_bridge_py.bridge.Bridge`
-(its channels' :class:`~ros_gz_bridge_py.channel.ChannelStats` and queue drops, its service
-bridges' calls and failures) into one :class:`ChannelStatus` per channel, with the rate and the
-errors of the period since the tracker's previous snapshot. Each consumer has its own tracker,
+A :class:`StatusTracker` turns the cumulative counters of a
+:class:`~ros_gz_bridge_py.core.bridge.Bridge` (its channels'
+:class:`~ros_gz_bridge_py.core.channel.ChannelStats` and queue drops, its service bridges'
+calls and failures) into one :class:`ChannelStatus` per channel, with the rate and the errors
+of the period since the tracker's previous snapshot. Each consumer has its own tracker,
 so the ``/diagnostics`` publisher and the table printed on SIGUSR1 never shorten each other's
 periods.
 
@@ -33,11 +34,11 @@ from typing import Any, TextIO
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.clock import Clock, ClockType
 
-from ros_gz_bridge_py.bridge import Bridge
-from ros_gz_bridge_py.channel import Channel, ChannelState, GzToRosChannel
-from ros_gz_bridge_py.runtime import make_executor, spin_until_stopped
-from ros_gz_bridge_py.services import ServiceBridge
-from ros_gz_bridge_py.stop_signal import StopSignal
+from ros_gz_bridge_py.app.stop_signal import StopSignal
+from ros_gz_bridge_py.core.bridge import Bridge
+from ros_gz_bridge_py.core.channel import Channel, ChannelState, GzToRosChannel
+from ros_gz_bridge_py.core.services import ServiceBridge
+from ros_gz_bridge_py.ros.runtime import make_executor, spin_until_stopped
 
 #: Prefix of every DiagnosticStatus name, as ``ros_gz_bridge: <direction> <ros name>``.
 NAME_PREFIX = "ros_gz_bridge"

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ros_gz_bridge_py.config_model import (
+from ros_gz_bridge_py.config.model import (
     BridgeSpec,
     Direction,
     ParseResult,

@@ -21,8 +21,8 @@ holds as many, per topic.)
 Pairs with a bulk path (Image, PointCloud2) take it unless ``ChannelContext.bulk_path`` is off:
 serialized messages on the ROS side, the bulk bytes copied once, and the DDS write made with
 the GIL released (see :mod:`ros_gz_bridge_py.bulk`). The other ROS->Gazebo channels take the
-serialized message too and read it with :mod:`ros_gz_bridge_py.ros_cdr` (several times cheaper
-than rclpy's message objects) unless ``ChannelContext.light_read`` is off.
+serialized message too and read it with :mod:`ros_gz_bridge_py.ros.light_reader` (several
+times cheaper than rclpy's message objects) unless ``ChannelContext.light_read`` is off.
 """
 
 from __future__ import annotations
@@ -40,16 +40,16 @@ from typing import Any
 from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
 
-from ros_gz_bridge_py import ros_cdr
 from ros_gz_bridge_py.bulk.path import BulkPath, gz_to_ros_cdr, ros_cdr_to_gz
 from ros_gz_bridge_py.bulk.serialized_publisher import SerializedPublisher
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.diagnosis import Finding, Flow
+from ros_gz_bridge_py.core.diagnosis import Finding, Flow
+from ros_gz_bridge_py.core.loop_guard import OwnPublications
 from ros_gz_bridge_py.errors import ConversionError
-from ros_gz_bridge_py.loop_guard import OwnPublications
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.qos import (
+from ros_gz_bridge_py.ros import light_reader
+from ros_gz_bridge_py.ros.qos import (
     PUBLISHER_OVERRIDES,
     SUBSCRIPTION_OVERRIDES,
     endpoint_qos,
@@ -393,7 +393,7 @@ class RosToGzChannel(Channel):
         self._light = (
             ctx.light_read
             and self.bulk is None
-            and ros_cdr.reader_for(self.pair.ros_class) is not None
+            and light_reader.reader_for(self.pair.ros_class) is not None
         )
         self._subscription: Any = None
         self._subscription_node: Any = None
@@ -497,7 +497,7 @@ class RosToGzChannel(Channel):
     def _read(self, cdr: bytes) -> Any:
         """The message in ``cdr`` for ``to_gz``: a light tree, or rclpy's message when the
         encapsulation is not plain little-endian CDR."""
-        tree = ros_cdr.read(cdr, self.pair.ros_class)
+        tree = light_reader.read(cdr, self.pair.ros_class)
         return tree if tree is not None else deserialize_message(cdr, self.pair.ros_class)
 
     def _publish_serialized(self, publisher: Publisher, cdr: bytes) -> None:

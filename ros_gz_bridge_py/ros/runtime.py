@@ -27,8 +27,8 @@ from typing import Any
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import get_default_context
 
-from ros_gz_bridge_py.ros_speed import apply_fastdds_profile
-from ros_gz_bridge_py.stop_signal import StopSignal
+from ros_gz_bridge_py.app.stop_signal import StopSignal
+from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
 
 M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3

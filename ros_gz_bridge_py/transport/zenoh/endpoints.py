@@ -1,4 +1,4 @@
-"""The handles a :class:`~ros_gz_bridge_py.transport.zenoh_node.ZenohNode` gives out.
+"""The handles a :class:`~ros_gz_bridge_py.transport.zenoh.node.ZenohNode` gives out.
 
 Each handle owns its Zenoh entities (publisher, subscriber or queryable) and its liveliness
 token, and undeclares exactly those when closed, so closing one never affects another.
@@ -19,7 +19,7 @@ from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue, payload_
 from ros_gz_bridge_py.transport.wire_types import WireTypeCache
 
 if TYPE_CHECKING:
-    from ros_gz_bridge_py.transport.zenoh_node import ZenohNode
+    from ros_gz_bridge_py.transport.zenoh.node import ZenohNode
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 

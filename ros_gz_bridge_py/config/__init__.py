@@ -61,8 +61,8 @@ is in ``ConfigError.source``.
 
 from __future__ import annotations
 
-from ros_gz_bridge_py.config_cli import USAGE, parse_cli_args
-from ros_gz_bridge_py.config_model import (
+from ros_gz_bridge_py.config.cli import USAGE, parse_cli_args
+from ros_gz_bridge_py.config.model import (
     QOS_PROFILE_NAMES,
     BridgeSpec,
     Direction,
@@ -71,9 +71,9 @@ from ros_gz_bridge_py.config_model import (
     TopicBridgeSpec,
     UsageError,
 )
-from ros_gz_bridge_py.config_names import expand_topic_name
-from ros_gz_bridge_py.config_params import parse_parameter_bridges
-from ros_gz_bridge_py.config_yaml import parse_yaml, read_yaml_file
+from ros_gz_bridge_py.config.names import expand_topic_name
+from ros_gz_bridge_py.config.params import parse_parameter_bridges
+from ros_gz_bridge_py.config.yaml_file import parse_yaml, read_yaml_file
 
 __all__ = [
     "QOS_PROFILE_NAMES",
