@@ -26,7 +26,7 @@ from typing import Any
 
 from benchmarks.report import write_section
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import create_node
+from ros_gz_bridge_py.transport import create_gz_node
 from tests.gzpeer import peer_binary, start_process, stop_processes, wait_for_line
 
 BYTES_TYPE = "ignition.msgs.Bytes"
@@ -76,7 +76,7 @@ def run_pub(topic: str, size: int, seconds: float, hz: float) -> None:
     stop = _stop_on_sigterm()
     message = bytearray(message_class(BYTES_TYPE)(data=bytes(max(size, 8))).SerializeToString())
     at = data_offset(bytes(message))
-    with create_node() as node:
+    with create_gz_node() as node:
         publisher = node.advertise(topic, BYTES_TYPE)
         print("READY", flush=True)
         deadline = time.monotonic() + 5
@@ -118,7 +118,7 @@ def run_sub(topic: str, seconds: float) -> None:
         arrivals.append(now)
         total[0] += len(payload)
 
-    with create_node() as node:
+    with create_gz_node() as node:
         subscription = node.subscribe(topic, on_message, BYTES_TYPE)
         print("READY", flush=True)
         stop.wait(seconds)

@@ -24,7 +24,7 @@ from benchmarks.payloads import KINDS, GzPayloads, Kind, gz_stamp, now_ns, ros_s
 from benchmarks.transport import stats_line
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
-from ros_gz_bridge_py.transport import MessageInfo, create_node
+from ros_gz_bridge_py.transport import MessageInfo, create_gz_node
 
 #: How long a publisher waits for its first subscriber.
 MATCH_WAIT = 15.0
@@ -179,7 +179,7 @@ def _announce_match(matched: Callable[[], bool]) -> None:
 
 def gz_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
     payloads = GzPayloads(kind)
-    with create_node() as node:
+    with create_gz_node() as node:
         publisher = node.advertise(topic, kind.gz_type)
         say("READY")
         deadline = time.monotonic() + MATCH_WAIT
@@ -203,7 +203,7 @@ def gz_sub(topic: str, kind: Kind, seconds: float, slow_s: float) -> None:
     def on_message(payload: bytes, _info: MessageInfo) -> None:
         recorder.record(gz_stamp(kind, parse(payload)), len(payload))
 
-    with create_node() as node:
+    with create_gz_node() as node:
         subscription = node.subscribe(topic, on_message, kind.gz_type)
         say("READY")
         _announce_match(lambda: bool(node.topic_info(topic)))

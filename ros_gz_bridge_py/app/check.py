@@ -23,8 +23,7 @@ from ros_gz_bridge_py.core.explain import gazebo_name, ros_endpoints, type_hints
 from ros_gz_bridge_py.errors import ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.qos import endpoint_qos, gz_to_ros_publisher_qos
-from ros_gz_bridge_py.transport import Node as GzNode
-from ros_gz_bridge_py.transport import Publisher
+from ros_gz_bridge_py.transport import GzNode, Publisher
 from ros_gz_bridge_py.transport.api import GraphEndpoint
 
 #: Seconds ``--check`` listens by default: discovery re-announces every second, the ROS graph

@@ -44,7 +44,7 @@ from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
-from ros_gz_bridge_py.transport import NodeOptions, create_node
+from ros_gz_bridge_py.transport import NodeOptions, create_gz_node
 
 NODE_NAME = "ros_gz_bridge"
 #: ``parameter_bridge --check [SECONDS]``: report on the entries instead of bridging them.
@@ -225,7 +225,7 @@ def check(node: Node, cli: ParseResult, params: dict[str, Any], seconds: float) 
     options = NodeOptions(implementation=params["gz_transport_implementation"] or None)
     executor = make_executor()
     executor.add_node(node)
-    with create_node(options) as gz_node:
+    with create_gz_node(options) as gz_node:
         sides = Sides(node, gz_node, default_registry())
         status = run_check(sides, specs, seconds, out=sys.stdout, spin_once=executor.spin_once)
     if errors:

@@ -52,8 +52,7 @@ from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT, ServiceBridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.ros.side_node import SideNode, side_node_name
-from ros_gz_bridge_py.transport import Node as GzNode
-from ros_gz_bridge_py.transport import NodeOptions, create_node
+from ros_gz_bridge_py.transport import GzNode, NodeOptions, create_gz_node
 
 #: Environment switch: ``off`` sends images and point clouds through the object path.
 BULK_PATH_ENV = "ROS_GZ_BRIDGE_BULK_PATH"
@@ -117,7 +116,7 @@ class Bridge:
             gz_options = dataclasses.replace(
                 gz_options or NodeOptions(), legacy_spelling=Spelling.GZ
             )
-        self.gz_node = gz_node if gz_node is not None else create_node(gz_options)
+        self.gz_node = gz_node if gz_node is not None else create_gz_node(gz_options)
         self._side: SideNode | None = None
         self._ctx = ChannelContext(
             ros_node=ros_node,

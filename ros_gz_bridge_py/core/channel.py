@@ -55,7 +55,7 @@ from ros_gz_bridge_py.ros.qos import (
     endpoint_qos,
     gz_to_ros_publisher_qos,
 )
-from ros_gz_bridge_py.transport import MessageInfo, Node, Publisher, Subscription
+from ros_gz_bridge_py.transport import GzNode, MessageInfo, Publisher, Subscription
 
 #: Minimum seconds between two log lines about conversion errors of one channel.
 ERROR_LOG_PERIOD = 5.0
@@ -110,7 +110,7 @@ class ChannelContext:
     """What channels share: the nodes and the node-wide options."""
 
     ros_node: Any
-    gz_node: Node
+    gz_node: GzNode
     #: The bridge's side node (created on first use), for subscriptions that need message info.
     side_node: Callable[[], Any]
     #: (name, namespace) of the bridge's own ROS nodes, left out when counting readers.

@@ -29,7 +29,7 @@ from ros_gz_bridge_py.core.diagnosis import (
     findings,
     flow,
 )
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 
 #: Seconds between two evaluations of every channel.

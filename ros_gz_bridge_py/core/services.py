@@ -19,7 +19,7 @@ from ros_gz_bridge_py.errors import ConfigError, ConversionError, TransportError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.side_node import SideNode
-from ros_gz_bridge_py.transport import Node
+from ros_gz_bridge_py.transport import GzNode
 
 DEFAULT_TIMEOUT = 5.0
 
@@ -58,7 +58,7 @@ class ServiceBridge:
     def __init__(
         self,
         host: SideNode,
-        gz_node: Node,
+        gz_node: GzNode,
         spec: ServiceBridgeSpec,
         pair: ServicePair,
         timeout: float = DEFAULT_TIMEOUT,

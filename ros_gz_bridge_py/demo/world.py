@@ -20,7 +20,7 @@ from typing import Any
 from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.demo import sim, topics
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import MessageInfo, Node, Publisher, create_node
+from ros_gz_bridge_py.transport import GzNode, MessageInfo, Publisher, create_gz_node
 
 #: Physics steps per second; the publish periods below are in steps.
 STEP_HZ = 100
@@ -188,7 +188,7 @@ def image_message(state: sim.RobotState, stamp: float, frame: int) -> Any:
 class World:
     """The robot, its command, and one publisher per sensor topic on ``node``."""
 
-    def __init__(self, node: Node, room: sim.Room | None = None) -> None:
+    def __init__(self, node: GzNode, room: sim.Room | None = None) -> None:
         self.room = room or sim.Room()
         self.state = sim.RobotState()
         self._command = (0.0, 0.0)
@@ -248,7 +248,7 @@ class World:
 
 
 def main() -> int:
-    with StopSignal() as stop, create_node() as node:
+    with StopSignal() as stop, create_gz_node() as node:
         world = World(node)
         print(f"READY: demo world publishing {len(topics.GZ_TO_ROS)} topics", flush=True)
         world.run(stop)

@@ -1,32 +1,36 @@
 """Gazebo Transport for Python: a node that talks to gz-transport 8-15 and ign-transport 11.
 
-``create_node()`` returns the backend gz itself would use: ``GZ_TRANSPORT_IMPLEMENTATION``
-(``zeromq``, the default, or ``zenoh``), or ``NodeOptions.implementation`` when given.
+``create_gz_node()`` returns a node of the backend gz itself would use:
+``GZ_TRANSPORT_IMPLEMENTATION`` (``zeromq``, the default, or ``zenoh``), or
+``NodeOptions.implementation`` when given; ``memory`` is an in-process backend for tests.
+Backends are data (:data:`BACKENDS`): a name and where its node class lives, loaded on use,
+so the ZeroMQ path never imports zenoh.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
 
 from ros_gz_bridge_py.errors import TransportError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE
 from ros_gz_bridge_py.transport.api import (
+    GraphEndpoint,
     MessageInfo,
-    Node,
     NodeOptions,
-    Publisher,
-    ServiceOffer,
-    Subscription,
     TopicInfo,
     TransportStats,
 )
+from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
+from ros_gz_bridge_py.transport.node import GzNode
 from ros_gz_bridge_py.transport.settings import TransportSettings
-from ros_gz_bridge_py.transport.zmq.node import ZmqNode
 
 __all__ = [
+    "BACKENDS",
     "GENERIC_TYPE",
+    "GraphEndpoint",
+    "GzNode",
     "MessageInfo",
-    "Node",
     "NodeOptions",
     "Publisher",
     "ServiceOffer",
@@ -34,31 +38,44 @@ __all__ = [
     "TopicInfo",
     "TransportSettings",
     "TransportStats",
-    "ZmqNode",
-    "create_node",
+    "create_gz_node",
 ]
 
+#: Backend name (``GZ_TRANSPORT_IMPLEMENTATION`` value) -> "module:class" of its node.
+BACKENDS: dict[str, str] = {
+    "zeromq": "ros_gz_bridge_py.transport.zmq.node:ZmqGzNode",
+    "zenoh": "ros_gz_bridge_py.transport.zenoh.node:ZenohGzNode",
+    "memory": "ros_gz_bridge_py.transport.memory.node:MemoryGzNode",
+}
 
-def create_node(options: NodeOptions | None = None) -> Node:
+
+def backend_class(name: str) -> type[GzNode]:
+    """The node class of backend ``name`` (case-insensitive).
+
+    Raises:
+        TransportError: no backend of that name.
+    """
+    where = BACKENDS.get(name.lower())
+    if where is None:
+        msg = (
+            f"Gazebo Transport implementation {name!r} is not available; use one of "
+            f"{', '.join(sorted(BACKENDS))} (GZ_TRANSPORT_IMPLEMENTATION)"
+        )
+        raise TransportError(msg)
+    module, _, cls = where.partition(":")
+    node_class: type[GzNode] = getattr(importlib.import_module(module), cls)
+    return node_class
+
+
+def create_gz_node(options: NodeOptions | None = None) -> GzNode:
     """A started node for ``options`` (environment defaults when None).
 
     Raises:
-        TransportError: the implementation is not available or the sockets cannot be opened.
+        TransportError: the implementation is not available or cannot start.
     """
     options = options or NodeOptions()
     settings = TransportSettings.from_env()
     if options.legacy_spelling is not None:
         settings = dataclasses.replace(settings, legacy_spelling=options.legacy_spelling)
-    implementation = (options.implementation or settings.implementation).lower()
-    if implementation == "zenoh":
-        # Imported here so the ZeroMQ path never loads zenoh.
-        from ros_gz_bridge_py.transport.zenoh.node import ZenohNode  # noqa: PLC0415
-
-        return ZenohNode(options.partition, options.namespace, settings)
-    if implementation != "zeromq":
-        msg = (
-            f"Gazebo Transport implementation {implementation!r} is not available; "
-            "use 'zeromq' or 'zenoh' (GZ_TRANSPORT_IMPLEMENTATION)"
-        )
-        raise TransportError(msg)
-    return ZmqNode(options.partition, options.namespace, settings)
+    node_class = backend_class(options.implementation or settings.implementation)
+    return node_class(options.partition, options.namespace, settings)

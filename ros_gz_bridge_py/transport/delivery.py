@@ -1,8 +1,11 @@
-"""A bounded drop-oldest queue drained by its own thread.
+"""Handing received payloads to callbacks: the deliverers, and the one drop-oldest queue.
 
-A subscription created with ``queue_size=N`` delivers through one of these, so a slow
-callback delays only its own topic and never the node's I/O thread. When the queue is full
-the oldest message is dropped and counted, the same policy as ROS "keep last N".
+A subscription created with ``queue_size=N`` keeps at most the newest N messages (and at most
+:data:`MAX_QUEUED_BYTES` of them) between the network and its callback, so a slow callback
+delays only its own topic and never a backend's I/O thread; when full, the oldest message is
+dropped and counted, the policy of ROS "keep last N". Every backend keeps them in a
+:class:`DropOldestQueue`: the ZeroMQ reader fills and drains it on its own thread
+(``zmq/reader.py``), the others through a :class:`DeliveryQueue`, which drains it on a thread.
 """
 
 from __future__ import annotations
@@ -26,6 +29,11 @@ Payload = bytes | bytearray | memoryview
 #: A node's counter increment, e.g. ``node.count("callback_errors")``.
 Count = Callable[[str], None]
 Deliver = Callable[[Payload, "MessageInfo"], None]
+#: One received message waiting in a queue: its payload and what the callback is told.
+Delivery = tuple[Payload, "MessageInfo"]
+
+#: Bytes a delivery queue may hold (at least one item is always kept): ten 1080p frames.
+MAX_QUEUED_BYTES = 64 * 1024 * 1024
 
 
 def raw_deliverer(
@@ -70,13 +78,9 @@ def typed_deliverer(
     return deliver
 
 
-def payload_size(item: tuple[Payload, MessageInfo]) -> int:
-    """The weight of a queued (payload, info) delivery: its payload's size."""
+def payload_size(item: Delivery) -> int:
+    """The weight of a queued delivery: its payload's size."""
     return len(item[0])
-
-
-#: Bytes a delivery queue may hold (at least one item is always kept): ten 1080p frames.
-MAX_QUEUED_BYTES = 64 * 1024 * 1024
 
 
 def require_queue_size(size: int) -> None:
@@ -90,16 +94,88 @@ def require_queue_size(size: int) -> None:
         raise ValueError(msg)
 
 
-class DeliveryQueue(Generic[T]):
-    """Hands items to ``handler`` on a dedicated daemon thread, keeping the newest ``size``
-    items and no more than ``max_bytes`` of them as ``weigh`` measures (but always one).
+class QueueClosedError(Exception):
+    """:meth:`DropOldestQueue.get` after :meth:`DropOldestQueue.close`."""
+
+
+class DropOldestQueue(Generic[T]):
+    """The newest ``size`` items, and no more than ``max_bytes`` of them as ``weigh`` measures
+    (but always one); :meth:`put` from any thread, :meth:`get` by one consumer.
 
     Built on :class:`queue.SimpleQueue`, whose put and get are single C calls: at tens of
-    thousands of small messages per second a Condition-based queue costs the producer (the
-    node's I/O thread) more than the message itself. The bound is kept by the producer, which
-    takes the oldest item out when the queue is over ``size``; a get racing with that can make
-    the queue briefly hold one more or one fewer item, never an unbounded number.
-    ``on_start`` runs on the delivery thread before it takes the first item.
+    thousands of small messages per second a Condition-based queue costs the producer more
+    than the message itself. The producer keeps the bound, taking the oldest items out when
+    the queue is over it; a get racing with that can make the queue briefly hold one item more
+    or fewer, never an unbounded number.
+    """
+
+    def __init__(
+        self, size: int, *, weigh: Callable[[T], int], max_bytes: int = MAX_QUEUED_BYTES
+    ) -> None:
+        require_queue_size(size)
+        self._size = size
+        self._weigh = weigh
+        self._max_bytes = max_bytes
+        # Queued bytes = put - dropped (written by producers) - taken (by the consumer).
+        self._bytes_put = self._bytes_dropped = self._bytes_taken = 0
+        self._items: queue.SimpleQueue[T | object] = queue.SimpleQueue()
+        #: Items dropped so far, oldest first.
+        self.dropped = 0
+
+    def put(self, item: T) -> int:
+        """Queue ``item``; returns how many older items that pushed out."""
+        items = self._items
+        weigh = self._weigh
+        self._bytes_put += weigh(item)
+        items.put(item)
+        dropped = 0
+        while items.qsize() > self._size or self._over_budget():
+            try:
+                oldest = items.get_nowait()
+            except queue.Empty:  # the consumer took it first
+                break
+            if oldest is _CLOSED:  # never drop the end mark
+                items.put(oldest)
+                break
+            self._bytes_dropped += weigh(cast(T, oldest))
+            dropped += 1
+        self.dropped += dropped
+        return dropped
+
+    def _over_budget(self) -> bool:
+        queued = self._bytes_put - self._bytes_dropped - self._bytes_taken
+        return queued > self._max_bytes and self._items.qsize() > 1
+
+    def get(self, *, block: bool = True, timeout: float | None = None) -> T:
+        """The oldest item; waiting (up to ``timeout`` seconds, None: for ever) if ``block``.
+
+        Raises:
+            queue.Empty: nothing is there (``block`` False) or came within ``timeout``.
+            QueueClosedError: the queue was closed.
+        """
+        item = self._items.get(block, timeout)
+        if item is _CLOSED:
+            self._items.put(item)  # every later get sees it too
+            raise QueueClosedError
+        self._bytes_taken += self._weigh(cast(T, item))
+        return cast(T, item)
+
+    def __len__(self) -> int:
+        return self._items.qsize()
+
+    def close(self) -> None:
+        """Wake the consumer: every later :meth:`get` raises :class:`QueueClosedError`."""
+        self._items.put(_CLOSED)
+
+
+#: The end mark :meth:`DropOldestQueue.close` puts in.
+_CLOSED = object()
+
+
+class DeliveryQueue(Generic[T]):
+    """A :class:`DropOldestQueue` whose items ``handler`` takes on a daemon thread of its own.
+
+    ``on_start`` runs on that thread before it takes the first item.
     """
 
     def __init__(
@@ -112,60 +188,38 @@ class DeliveryQueue(Generic[T]):
         max_bytes: int = MAX_QUEUED_BYTES,
         on_start: Callable[[], None] | None = None,
     ) -> None:
-        require_queue_size(size)
-        self._size = size
-        self._weigh = weigh
-        self._max_bytes = max_bytes
-        # Queued bytes = put - dropped (written by the producer) - handled (by the consumer);
-        # one writer per counter, so no lock on the hot path.
-        self._bytes_put = self._bytes_dropped = self._bytes_handled = 0
-        self._items: queue.SimpleQueue[T | object] = queue.SimpleQueue()
+        self._queue: DropOldestQueue[T] = DropOldestQueue(size, weigh=weigh, max_bytes=max_bytes)
         self._handler = handler
         self._on_start = on_start
         self._closed = False
-        self.dropped = 0
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
 
-    def put(self, item: T) -> bool:
-        """Queue ``item``; False if that pushed out older ones."""
-        items = self._items
-        weigh = self._weigh
-        self._bytes_put += weigh(item)
-        items.put(item)
-        kept = True
-        while items.qsize() > self._size or self._over_budget():
-            try:
-                oldest = items.get_nowait()
-            except queue.Empty:  # the delivery thread took it first
-                break
-            self._bytes_dropped += weigh(cast(T, oldest))
-            self.dropped += 1
-            kept = False
-        return kept
+    @property
+    def dropped(self) -> int:
+        """Items dropped so far, oldest first."""
+        return self._queue.dropped
 
-    def _over_budget(self) -> bool:
-        queued = self._bytes_put - self._bytes_dropped - self._bytes_handled
-        return queued > self._max_bytes and self._items.qsize() > 1
+    def put(self, item: T) -> int:
+        """Queue ``item``; returns how many older items that pushed out."""
+        return self._queue.put(item)
 
     def close(self) -> None:
         """Stop after the item being handled; pending items are discarded. Idempotent."""
         self._closed = True
-        self._items.put(_STOP)
+        self._queue.close()
         if self._thread is not threading.current_thread():
             self._thread.join()
 
     def _run(self) -> None:
         if self._on_start is not None:
             self._on_start()
-        get = self._items.get
+        get = self._queue.get
         while True:
-            item = cast(T, get())  # only _STOP is not a T, and it comes after close
+            try:
+                item = get()
+            except QueueClosedError:
+                return
             if self._closed:
                 return
-            self._bytes_handled += self._weigh(item)
             self._handler(item)
-
-
-#: Wakes the delivery thread for :meth:`DeliveryQueue.close`.
-_STOP = object()

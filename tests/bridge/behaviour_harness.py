@@ -6,7 +6,7 @@
 * :class:`RosSide` is an rclpy node in a context of its own, spun by a background thread; every
   call that touches the node goes through :meth:`RosSide.run`, which holds the lock the spin
   loop holds, so entities are never created or destroyed under a running ``spin_once``.
-* The Gazebo side is our own ``ZmqNode`` (``create_node()``), whose publishers tell through
+* The Gazebo side is our own ``ZmqGzNode`` (``create_gz_node()``), whose publishers tell through
   ``has_connections()`` whether the bridge subscribed, and whose discovery lists what the
   bridge advertised.
 
@@ -30,8 +30,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile
 from rclpy.utilities import try_shutdown
 
-from ros_gz_bridge_py.transport import Node as GzNode
-from ros_gz_bridge_py.transport import create_node
+from ros_gz_bridge_py.transport import GzNode, create_gz_node
 from tests.gzpeer import Inbox, PeerProcess, start_process, wait_for_line, wait_until
 
 #: The console script of this venv (``pip install -e .`` put it next to the interpreter).
@@ -175,5 +174,5 @@ def ros_side() -> Iterator[RosSide]:
 
 @pytest.fixture(scope="module")
 def gz_node() -> Iterator[GzNode]:
-    with create_node() as node:
+    with create_gz_node() as node:
         yield node

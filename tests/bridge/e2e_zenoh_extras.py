@@ -1,6 +1,6 @@
 """A Gazebo-side service provider over Zenoh: ``python e2e_zenoh_extras.py SERVICE SECONDS``.
 
-Our ``ZenohNode`` (created as gz-transport 15 creates one, from ``GZ_TRANSPORT_IMPLEMENTATION``
+Our ``ZenohGzNode`` (created as gz-transport 15 creates one, from ``GZ_TRANSPORT_IMPLEMENTATION``
 and ``GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE``) offers SERVICE with ``gz.msgs.WorldControl``
 requests and ``gz.msgs.Boolean`` replies, answering ``data: true``. Output: ``NODE <class>``,
 ``READY``, then ``REQUEST <one-line text of the request>`` per request. Runs until SIGTERM or
@@ -16,7 +16,7 @@ from google.protobuf import text_format
 
 from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import create_node
+from ros_gz_bridge_py.transport import create_gz_node
 
 REQUEST_TYPE = "gz.msgs.WorldControl"
 REPLY_TYPE = "gz.msgs.Boolean"
@@ -38,7 +38,7 @@ def main() -> int:
             emit(f"REQUEST {text_format.MessageToString(request, as_one_line=True)}")
             return True, reply
 
-        with create_node() as node:
+        with create_gz_node() as node:
             emit(f"NODE {type(node).__name__}")
             node.advertise_service(service, REQUEST_TYPE, REPLY_TYPE, handle)
             emit("READY")

@@ -1,4 +1,4 @@
-"""The Gazebo side of the Zenoh end-to-end tests: our ``ZenohNode`` in a process of its own.
+"""The Gazebo side of the Zenoh end-to-end tests: our ``ZenohGzNode`` in a process of its own.
 
 Usage: ``python e2e_zenoh_gazebo.py SPEC`` where SPEC is JSON::
 
@@ -22,7 +22,7 @@ from google.protobuf import text_format
 
 from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import MessageInfo, create_node
+from ros_gz_bridge_py.transport import MessageInfo, create_gz_node
 
 _PUBLISH_PERIOD = 0.2
 
@@ -34,7 +34,7 @@ def emit(text: str) -> None:
 
 def main() -> int:
     spec = json.loads(sys.argv[1])
-    with StopSignal() as stop, create_node() as node:
+    with StopSignal() as stop, create_gz_node() as node:
         emit(f"NODE {type(node).__name__}")
         publishers = []
         for topic, gz_type, text in spec.get("publish", []):

@@ -16,7 +16,7 @@ import pytest
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     STRING,
     WAIT,

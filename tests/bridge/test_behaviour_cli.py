@@ -11,7 +11,7 @@ import subprocess
 import pytest
 
 from ros_gz_bridge_py.config import USAGE
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     STRING,
     WAIT,

@@ -18,7 +18,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from tf2_msgs.msg import TFMessage
 
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     STRING,
     WAIT,

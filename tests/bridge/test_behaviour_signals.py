@@ -17,7 +17,7 @@ import uuid
 import pytest
 from rcl_interfaces.srv import ListParameters
 
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from ros_gz_bridge_py.transport.zmq.discovery import SILENCE_INTERVAL
 from tests.bridge.behaviour_harness import (
     PARAMETER_BRIDGE,

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     STRING,
     WAIT,

@@ -25,7 +25,7 @@ from ros_gz_bridge_py.core.bridge import BULK_PATH_ENV as BULK_ENV
 from ros_gz_bridge_py.core.channel import BULK_THREAD_NICE
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     WAIT,
     RosSide,

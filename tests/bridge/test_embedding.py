@@ -20,7 +20,7 @@ import rclpy
 from ros_gz_bridge_py import Bridge
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.core.bridge import BridgeOptions
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     STRING,
     WAIT,

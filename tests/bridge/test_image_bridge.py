@@ -1,4 +1,4 @@
-"""image_bridge end to end: real Gazebo publishers (the C++ ign peer, our ZmqNode), real rclpy.
+"""image_bridge end to end: real Gazebo publishers (the C++ ign peer, our ZmqGzNode), real rclpy.
 
 One lazy ``image_bridge`` process serves most tests: two plain topics, a renamed one, a lazy
 probe, a topic for bad frames, and a config file with one image entry and one entry it skips;
@@ -19,7 +19,7 @@ from typing import Any
 import pytest
 from sensor_msgs.msg import CameraInfo, Image
 
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     WAIT,
     RosSide,

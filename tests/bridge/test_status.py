@@ -2,7 +2,7 @@
 
 One ``parameter_bridge`` process (``status_period:=0.5``) bridges a String and an Image topic
 Gazebo -> ROS, a String topic ROS -> Gazebo, a service, and a lazy topic nobody reads. The
-Gazebo side is our ``ZmqNode``, the ROS side an rclpy node. Counters are cumulative, so each
+Gazebo side is our ``ZmqGzNode``, the ROS side an rclpy node. Counters are cumulative, so each
 count check first lets the channel settle after its warm-up messages (the first messages after
 discovery may be lost) and then compares the increase with exactly what the test sent.
 """
@@ -22,7 +22,7 @@ from sensor_msgs.msg import Image
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import Node as GzNode
+from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     STRING,
     WAIT,

@@ -1,6 +1,6 @@
 """The TurtleBot3 configuration bridges every entry over Zenoh (gz-transport 15), end to end.
 
-There is no Jetty binary here, so the Gazebo side is our ``ZenohNode`` in a process of its own
+There is no Jetty binary here, so the Gazebo side is our ``ZenohGzNode`` in a process of its own
 (``e2e_zenoh_gazebo.py``) publishing the Gazebo->ROS entries and echoing ``cmd_vel``. The
 bridge is the real ``parameter_bridge`` with ``GZ_TRANSPORT_IMPLEMENTATION=zenoh`` and its
 Zenoh configuration in ``GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE``, gz-transport's own variable:
@@ -149,7 +149,7 @@ class ZenohE2E:
 
     def test_gazebo_side_speaks_zenoh(self, run: ZenohRun) -> None:
         # Data that reached a Zenoh-only peer proves the bridge used Zenoh too.
-        assert lines(run.cmd_vel.proc, "NODE ") == ["ZenohNode"]
+        assert lines(run.cmd_vel.proc, "NODE ") == ["ZenohGzNode"]
 
     def test_cmd_vel_arrives_in_gazebo_converted(self, run: ZenohRun) -> None:
         arrived = run.cmd_vel.messages()

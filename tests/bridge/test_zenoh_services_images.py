@@ -1,6 +1,6 @@
 """A service bridge and ``image_bridge`` over Zenoh (gz-transport 15), end to end.
 
-The Gazebo side is our ``ZenohNode`` in a process of its own: ``e2e_zenoh_extras.py`` offers
+The Gazebo side is our ``ZenohGzNode`` in a process of its own: ``e2e_zenoh_extras.py`` offers
 a ``gz.msgs.WorldControl``/``gz.msgs.Boolean`` service, ``e2e_zenoh_gazebo.py`` publishes a
 ``gz.msgs.Image``. The bridges are the real console scripts with
 ``GZ_TRANSPORT_IMPLEMENTATION=zenoh`` and ``GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE`` set as in
@@ -99,7 +99,7 @@ def test_control_world_service_over_zenoh(group: ProcessGroup, ros_side: RosSide
     )
     gazebo = group.python(SERVICE_SIDE, served, GAZEBO_SECONDS, env=gazebo_env)
     wait_for_line(gazebo, "^READY$", timeout=15)
-    assert lines(gazebo, "NODE ") == ["ZenohNode"]
+    assert lines(gazebo, "NODE ") == ["ZenohGzNode"]
 
     client = ros_side.run(lambda: ros_side.node.create_client(ControlWorld, served))
     absent_client = ros_side.run(lambda: ros_side.node.create_client(ControlWorld, absent))
@@ -147,7 +147,7 @@ def test_image_bridge_over_zenoh(group: ProcessGroup, ros_side: RosSide) -> None
     }
     gazebo = group.python(GAZEBO_SIDE, json.dumps(spec), env=gazebo_env)
     wait_for_line(gazebo, "^READY$", timeout=15)
-    assert lines(gazebo, "NODE ") == ["ZenohNode"]
+    assert lines(gazebo, "NODE ") == ["ZenohGzNode"]
     if not inbox.holds_within(bool, 2 * WAIT):
         pytest.fail(f"no image in ROS; bridge:\n{bridge.output()}\ngazebo:\n{gazebo.output()}")
     image, _ = inbox.items()[0]

@@ -17,7 +17,7 @@ _ROOT = str(Path(__file__).resolve().parents[2])
 if _ROOT not in sys.path:
     sys.path.insert(0, _ROOT)
 
-from ros_gz_bridge_py.transport import create_node  # noqa: E402
+from ros_gz_bridge_py.transport import create_gz_node  # noqa: E402
 from tests.gzpeer import gz_processes, ign_peer  # noqa: E402
 
 __all__ = ["gz_node", "gz_processes", "ign_peer", "stop_started_processes"]
@@ -31,5 +31,5 @@ def stop_started_processes(gz_processes: None) -> None:
 @pytest.fixture
 def gz_node() -> Iterator[Any]:
     """A started node of ours (closed after the test)."""
-    with create_node() as node:
+    with create_gz_node() as node:
         yield node

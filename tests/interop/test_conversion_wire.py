@@ -2,7 +2,7 @@
 
 Gazebo to ROS: for one representative pair of each gz package family, a real publisher (the C++
 peer's ``pub`` mode, and for two cases also the Debian CLI one-shot ``ign-transport-topic -p``)
-sends a message built from a text protobuf with distinctive values. Our ZmqNode subscribes raw
+sends a message built from a text protobuf with distinctive values. Our ZmqGzNode subscribes raw
 with the exact Fortress type string ``ignition.msgs.X``; the bytes are decoded with
 ``message_class("ignition.msgs.X")``, converted with the registry's pair, and the ROS fields are
 checked against ``/work/shared/spec/conversions.md`` (section numbers in the checks). The peer
@@ -13,7 +13,7 @@ Of the pairs added for issue 16, LogicalCameraImage and LogPlaybackStatistics ar
 both ways. AirSpeed, DVLVelocityTracking (Harmonic+) and NavSatWithCovariance (Jetty) are not:
 ign-msgs 8 has no such types, so the Fortress peer can neither build nor decode them.
 
-ROS to Gazebo: for a few pairs, our ``to_gz`` output is serialized, published by our ZmqNode
+ROS to Gazebo: for a few pairs, our ``to_gz`` output is serialized, published by our ZmqGzNode
 under ``ignition.msgs.X`` and printed by the C++ peer's ``echo`` mode (decoded with the Fortress
 schema compiled into ign-msgs 8); the printed text is checked for the expected fields and parsed
 back into the message we sent.
@@ -77,7 +77,7 @@ from vision_msgs.msg import Detection2D
 
 from ros_gz_bridge_py.converters import default_registry
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.transport import create_node
+from ros_gz_bridge_py.transport import create_gz_node
 from tests.gzpeer import (
     IGN_TOPIC,
     Inbox,
@@ -809,7 +809,7 @@ def run_limited(jobs: Sequence[Any], parallel: int) -> None:
 def gz_node() -> Iterator[Any]:
     """One node of ours for the whole module (overrides the per-test one of conftest)."""
     require_peer()
-    with create_node() as node:
+    with create_gz_node() as node:
         yield node
 
 

@@ -1,1 +1,1 @@
-"""transport/zenoh."""
+"""The Zenoh backend of gz-transport 15 (docs/protocol.md §4)."""

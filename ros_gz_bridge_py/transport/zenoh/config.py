@@ -113,3 +113,21 @@ def endpoints_config(
     config.insert_json5("listen/endpoints", json.dumps(list(listen)))
     config.insert_json5("connect/endpoints", json.dumps(list(connect)))
     return config
+
+
+def describe_session(config: zenoh.Config) -> str:
+    """``Zenoh peer, connect [...], listen [...], multicast scouting on`` for users."""
+
+    def value(key: str) -> str:
+        try:
+            return str(config.get_json(key))
+        except zenoh.ZError:
+            return "?"
+
+    mode = value("mode").strip('"')
+    mode = "peer" if mode in ("null", "?") else mode
+    scouting = "off" if value("scouting/multicast/enabled") == "false" else "on"
+    return (
+        f"Zenoh {mode}, connect {value('connect/endpoints')}, listen "
+        f"{value('listen/endpoints')}, multicast scouting {scouting}"
+    )

@@ -1,1 +1,1 @@
-"""transport/zmq."""
+"""The ZeroMQ backend of every Gazebo line (docs/protocol.md §2)."""

@@ -8,10 +8,12 @@ subscribed to its one topic and connected to that topic's publishers, and its th
 reads and delivers: no hand-over, and each topic has its own TCP connection, so a flooded
 topic's back-pressure never holds another topic's messages.
 
-The newest ``size`` messages (and at most ``max_bytes`` of them) wait; the socket is drained
-between deliveries, so when the callback is slower than the publisher the oldest are dropped
-and counted, as with ROS "keep last". ZeroMQ sockets are single-threaded: connects and local
-(intra-process) messages from other threads are posted to the reader and it wakes up.
+The newest ``size`` messages (and at most ``max_bytes`` of them) wait in the transport's one
+:class:`~ros_gz_bridge_py.transport.delivery.DropOldestQueue`; the socket is drained between
+deliveries, so when the callback is slower than the publisher the oldest are dropped and
+counted, as with ROS "keep last". ZeroMQ sockets are single-threaded: connects from other
+threads are posted to the reader; local (intra-process) messages go into its queue; both wake
+it up.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import logging
+import queue
 import socket
 import threading
 import time
@@ -29,7 +32,14 @@ import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.transport.api import MessageInfo
-from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES, require_queue_size
+from ros_gz_bridge_py.transport.delivery import (
+    MAX_QUEUED_BYTES,
+    Delivery,
+    DropOldestQueue,
+    Payload,
+    QueueClosedError,
+    payload_size,
+)
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
 
@@ -46,8 +56,6 @@ DELIVERY_SLICE = 0.001
 IDLE_POLL = 0.25
 #: Messages read from the socket per drain, so a flood cannot hold the thread in reading.
 READ_BATCH = 256
-#: One waiting message: the payload and what the callback is told about it.
-Delivery = tuple[Frame, MessageInfo]
 
 
 class SubscriptionReader:
@@ -63,24 +71,21 @@ class SubscriptionReader:
         deliver: Callable[[Frame, MessageInfo], None],
         size: int,
         rcvhwm: int,
-        count: Callable[[str], None],
+        count: Callable[..., None],
         on_start: Callable[[], None] | None = None,
         max_bytes: int = MAX_QUEUED_BYTES,
     ) -> None:
-        require_queue_size(size)
         self.fqn = fqn
-        self.dropped = 0
         self.received = 0
         self._partition = partition
         self._name = (decompose(fqn) or ("", fqn))[1]
         self._accepts = accepts
         self._deliver = deliver
-        self._size = size
-        self._max_bytes = max_bytes
+        self._pending: DropOldestQueue[Delivery] = DropOldestQueue(
+            size, weigh=payload_size, max_bytes=max_bytes
+        )
         self._count = count
         self._on_start = on_start
-        self._pending: collections.deque[Delivery] = collections.deque()
-        self._pending_bytes = 0
         self._infos: dict[tuple[Frame, Frame, Frame], MessageInfo | None] = {}
         self._connected: set[str] = set()
         self._posted: collections.deque[Callable[[], None]] = collections.deque()
@@ -102,9 +107,19 @@ class SubscriptionReader:
         """Connect to a publisher of the topic (once per address)."""
         self._post(lambda: self._connect(address))
 
-    def offer_local(self, payload: bytes, info: MessageInfo) -> None:
-        """An intra-process message: queued like a received one."""
-        self._post(lambda: self._keep((payload, info)))
+    @property
+    def dropped(self) -> int:
+        """Messages dropped so far, oldest first."""
+        return self._pending.dropped
+
+    def offer(self, payload: Payload, info: MessageInfo) -> int:
+        """An intra-process message (from any thread): queued like a received one; returns how
+        many older messages it pushed out."""
+        if self._closed:
+            return 0
+        dropped = self._pending.put((bytes(payload), info))
+        self._wake()
+        return dropped
 
     def close(self) -> None:
         """Stop after the message being delivered; pending ones are discarded. Idempotent."""
@@ -135,7 +150,7 @@ class SubscriptionReader:
             poller.register(self._wake_r.fileno(), zmq.POLLIN)
             while not self._closed:
                 try:
-                    poller.poll(0 if self._pending else int(IDLE_POLL * 1000))
+                    poller.poll(0 if len(self._pending) else int(IDLE_POLL * 1000))
                     self._turn()
                 except zmq.ContextTerminated:  # the node went away without closing us
                     return
@@ -154,9 +169,11 @@ class SubscriptionReader:
             self._posted.popleft()()
         self._drain()
         end = time.monotonic() + DELIVERY_SLICE
-        while self._pending and not self._closed:
-            payload, info = self._pending.popleft()
-            self._pending_bytes -= len(payload)
+        while not self._closed:
+            try:
+                payload, info = self._pending.get(block=False)
+            except (queue.Empty, QueueClosedError):
+                return
             self._deliver(payload, info)
             if time.monotonic() >= end:
                 return
@@ -208,16 +225,9 @@ class SubscriptionReader:
 
     def _keep(self, item: Delivery) -> None:
         """Queue ``item``, dropping the oldest beyond ``size`` messages or ``max_bytes``."""
-        self._pending.append(item)
-        self._pending_bytes += len(item[0])
-        pending = self._pending
-        while len(pending) > self._size or (
-            self._pending_bytes > self._max_bytes and len(pending) > 1
-        ):
-            payload, _ = pending.popleft()
-            self._pending_bytes -= len(payload)
-            self.dropped += 1
-            self._count("messages_dropped")
+        dropped = self._pending.put(item)
+        if dropped:
+            self._count("messages_dropped", dropped)
 
 
 def receive_message(sock: Any) -> list[Frame]:

@@ -1,4 +1,4 @@
-"""The service side of a :class:`~ros_gz_bridge_py.transport.zmq.node.ZmqNode` (§2.9).
+"""The service side of a :class:`~ros_gz_bridge_py.transport.zmq.node.ZmqGzNode` (§2.9).
 
 :class:`ServiceRouter` keeps the node's service offers, its calls waiting for a provider, a
 route or a response, and the ROUTER sends retried until their peer is routable. It runs on the
@@ -18,8 +18,9 @@ from typing import Any
 
 import zmq
 
-from ros_gz_bridge_py.msgs.names import canonical_type, same_message
-from ros_gz_bridge_py.transport.api import ONE_WAY_TYPES, ServiceCall
+from ros_gz_bridge_py.msgs.names import same_message
+from ros_gz_bridge_py.transport.api import ONE_WAY_TYPES, ReplyCallback, ServiceCall
+from ros_gz_bridge_py.transport.handles import ServiceOffer, offer_key
 from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine, Outgoing
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqServiceOffer
 from ros_gz_bridge_py.transport.zmq.wire import (
@@ -71,11 +72,23 @@ class RouterSockets:
 
 
 class ServiceRouter:
-    """Offers, outgoing calls and retried ROUTER sends of one node (I/O thread only)."""
+    """Offers, outgoing calls and retried ROUTER sends of one node (I/O thread only).
 
-    def __init__(self, sockets: RouterSockets, count: Callable[[str], None]) -> None:
+    ``run_handler`` runs an offer's handler (counting its errors); ``finish`` runs a call's
+    callback (likewise): the node's shared ways of doing both.
+    """
+
+    def __init__(
+        self,
+        sockets: RouterSockets,
+        count: Callable[[str], None],
+        run_handler: Callable[[ServiceOffer, bytes], tuple[bool, bytes]],
+        finish: Callable[[ReplyCallback, bool | None, bytes], None],
+    ) -> None:
         self._io = sockets
         self._count = count
+        self._run_handler = run_handler
+        self._finish_callback = finish
         self._offers: dict[tuple[str, str, str], ZmqServiceOffer] = {}
         self._calls: dict[str, PendingCall] = {}
         self._routed: list[RoutedSend] = []
@@ -85,18 +98,18 @@ class ServiceRouter:
     # --- offers -----------------------------------------------------------------------------
 
     def add_offer(self, offer: ZmqServiceOffer) -> None:
-        self._offers[_offer_key(*offer.key)] = offer
+        self._offers[offer.key] = offer
         self._io.announce(self._io.engine.advertise(offer.record))
 
     def remove_offer(self, offer: ZmqServiceOffer) -> None:
-        if self._offers.get(_offer_key(*offer.key)) is offer:
-            del self._offers[_offer_key(*offer.key)]
+        if self._offers.get(offer.key) is offer:
+            del self._offers[offer.key]
         self._io.announce(self._io.engine.unadvertise(offer.record))
 
     def on_request(self, frames: list[Frame]) -> None:
         """§2.9.3: look up the handler, run it, answer unless one-way."""
         request = decode_request(frames)
-        key = _offer_key(request.service, request.request_type, request.response_type)
+        key = offer_key(request.service, request.request_type, request.response_type)
         offer = self._offers.get(key)
         if offer is None:
             self._count("requests_unhandled")
@@ -113,20 +126,11 @@ class ServiceRouter:
         frames_out = encode_response(request.response_id, response)
         self._routed.append(RoutedSend(replier, frames_out, time.monotonic() + ROUTE_RETRY))
 
-    def _run_handler(self, offer: ZmqServiceOffer, request: bytes) -> tuple[bool, bytes]:
-        try:
-            ok, payload = offer.handler(request)
-        except Exception:
-            self._count("callback_errors")
-            _LOG.exception("service handler for %s raised", offer.record.topic)
-            return False, b""
-        return ok, payload if ok else b""
-
     # --- calls ------------------------------------------------------------------------------
 
     def start_call(self, call: PendingCall) -> None:
         """A local offer answers at once; otherwise send to a known provider or ask for one."""
-        offer = self._offers.get(_offer_key(call.fqn, call.request_type, call.response_type))
+        offer = self._offers.get(offer_key(call.fqn, call.request_type, call.response_type))
         if offer is not None:
             ok, payload = self._run_handler(offer, call.request)
             self._finish(call, ok, b"" if call.response_type in ONE_WAY_TYPES else payload)
@@ -181,11 +185,7 @@ class ServiceRouter:
 
     def _finish(self, call: PendingCall, ok: bool | None, payload: bytes) -> None:
         self._calls.pop(call.request_uuid, None)
-        try:
-            call.callback(ok, payload)
-        except Exception:
-            self._count("callback_errors")
-            _LOG.exception("service reply callback for %s raised", call.fqn)
+        self._finish_callback(call.callback, ok, payload)
 
     def cancel_all(self) -> None:
         """Every waiting call fails (the node is closing)."""
@@ -220,11 +220,6 @@ class ServiceRouter:
                 routed.on_sent()
         for call in [c for c in self._calls.values() if c.deadline <= now]:
             self._finish(call, None, b"")
-
-
-def _offer_key(fqn: str, request_type: str, response_type: str) -> tuple[str, str, str]:
-    """What a request must match to reach an offer (either spelling of each type)."""
-    return fqn, canonical_type(request_type), canonical_type(response_type)
 
 
 def _connect_once(sock: Any, address: str, connected: set[str]) -> None:

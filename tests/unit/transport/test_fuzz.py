@@ -13,8 +13,9 @@ from collections.abc import Callable
 
 import zmq
 
-from ros_gz_bridge_py.transport import TransportSettings, ZmqNode
+from ros_gz_bridge_py.transport import TransportSettings
 from ros_gz_bridge_py.transport.api import Scope
+from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
 from ros_gz_bridge_py.transport.zmq.wire import (
     DiscoveryMessage,
     DiscoveryType,
@@ -69,7 +70,7 @@ def test_fuzzed_node_keeps_working() -> None:
         partition=f"fuzz-{port}", ip="127.0.0.1", msg_port=port, srv_port=port + 1
     )
     rng = random.Random(1234)
-    with ZmqNode(settings=settings) as victim:
+    with ZmqGzNode(settings=settings) as victim:
         victim.subscribe("/fuzzed", lambda *_: None)
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as attacker:
             for index, data in enumerate(bad_datagrams(rng, f"@/fuzz-{port}@/fuzzed")):
@@ -94,7 +95,7 @@ def test_fuzzed_node_keeps_working() -> None:
         assert stats.io_errors == 0
 
         # Still a working participant.
-        with ZmqNode(settings=settings) as other:
+        with ZmqGzNode(settings=settings) as other:
             got: list[bytes] = []
             victim.subscribe("/after", lambda data, _: got.append(data))
             pub = other.advertise("/after", "gz.msgs.StringMsg")

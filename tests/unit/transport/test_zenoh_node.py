@@ -1,7 +1,7 @@
-"""ZenohNode against a second process (``zenoh_peer.py``), in peer mode and through a router.
+"""ZenohGzNode against a second process (``zenoh_peer.py``), in peer mode and through a router.
 
 Every session listens/connects on explicit ``tcp/127.0.0.1`` ports with multicast scouting
-off. The peer process runs its own ZenohNode plus raw Zenoh entities (plain subscriber,
+off. The peer process runs its own ZenohGzNode plus raw Zenoh entities (plain subscriber,
 hand-made puts and tokens) to play a gz process or a misbehaving one.
 """
 
@@ -30,7 +30,7 @@ from ros_gz_bridge_py.transport.zenoh.config import (
     parse_overrides,
     session_config,
 )
-from ros_gz_bridge_py.transport.zenoh.node import ZenohNode
+from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
 
 PEER_SCRIPT = Path(__file__).with_name("zenoh_peer.py")
 ROOT = PEER_SCRIPT.parents[3]
@@ -128,25 +128,25 @@ def router_port() -> Iterator[int]:
 
 
 @pytest.fixture(scope="module", params=["peer", "client"])
-def pair(request: pytest.FixtureRequest, router_port: int) -> Iterator[tuple[ZenohNode, Peer]]:
+def pair(request: pytest.FixtureRequest, router_port: int) -> Iterator[tuple[ZenohGzNode, Peer]]:
     """Our node and a peer process, directly connected or both clients of the router."""
     if request.param == "peer":
         port = free_port()
-        node = ZenohNode(config=endpoints_config("peer", listen=[endpoint(port)]))
+        node = ZenohGzNode(config=endpoints_config("peer", listen=[endpoint(port)]))
         peer = Peer("node", "--mode", "peer", "--connect", endpoint(port))
     else:
-        node = ZenohNode(config=endpoints_config("client", connect=[endpoint(router_port)]))
+        node = ZenohGzNode(config=endpoints_config("client", connect=[endpoint(router_port)]))
         peer = Peer("node", "--mode", "client", "--connect", endpoint(router_port))
     yield node, peer
     peer.close()
     node.close()
 
 
-def unique(name: str, node: ZenohNode) -> str:
+def unique(name: str, node: ZenohGzNode) -> str:
     return f"/{name}_{node.node_uuid[:8]}"
 
 
-def test_publish_to_peer_subscriptions(pair: tuple[ZenohNode, Peer]) -> None:
+def test_publish_to_peer_subscriptions(pair: tuple[ZenohGzNode, Peer]) -> None:
     node, peer = pair
     topic = unique("to_peer", node)
     publisher = node.advertise(topic, STRING)
@@ -161,7 +161,7 @@ def test_publish_to_peer_subscriptions(pair: tuple[ZenohNode, Peer]) -> None:
 
 
 @pytest.mark.parametrize("wire_type", [STRING, "ignition.msgs.StringMsg"])
-def test_subscribe_to_peer_publisher(pair: tuple[ZenohNode, Peer], wire_type: str) -> None:
+def test_subscribe_to_peer_publisher(pair: tuple[ZenohGzNode, Peer], wire_type: str) -> None:
     node, peer = pair
     topic = unique("from_peer", node)
     typed: queue.Queue[tuple[Any, MessageInfo]] = queue.Queue()
@@ -187,7 +187,7 @@ def test_subscribe_to_peer_publisher(pair: tuple[ZenohNode, Peer], wire_type: st
     assert (msg.data, info.msg_type) == ("respelled", other)
 
 
-def test_calls_to_peer_service(pair: tuple[ZenohNode, Peer]) -> None:
+def test_calls_to_peer_service(pair: tuple[ZenohGzNode, Peer]) -> None:
     node, peer = pair
     service, one_way = unique("srv", node), unique("oneway", node)
     peer.send("serve", service=service, req=STRING, rep=STRING)
@@ -203,7 +203,7 @@ def test_calls_to_peer_service(pair: tuple[ZenohNode, Peer]) -> None:
         node.request(service, b"ping", EMPTY, STRING, 0.2)
 
 
-def test_peer_calls_our_service(pair: tuple[ZenohNode, Peer]) -> None:
+def test_peer_calls_our_service(pair: tuple[ZenohGzNode, Peer]) -> None:
     node, peer = pair
     service = unique("ours", node)
     node.advertise_service(service, STRING, STRING, lambda req: (req != b"no", req[::-1]))
@@ -213,7 +213,7 @@ def test_peer_calls_our_service(pair: tuple[ZenohNode, Peer]) -> None:
     assert peer.expect("reply", service=service)["ok"] is False
 
 
-def test_listing_shows_peer_entities(pair: tuple[ZenohNode, Peer]) -> None:
+def test_listing_shows_peer_entities(pair: tuple[ZenohGzNode, Peer]) -> None:
     node, peer = pair
     topic, service = unique("listed", node), unique("listed_srv", node)
     peer.send("advertise", topic=topic, type=STRING)
@@ -227,7 +227,7 @@ def test_listing_shows_peer_entities(pair: tuple[ZenohNode, Peer]) -> None:
     assert provider.msg_type == f"{STRING}&{EMPTY}"
 
 
-def test_no_put_before_a_subscriber_token(pair: tuple[ZenohNode, Peer]) -> None:
+def test_no_put_before_a_subscriber_token(pair: tuple[ZenohGzNode, Peer]) -> None:
     node, peer = pair
     topic, marker = unique("gated", node), unique("gated_marker", node)
     publisher = node.advertise(topic, STRING)
@@ -245,7 +245,7 @@ def test_no_put_before_a_subscriber_token(pair: tuple[ZenohNode, Peer]) -> None:
     assert StringMsg.FromString(bytes.fromhex(first["data"])).data == "seen"
 
 
-def test_bad_input_is_counted_and_skipped(pair: tuple[ZenohNode, Peer]) -> None:
+def test_bad_input_is_counted_and_skipped(pair: tuple[ZenohGzNode, Peer]) -> None:
     node, peer = pair
     topic = unique("bad", node)
     received: queue.Queue[Any] = queue.Queue()
@@ -269,7 +269,7 @@ def test_bad_input_is_counted_and_skipped(pair: tuple[ZenohNode, Peer]) -> None:
     assert node.stats.io_errors == 0
 
 
-def test_local_delivery_once_and_ignore_local(pair: tuple[ZenohNode, Peer]) -> None:
+def test_local_delivery_once_and_ignore_local(pair: tuple[ZenohGzNode, Peer]) -> None:
     node, peer = pair
     topic = unique("local", node)
     got: list[tuple[str, bool]] = []
@@ -289,10 +289,12 @@ def test_local_delivery_once_and_ignore_local(pair: tuple[ZenohNode, Peer]) -> N
 
 
 @pytest.mark.parametrize("pair", ["client"], indirect=True)
-def test_close_leaves_no_threads_or_tokens(pair: tuple[ZenohNode, Peer], router_port: int) -> None:
+def test_close_leaves_no_threads_or_tokens(
+    pair: tuple[ZenohGzNode, Peer], router_port: int
+) -> None:
     _, peer = pair
     threads_before = set(threading.enumerate())
-    node = ZenohNode(config=endpoints_config("client", connect=[endpoint(router_port)]))
+    node = ZenohGzNode(config=endpoints_config("client", connect=[endpoint(router_port)]))
     topic, service = unique("closing", node), unique("closing_srv", node)
     node.advertise(topic, STRING)
     node.subscribe(topic, lambda _p, _i: None, queue_size=2)

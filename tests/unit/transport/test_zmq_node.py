@@ -12,7 +12,8 @@ import pytest
 
 from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
-from ros_gz_bridge_py.transport import MessageInfo, ZmqNode, create_node
+from ros_gz_bridge_py.transport import MessageInfo, create_gz_node
+from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
 
 StringMsg = message_class("gz.msgs.StringMsg")
 
@@ -44,17 +45,17 @@ def unique(name: str) -> str:
 
 
 @pytest.fixture
-def nodes() -> Iterator[tuple[ZmqNode, ZmqNode]]:
-    a, b = create_node(), create_node()
-    assert isinstance(a, ZmqNode)
-    assert isinstance(b, ZmqNode)
+def nodes() -> Iterator[tuple[ZmqGzNode, ZmqGzNode]]:
+    a, b = create_gz_node(), create_gz_node()
+    assert isinstance(a, ZmqGzNode)
+    assert isinstance(b, ZmqGzNode)
     yield a, b
     a.close()
     b.close()
 
 
 @pytest.mark.parametrize("msg_type", ["gz.msgs.StringMsg", "ignition.msgs.StringMsg"])
-def test_pub_sub_both_type_families(nodes: tuple[ZmqNode, ZmqNode], msg_type: str) -> None:
+def test_pub_sub_both_type_families(nodes: tuple[ZmqGzNode, ZmqGzNode], msg_type: str) -> None:
     a, b = nodes
     topic = unique("chatter")
     typed: list[tuple[str, MessageInfo]] = []
@@ -69,11 +70,11 @@ def test_pub_sub_both_type_families(nodes: tuple[ZmqNode, ZmqNode], msg_type: st
     assert {t[0] for t in typed} == {"hello", "raw"}
     info = typed[0][1]
     assert (info.topic, info.msg_type, info.intra_process) == (topic, msg_type, False)
-    assert info.publisher_address == pub.records[0].address
+    assert info.publisher_address == a.pub_address
     assert raw[0] == StringMsg(data="hello").SerializeToString()
 
 
-def test_type_mismatch_is_not_delivered(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+def test_type_mismatch_is_not_delivered(nodes: tuple[ZmqGzNode, ZmqGzNode]) -> None:
     a, b = nodes
     topic = unique("typed")
     wrong: list[bytes] = []
@@ -94,7 +95,7 @@ def test_type_mismatch_is_not_delivered(nodes: tuple[ZmqNode, ZmqNode]) -> None:
     ],
 )
 def test_either_spelling_reaches_subscribers_of_both_once(
-    nodes: tuple[ZmqNode, ZmqNode], published: str, subscribed: str
+    nodes: tuple[ZmqGzNode, ZmqGzNode], published: str, subscribed: str
 ) -> None:
     """Subscribers of either spelling and a generic one each get every message once."""
     a, b = nodes
@@ -120,7 +121,7 @@ def test_either_spelling_reaches_subscribers_of_both_once(
 
 
 def test_subscriptions_added_and_closed_while_messages_flow(
-    nodes: tuple[ZmqNode, ZmqNode],
+    nodes: tuple[ZmqGzNode, ZmqGzNode],
 ) -> None:
     """Received messages take a cached route; a subscription that starts or ends while the
     topic is flowing must be seen at once (the cache is emptied each time)."""
@@ -142,7 +143,9 @@ def test_subscriptions_added_and_closed_while_messages_flow(
     assert StringMsg.FromString(second[-1]).data == "3"
 
 
-def test_no_wire_traffic_without_subscribers_and_listing(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+def test_no_wire_traffic_without_subscribers_and_listing(
+    nodes: tuple[ZmqGzNode, ZmqGzNode],
+) -> None:
     a, b = nodes
     topic = unique("listed")
     pub = a.advertise(topic, "gz.msgs.StringMsg")
@@ -165,7 +168,7 @@ def test_no_wire_traffic_without_subscribers_and_listing(nodes: tuple[ZmqNode, Z
 
 
 def test_local_delivery_and_ignore_local() -> None:
-    with create_node() as node:
+    with create_gz_node() as node:
         topic = unique("local")
         seen: list[MessageInfo] = []
         ignored: list[bytes] = []
@@ -181,7 +184,7 @@ def test_local_delivery_and_ignore_local() -> None:
 
 
 def test_queue_size_drops_oldest() -> None:
-    with create_node() as node:
+    with create_gz_node() as node:
         topic = unique("queue")
         release = threading.Event()
         entered = threading.Event()
@@ -205,7 +208,7 @@ def test_queue_size_drops_oldest() -> None:
         assert node.stats.messages_dropped == 3
 
 
-def test_queued_subscriptions_read_only_their_own_topic(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+def test_queued_subscriptions_read_only_their_own_topic(nodes: tuple[ZmqGzNode, ZmqGzNode]) -> None:
     """A queued subscription reads its own SUB socket, subscribed by topic prefix as ZeroMQ
     does: messages of a longer topic sharing the prefix must not reach it, nor a type it does
     not accept; a queued and an unqueued subscription of one topic each get every message."""
@@ -246,7 +249,7 @@ def test_queued_subscriptions_read_only_their_own_topic(nodes: tuple[ZmqNode, Zm
 
 
 def test_on_delivery_start_runs_on_the_subscription_thread() -> None:
-    with create_node() as node:
+    with create_gz_node() as node:
         topic = unique("start")
         threads: list[tuple[str, int]] = []
         node.subscribe(
@@ -262,16 +265,16 @@ def test_on_delivery_start_runs_on_the_subscription_thread() -> None:
 
 
 def test_a_queue_of_no_messages_is_refused() -> None:
-    with create_node() as node, pytest.raises(ValueError, match="queue_size must be at least 1"):
+    with create_gz_node() as node, pytest.raises(ValueError, match="queue_size must be at least 1"):
         node.subscribe(unique("noroom"), lambda _p, _i: None, queue_size=0)
 
 
 def test_on_delivery_start_without_a_queue_is_refused() -> None:
-    with create_node() as node, pytest.raises(ValueError, match="needs a queue_size"):
+    with create_gz_node() as node, pytest.raises(ValueError, match="needs a queue_size"):
         node.subscribe(unique("noqueue"), lambda _p, _i: None, on_delivery_start=lambda: None)
 
 
-def test_callback_errors_are_counted(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+def test_callback_errors_are_counted(nodes: tuple[ZmqGzNode, ZmqGzNode]) -> None:
     a, b = nodes
     topic = unique("boom")
     calls: list[int] = []
@@ -294,7 +297,7 @@ def test_callback_errors_are_counted(nodes: tuple[ZmqNode, ZmqNode]) -> None:
     assert bad == []
 
 
-def test_services(nodes: tuple[ZmqNode, ZmqNode]) -> None:
+def test_services(nodes: tuple[ZmqGzNode, ZmqGzNode]) -> None:
     a, b = nodes
     echo, fail, oneway = unique("echo"), unique("fail"), unique("oneway")
     t = "gz.msgs.StringMsg"
@@ -328,7 +331,7 @@ def test_services(nodes: tuple[ZmqNode, ZmqNode]) -> None:
 
 
 def test_request_timeout_and_unknown_service() -> None:
-    with create_node() as node:
+    with create_gz_node() as node:
         replies: list[tuple[bool | None, bytes]] = []
         node.request_async(
             unique("nobody"), b"", "a", "b", 0.2, lambda ok, d: replies.append((ok, d))
@@ -337,7 +340,7 @@ def test_request_timeout_and_unknown_service() -> None:
 
 
 def test_request_from_io_thread_is_refused() -> None:
-    with create_node() as node:
+    with create_gz_node() as node:
         topic = unique("io")
         errors: list[Exception] = []
 
@@ -350,7 +353,7 @@ def test_request_from_io_thread_is_refused() -> None:
         pub = node.advertise(topic, "gz.msgs.StringMsg")
         node.subscribe(topic, call)
         # Intra-process delivery runs in this thread; make the I/O thread run the callback.
-        other = create_node()
+        other = create_gz_node()
         try:
             remote = other.advertise(topic, "gz.msgs.StringMsg")
             assert wait_until(remote.has_connections)
@@ -362,7 +365,7 @@ def test_request_from_io_thread_is_refused() -> None:
 
 def test_close_leaves_no_threads_and_is_idempotent() -> None:
     before = set(threading.enumerate())
-    node = create_node()
+    node = create_gz_node()
     node.subscribe(unique("q"), lambda *_: None, queue_size=3)
     node.advertise(unique("p"), "gz.msgs.StringMsg")
     node.close()

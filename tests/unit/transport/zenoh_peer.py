@@ -1,4 +1,4 @@
-"""A second Zenoh Gazebo Transport process for the ZenohNode tests.
+"""A second Zenoh Gazebo Transport process for the ZenohGzNode tests.
 
 Run ``python zenoh_peer.py node --mode peer --connect tcp/127.0.0.1:P`` (or ``router
 --listen tcp/127.0.0.1:P``). A node reads one JSON command per line on stdin and writes one
@@ -24,7 +24,7 @@ from ros_gz_bridge_py.transport.api import MessageInfo
 from ros_gz_bridge_py.transport.names import fully_qualified_name
 from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
 from ros_gz_bridge_py.transport.zenoh.keys import EntityKind, message_token
-from ros_gz_bridge_py.transport.zenoh.node import ZenohNode
+from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
 
 #: How long a peer waits for a graph condition before reporting failure.
 WAIT_LIMIT = 10.0
@@ -33,9 +33,9 @@ SLOW_HANDLER = 1.0
 
 
 class PeerNode:
-    """Runs the commands of one test against a ZenohNode and raw Zenoh entities."""
+    """Runs the commands of one test against a ZenohGzNode and raw Zenoh entities."""
 
-    def __init__(self, node: ZenohNode) -> None:
+    def __init__(self, node: ZenohGzNode) -> None:
         self.node = node
         self._out = threading.Lock()
         self._publishers: dict[str, Any] = {}
@@ -137,7 +137,7 @@ def main() -> None:
             sys.stdout.flush()
             sys.stdin.read()
         return
-    node = ZenohNode(config=endpoints_config(args.mode, args.listen, args.connect))
+    node = ZenohGzNode(config=endpoints_config(args.mode, args.listen, args.connect))
     peer = PeerNode(node)
     peer.emit("ready", process_uuid=node.process_uuid)
     for line in sys.stdin:

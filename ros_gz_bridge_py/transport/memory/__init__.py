@@ -1,0 +1,1 @@
+"""The in-memory backend: nodes of one process on a shared network object."""

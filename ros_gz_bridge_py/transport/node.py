@@ -1,0 +1,490 @@
+"""The Gazebo Transport node contract, and what every backend shares (in the manner of
+python-can's ``BusABC``).
+
+:class:`GzNode` is named so it cannot be mistaken for rclpy's ``Node``. It owns what is the
+same in every backend: the counters, the fully qualified names, the table of local
+subscriptions, local (intra-process) delivery, the choice of wire spellings per message
+(docs/protocol.md §9), ``has_connections``, blocking service calls, waiting for publishers,
+and an idempotent ``close``. A backend implements narrow hooks: open and close its publishers,
+subscriptions and service offers, send one message in one spelling, call a service, and tell
+what its discovery knows. The contract every backend must honour is tested by one suite,
+``tests/unit/transport/test_contract.py``; a new backend is written by passing it.
+"""
+
+from __future__ import annotations
+
+import abc
+import collections
+import logging
+import threading
+import time
+import uuid
+from collections.abc import Callable
+from typing import Any, ClassVar, Self
+
+from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling, spellings
+from ros_gz_bridge_py.transport.api import (
+    Callback,
+    GraphEndpoint,
+    MessageInfo,
+    ReplyCallback,
+    ServiceHandler,
+    TopicInfo,
+    TransportStats,
+)
+from ros_gz_bridge_py.transport.delivery import (
+    Deliver,
+    DeliveryQueue,
+    Payload,
+    payload_size,
+    raw_deliverer,
+    typed_deliverer,
+)
+from ros_gz_bridge_py.transport.handles import Delivery, Publisher, ServiceOffer, Subscription
+from ros_gz_bridge_py.transport.names import fully_qualified_name
+from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.wire_types import SubscriberBook
+
+_LOG = logging.getLogger("ros_gz_bridge_py.transport")
+
+
+class ThreadDelivery:
+    """A queued subscription's :class:`DeliveryQueue` (the default :class:`Delivery`)."""
+
+    def __init__(self, sub: Subscription, size: int, on_start: Callable[[], None] | None) -> None:
+        self._queue: DeliveryQueue[tuple[Payload, MessageInfo]] = DeliveryQueue(
+            size,
+            lambda item: sub.run(*item),
+            f"gz-sub {sub.topic}",
+            weigh=payload_size,
+            on_start=on_start,
+        )
+
+    @property
+    def dropped(self) -> int:
+        return self._queue.dropped
+
+    def offer(self, payload: Payload, info: MessageInfo) -> int:
+        return self._queue.put((payload, info))
+
+    def close(self) -> None:
+        self._queue.close()
+
+
+class GzNode(abc.ABC):
+    """A Gazebo Transport participant: advertise, subscribe, provide and call services.
+
+    Thread-safe: publishing, ``has_connections``, ``stats`` and every public method may be
+    called from any thread; ``request`` not from the node's own thread (it would wait for
+    itself). Bad network input never raises: it is counted in ``stats``.
+    """
+
+    #: The spelling taken for peers whose Gazebo line nothing tells (None: our own).
+    default_peer_spelling: ClassVar[Spelling | None] = None
+
+    def __init__(
+        self,
+        partition: str | None = None,
+        namespace: str = "",
+        settings: TransportSettings | None = None,
+    ) -> None:
+        """Raises:
+        LocalProtocolError: the partition or namespace is invalid."""
+        self.settings = settings or TransportSettings.from_env()
+        self.partition = self.settings.partition if partition is None else partition
+        self.namespace = namespace
+        fully_qualified_name(self.partition, namespace, "/check")
+        self.process_uuid = str(uuid.uuid4())
+        self.node_uuid = str(uuid.uuid4())
+        #: Remote subscribers per topic and their lines (written by the backend's discovery).
+        self.subscriber_book = SubscriberBook(self.default_peer_spelling)
+        self._counts: collections.Counter[str] = collections.Counter()
+        self._count_lock = threading.Lock()
+        # Read by publishing threads without a lock: entries are replaced, never mutated.
+        self._subscriptions: dict[str, tuple[Subscription, ...]] = {}
+        self._subscriptions_lock = threading.Lock()
+        # Discovery changes, for wait_for_publishers: a counter and its condition.
+        self._changed = threading.Condition()
+        self._generation = 0
+        self.closed = False
+
+    # --- names and counters ---------------------------------------------------------------
+
+    def names_of(self, msg_type: str) -> tuple[str, ...]:
+        """The type names a publisher or subscription of ``msg_type`` goes by (both spellings)."""
+        return spellings(msg_type)
+
+    def fqn(self, topic: str) -> str:
+        """``topic``'s fully qualified name in this node's partition and namespace."""
+        return fully_qualified_name(self.partition, self.namespace, topic)
+
+    def count(self, name: str, amount: int = 1) -> None:
+        """Add to one of the ``stats`` counters (thread-safe)."""
+        with self._count_lock:
+            self._counts[name] += amount
+
+    @property
+    def stats(self) -> TransportStats:
+        """A snapshot of the node's counters."""
+        with self._count_lock:
+            counts = dict(self._counts)
+        return TransportStats(**self._add_stats(counts))
+
+    def _add_stats(self, counts: dict[str, int]) -> dict[str, int]:
+        """Counters the backend keeps elsewhere, added to ``counts``."""
+        return counts
+
+    # --- topics -----------------------------------------------------------------------------
+
+    def advertise(self, topic: str, msg_type: str) -> Publisher:
+        """Advertise ``topic`` under the spellings of ``msg_type``.
+
+        Raises:
+            LocalProtocolError: the name is not a valid Gazebo topic.
+            TransportError: the node is closed.
+        """
+        self._check_open()
+        return self._open_publisher(topic, self.fqn(topic), msg_type)
+
+    def unadvertise(self, publisher: Publisher) -> None:
+        """Withdraw ``publisher`` (called by its ``close``)."""
+        if not self.closed:
+            self._close_publisher(publisher)
+
+    def publish(self, publisher: Publisher, payload: Payload, as_type: str | None = None) -> None:
+        """Local subscriptions first, then one message per spelling a remote subscriber needs
+        (docs/protocol.md §9); ``as_type`` limits both to that spelling."""
+        if as_type is None or as_type == publisher.msg_type:
+            local = self._local_receivers(publisher)
+            if local:
+                data = payload if isinstance(payload, bytes) else bytes(payload)
+                info = MessageInfo(
+                    publisher.topic, publisher.msg_type, self.partition, "", intra_process=True
+                )
+                for sub in local:
+                    sub.offer(data, info)
+        for wire_type in publisher.wire_types():
+            if as_type is None or wire_type == as_type:
+                self._send(publisher, wire_type, payload)
+
+    def has_connections(self, publisher: Publisher) -> bool:
+        """True if a remote subscriber or a local subscription would receive a message."""
+        return bool(publisher.wire_types()) or bool(self._local_receivers(publisher))
+
+    def _local_receivers(self, publisher: Publisher) -> list[Subscription]:
+        return [
+            sub
+            for sub in self._subscriptions.get(publisher.fqn, ())
+            if not sub.ignore_local and sub.accepts(publisher.msg_type)
+        ]
+
+    def subscribe(
+        self,
+        topic: str,
+        callback: Callback,
+        msg_type: str = GENERIC_TYPE,
+        *,
+        ignore_local: bool = False,
+        queue_size: int | None = None,
+        copy: bool = True,
+        on_delivery_start: Callable[[], None] | None = None,
+    ) -> Subscription:
+        """Receive raw payloads of ``msg_type`` (either spelling; GENERIC_TYPE = any).
+
+        ``queue_size`` None runs ``callback`` on the thread that receives (the backend's);
+        N gives the subscription its own delivery thread behind a drop-oldest queue of N
+        messages, which first runs ``on_delivery_start`` (e.g. to set its own priority).
+        ``copy=False`` hands over the backend's buffer (``bytes`` or a read-only
+        ``memoryview``) instead of copying it into ``bytes``.
+
+        Raises:
+            ValueError: a queue of no messages, or ``on_delivery_start`` without a queue.
+            LocalProtocolError: the name is not a valid Gazebo topic.
+            TransportError: the node is closed.
+        """
+        if on_delivery_start is not None and queue_size is None:
+            msg = "on_delivery_start needs a queue_size: without one there is no delivery thread"
+            raise ValueError(msg)
+        deliver = raw_deliverer(self.count, callback, copy=copy)
+        return self._add_subscription(
+            topic, msg_type, deliver, ignore_local, queue_size, on_delivery_start
+        )
+
+    def subscribe_typed(
+        self,
+        topic: str,
+        msg_class: type[Any],
+        callback: Callback,
+        *,
+        msg_type: str | None = None,
+        ignore_local: bool = False,
+        queue_size: int | None = None,
+    ) -> Subscription:
+        """Like :meth:`subscribe`, decoding with ``msg_class.FromString`` (no payload copy).
+
+        ``msg_type`` defaults to the class's full protobuf name. Undecodable payloads are
+        counted in ``stats.payloads_undecodable``.
+        """
+        deliver = typed_deliverer(self.count, msg_class, callback)
+        wanted = msg_type or msg_class.DESCRIPTOR.full_name
+        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size, None)
+
+    def _add_subscription(  # noqa: PLR0917 - private, called with every argument by name above
+        self,
+        topic: str,
+        msg_type: str,
+        deliver: Deliver,
+        ignore_local: bool,
+        queue_size: int | None,
+        on_start: Callable[[], None] | None,
+    ) -> Subscription:
+        self._check_open()
+        sub = self._new_subscription(topic, self.fqn(topic), msg_type, deliver, ignore_local)
+        if queue_size is not None:
+            sub.delivery = self._open_delivery(sub, queue_size, on_start)
+        with self._subscriptions_lock:
+            self._subscriptions[sub.fqn] = (*self._subscriptions.get(sub.fqn, ()), sub)
+        try:
+            self._open_subscription(sub)
+        except Exception:
+            sub.close()
+            raise
+        return sub
+
+    def unsubscribe(self, sub: Subscription) -> None:
+        """Remove ``sub`` (called by its ``close``)."""
+        with self._subscriptions_lock:
+            remaining = tuple(s for s in self._subscriptions.get(sub.fqn, ()) if s is not sub)
+            if remaining:
+                self._subscriptions[sub.fqn] = remaining
+            else:
+                self._subscriptions.pop(sub.fqn, None)
+        if not self.closed:
+            self._close_subscription(sub, last=not remaining)
+
+    def subscriptions(self, fqn: str) -> tuple[Subscription, ...]:
+        """The local subscriptions of ``fqn`` (a snapshot)."""
+        return self._subscriptions.get(fqn, ())
+
+    def _new_subscription(
+        self, topic: str, fqn: str, msg_type: str, deliver: Deliver, ignore_local: bool
+    ) -> Subscription:
+        """The subscription handle (backends that keep more per subscription subclass it)."""
+        return Subscription(self, topic, fqn, msg_type, deliver, ignore_local=ignore_local)
+
+    def _open_delivery(
+        self, sub: Subscription, size: int, on_start: Callable[[], None] | None
+    ) -> Delivery:
+        """The queued delivery of ``sub``: by default a thread behind a drop-oldest queue."""
+        return ThreadDelivery(sub, size, on_start)
+
+    # --- services ---------------------------------------------------------------------------
+
+    def advertise_service(
+        self, service: str, request_type: str, response_type: str, handler: ServiceHandler
+    ) -> ServiceOffer:
+        """Provide ``service``: calls of either spelling of the two types reach ``handler``,
+        which runs on a backend thread; an exception means failure.
+
+        Raises:
+            LocalProtocolError: the name is not a valid Gazebo service name.
+            TransportError: the node is closed.
+        """
+        self._check_open()
+        return self._open_offer(service, self.fqn(service), (request_type, response_type), handler)
+
+    def unadvertise_service(self, offer: ServiceOffer) -> None:
+        """Withdraw ``offer`` (called by its ``close``)."""
+        if not self.closed:
+            self._close_offer(offer)
+
+    def request(
+        self, service: str, request: bytes, request_type: str, response_type: str, timeout: float
+    ) -> tuple[bool, bytes]:
+        """Call a service and wait for the reply (one-way calls return (True, b"") once sent).
+
+        Raises:
+            TransportTimeoutError: no reply within ``timeout`` seconds.
+            TransportError: called from the node's own thread, which would wait for itself.
+        """
+        if self._on_node_thread():
+            msg = "request() would block the node's own thread; use request_async() in callbacks"
+            raise TransportError(msg)
+        done = threading.Event()
+        result: list[tuple[bool | None, bytes]] = []
+
+        def on_reply(ok: bool | None, payload: bytes) -> None:
+            result.append((ok, payload))
+            done.set()
+
+        self.request_async(service, request, request_type, response_type, timeout, on_reply)
+        done.wait()
+        ok, payload = result[0]
+        if ok is None:
+            msg = f"service {service!r} did not answer within {timeout} s"
+            raise TransportTimeoutError(msg)
+        return ok, payload
+
+    def call_handler(self, offer: ServiceOffer, request: bytes) -> tuple[bool, bytes]:
+        """Run ``offer``'s handler: (False, b"") when it raises (counted) or fails."""
+        try:
+            ok, payload = offer.handler(request)
+        except Exception:
+            self.count("callback_errors")
+            _LOG.exception("service handler for %s raised", offer.service)
+            return False, b""
+        return ok, payload if ok else b""
+
+    def finish_call(self, callback: ReplyCallback, ok: bool | None, payload: bytes) -> None:
+        """Run a ``request_async`` callback, counting (never raising) its errors."""
+        try:
+            callback(ok, payload)
+        except Exception:
+            self.count("callback_errors")
+            _LOG.exception("service reply callback raised")
+
+    @abc.abstractmethod
+    def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
+        self,
+        service: str,
+        request: bytes,
+        request_type: str,
+        response_type: str,
+        timeout: float,
+        callback: ReplyCallback,
+    ) -> None:
+        """Call a provider of either spelling of the two types; ``callback(ok, reply)`` runs
+        exactly once: (True/False, reply) on a reply, (None, b"") on timeout, (True, b"")
+        once sent for a one-way call (response ``gz.msgs.Empty``)."""
+
+    # --- discovery ---------------------------------------------------------------------------
+
+    def graph_changed(self) -> None:
+        """Backends call this when discovery learned something (wakes wait_for_publishers)."""
+        with self._changed:
+            self._generation += 1
+            self._changed.notify_all()
+
+    def wait_for_publishers(
+        self, topic: str, timeout: float, msg_type: str | None = None
+    ) -> list[TopicInfo]:
+        """Publishers of ``topic`` (of ``msg_type`` if given) as soon as one is known; [] when
+        none is within ``timeout``."""
+        deadline = time.monotonic() + timeout
+        while True:
+            seen = self._generation
+            found = [
+                i for i in self.topic_info(topic) if msg_type is None or i.msg_type == msg_type
+            ]
+            remaining = deadline - time.monotonic()
+            if found or remaining <= 0:
+                return found
+            self._wait_for_change(seen, remaining)
+
+    def _wait_for_change(self, seen: int, timeout: float) -> None:
+        with self._changed:
+            self._changed.wait_for(lambda: self._generation != seen, timeout)
+
+    @abc.abstractmethod
+    def topic_list(self) -> list[str]:
+        """Topics with publishers in this partition, like ``gz topic -l``."""
+
+    @abc.abstractmethod
+    def topic_info(self, topic: str) -> list[TopicInfo]:
+        """Publishers of ``topic``, like ``gz topic -i -t``."""
+
+    @abc.abstractmethod
+    def service_list(self) -> list[str]:
+        """Services with providers in this partition, like ``gz service -l``."""
+
+    @abc.abstractmethod
+    def service_info(self, service: str) -> list[TopicInfo]:
+        """Providers of ``service``; ``msg_type`` is ``"<request type>&<response type>"``."""
+
+    @abc.abstractmethod
+    def observe(self, topic: str) -> list[GraphEndpoint]:
+        """Every publisher and subscriber of ``topic`` (resolved as our own would be) that
+        other processes have, in every partition discovery reaches."""
+
+    @abc.abstractmethod
+    def peer_processes(self) -> int:
+        """How many other Gazebo Transport processes this node hears."""
+
+    @abc.abstractmethod
+    def listening(self) -> str:
+        """Where this node looks for peers (backend, partition, addresses), for users."""
+
+    @abc.abstractmethod
+    def ask_subscribers(self) -> None:
+        """Ask peers to list their subscriptions where the protocol has a way (ZeroMQ with
+        gz-transport 13+ peers); the answers show in :meth:`observe`."""
+
+    # --- life -------------------------------------------------------------------------------
+
+    def _check_open(self) -> None:
+        if self.closed:
+            msg = "the Gazebo Transport node is closed"
+            raise TransportError(msg)
+
+    def close(self) -> None:
+        """Say goodbye to peers, close every handle and release the backend; idempotent."""
+        if self.closed:
+            return
+        self._shutdown()
+        self.closed = True
+        subscriptions = [sub for subs in self._subscriptions.values() for sub in subs]
+        for sub in subscriptions:
+            sub.close()
+        self._release()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    # --- the backend's hooks ------------------------------------------------------------------
+
+    @abc.abstractmethod
+    def _open_publisher(self, topic: str, fqn: str, msg_type: str) -> Publisher:
+        """Create and announce a publisher (a :class:`Publisher`, or a subclass)."""
+
+    @abc.abstractmethod
+    def _send(self, publisher: Publisher, wire_type: str, payload: Payload) -> None:
+        """Send one message of ``publisher`` in the spelling ``wire_type`` to remote peers."""
+
+    @abc.abstractmethod
+    def _close_publisher(self, publisher: Publisher) -> None:
+        """Withdraw ``publisher``'s announcements."""
+
+    @abc.abstractmethod
+    def _open_subscription(self, sub: Subscription) -> None:
+        """Start receiving for ``sub`` (already in the table of subscriptions)."""
+
+    @abc.abstractmethod
+    def _close_subscription(self, sub: Subscription, *, last: bool) -> None:
+        """Stop receiving for ``sub`` (``last``: no other local subscription of its topic)."""
+
+    @abc.abstractmethod
+    def _open_offer(
+        self, service: str, fqn: str, types: tuple[str, str], handler: ServiceHandler
+    ) -> ServiceOffer:
+        """Create and announce a service offer."""
+
+    @abc.abstractmethod
+    def _close_offer(self, offer: ServiceOffer) -> None:
+        """Withdraw ``offer``."""
+
+    @abc.abstractmethod
+    def _on_node_thread(self) -> bool:
+        """True when the caller runs on the node's own thread (where blocking is forbidden)."""
+
+    @abc.abstractmethod
+    def _shutdown(self) -> None:
+        """Say goodbye on the wire and stop the backend's threads; pending calls end as
+        timeouts. Called once, before the handles close."""
+
+    @abc.abstractmethod
+    def _release(self) -> None:
+        """Release sockets and sessions. Called once, last."""

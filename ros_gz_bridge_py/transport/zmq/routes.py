@@ -1,0 +1,76 @@
+"""Received data messages to the local subscriptions that take them (I/O thread only).
+
+§2.8.1 step 8: the exact fully qualified name (ZeroMQ filters by prefix), and a spelling
+the subscription takes from that sender (docs/protocol.md §9). A (topic, sender, type) seen
+before takes its cached route: no decoding, no matching; the node empties the cache whenever
+a subscription starts or ends (on the same thread).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ros_gz_bridge_py.transport.api import MessageInfo
+from ros_gz_bridge_py.transport.handles import Subscription
+from ros_gz_bridge_py.transport.names import decompose
+from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
+
+#: Cached routes (topic, sender, type frames -> subscriptions, info); cleared beyond this size.
+ROUTE_CACHE_SIZE = 1024
+#: Where received data goes: the subscriptions that accept it, and what they are told.
+Route = tuple[tuple[Subscription, ...], MessageInfo]
+
+
+class DataRouter:
+    """Routes the messages of the node's shared SUB socket."""
+
+    def __init__(
+        self, subscriptions: Callable[[str], tuple[Subscription, ...]], partition: str
+    ) -> None:
+        self._subscriptions = subscriptions
+        self._partition = partition
+        self._routes: dict[tuple[Frame, Frame, Frame], Route] = {}
+        #: Messages routed to at least one subscription.
+        self.received = 0
+
+    def clear(self) -> None:
+        """Forget the cached routes (a subscription started or ended)."""
+        self._routes.clear()
+
+    def on_data(self, frames: list[Frame]) -> None:
+        """Deliver one message of four frames (§2.8.2).
+
+        Raises:
+            RemoteProtocolError: the frames are not a data message.
+        """
+        if len(frames) == DATA_FRAMES:
+            route = self._routes.get((frames[0], frames[1], frames[3]))
+            if route is not None:
+                self.received += 1
+                subs, info = route
+                payload = frames[2]
+                for sub in subs:
+                    sub.offer(payload, info)
+                return
+        self._route(frames)
+
+    def _route(self, frames: list[Frame]) -> None:
+        message = decode_data(frames)
+        # Queued subscriptions read their own sockets: a message for a topic that has only
+        # those reached this socket by prefix (ZeroMQ matches prefixes) and is not ours.
+        subs = tuple(s for s in self._subscriptions(message.topic) if s.delivery is None)
+        if not subs:
+            return
+        self.received += 1
+        name = (decompose(message.topic) or ("", message.topic))[1]
+        info = MessageInfo(
+            name, message.msg_type, self._partition, message.sender, intra_process=False
+        )
+        accepting = tuple(s for s in subs if s.accepts_from(message.sender, message.msg_type))
+        key = (frames[0], frames[1], frames[3])
+        if all(isinstance(frame, bytes) for frame in key):
+            if len(self._routes) >= ROUTE_CACHE_SIZE:
+                self._routes.clear()
+            self._routes[key] = (accepting, info)
+        for sub in accepting:
+            sub.offer(message.payload, info)
