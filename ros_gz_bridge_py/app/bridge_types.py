@@ -1,6 +1,6 @@
 """``bridge_types``: list the supported ROS <=> Gazebo type pairs, like the C++ tool.
 
-Options and their texts and exit codes follow ros-gz-bridge-behaviour.md §1.4; the option
+Options and their texts and exit codes follow docs/behaviour.md §1.2; the option
 comes first and its argument second. Differences: each pair is listed once (with its
 ``gz.msgs.X`` name; ``ignition.msgs.X`` is accepted wherever a Gazebo type is read), types are
 listed once each and sorted, services get their own heading, ``--json`` prints everything

@@ -1,6 +1,6 @@
 """``parameter_bridge`` positional arguments (``name@ros_type@gz_type`` ...) parsed into specs.
 
-The grammar and the delimiter precedence are the C++ bridge's (behaviour spec 2.1/2.2): the
+The grammar and the delimiter precedence are the C++ bridge's (docs/behaviour.md §2.1, §2.2): the
 first ``@`` ends the name; in the rest an ``@`` (not first) wins over ``[``, which wins over
 ``]``, wherever they are; a ROS type containing ``/srv/`` makes a service bridge. Every
 argument C++ answers with the usage text, and the two it gets wrong silently, raise

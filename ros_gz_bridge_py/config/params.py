@@ -1,4 +1,6 @@
-"""Bridges defined by node parameters: ``bridge_names`` plus ``bridges.<name>.*`` (spec 3.2).
+"""Bridges defined by node parameters: ``bridge_names`` plus ``bridges.<name>.*``.
+
+The C++ node's rules: docs/behaviour.md §3.2.
 
 This is what the launch action's XML ``<topic>``/``<service>`` children turn into. The checks
 and error texts are the C++ node's; the parameter values are read through a callback so this

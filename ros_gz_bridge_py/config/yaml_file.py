@@ -1,6 +1,6 @@
 """Bridge YAML files (the ``config_file`` parameter) parsed into specs with located errors.
 
-Keys, precedence and the error texts are the C++ bridge's (behaviour spec 4.1-4.3); an invalid
+Keys, precedence and the error texts are the C++ bridge's (docs/behaviour.md §4.1-§4.3); an invalid
 entry is skipped and the others still parse. The file is composed (PyYAML ``SafeLoader``) into
 a node tree rather than loaded, so every error and warning can name the entry and its line.
 """

@@ -14,7 +14,7 @@ from ros_gz_bridge_py.msgs.names import Spelling
 
 
 class Scope(enum.IntEnum):
-    """How far an advertisement travels (values as in Discovery.Publisher.Scope, §2.6)."""
+    """How far an advertisement travels (Discovery.Publisher.Scope, docs/protocol.md §2.6)."""
 
     PROCESS = 0
     HOST = 1
@@ -126,7 +126,7 @@ Callback = Callable[[Any, MessageInfo], None]
 ServiceHandler = Callable[[bytes], tuple[bool, bytes]]
 #: Async service callback: ``(True/False, reply)`` on a reply, ``(None, b"")`` on timeout.
 ReplyCallback = Callable[[bool | None, bytes], None]
-#: Response types that make a service call one-way (ZeroMQ §2.9.3, Zenoh §4.6): there is no
+#: Response types that make a service call one-way (docs/protocol.md §2.9.3, §4.6): there is no
 #: reply, the call is done once the request is sent.
 ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
 

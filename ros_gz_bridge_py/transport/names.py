@@ -1,4 +1,4 @@
-"""Fully qualified topic and service names (gz-transport-protocol.md §1.1).
+"""Fully qualified topic and service names (docs/protocol.md §1.1).
 
 Every topic and service travels on the wire as ``@<partition>@<name>``. These functions build,
 check and split that form exactly as gz-transport does, so listings and subscriptions match

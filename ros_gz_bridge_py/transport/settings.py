@@ -1,4 +1,4 @@
-"""Transport settings read from the environment (gz-transport-protocol.md §1.2, §1.4).
+"""Transport settings read from the environment (docs/protocol.md §1.2, §1.4).
 
 We talk to every Gazebo line, so each variable is read under its ``GZ_`` name first and its
 Fortress ``IGN_`` name second (the Garden rule). Bad port values fall back to the defaults,

@@ -7,7 +7,7 @@ ROS->Gazebo entry, and a typed C++ echo of that entry. As Harmonic, the peers pu
 names and Harmonic layouts on the wire (``--wire-type``, see ``tests/peer``); as Fortress, they
 are what they are: ``ignition.msgs.*`` publishers and typed ``ignition.msgs.*`` subscribers
 (as the DiffDrive system is), with the Fortress IMU layout. Each arrival is checked field by
-field against ``e2e_values`` (the conversion spec), and traffic against the configured
+field against ``e2e_values`` (the rules of docs/conversions.md), and traffic against the configured
 direction must not cross.
 """
 

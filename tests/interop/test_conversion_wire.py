@@ -5,7 +5,7 @@ peer's ``pub`` mode, and for two cases also the Debian CLI one-shot ``ign-transp
 sends a message built from a text protobuf with distinctive values. Our ZmqGzNode subscribes raw
 with the exact Fortress type string ``ignition.msgs.X``; the bytes are decoded with
 ``message_class("ignition.msgs.X")``, converted with the registry's pair, and the ROS fields are
-checked against ``/work/shared/spec/conversions.md`` (section numbers in the checks). The peer
+checked against ``docs/conversions.md`` (its section numbers are in the checks). The peer
 prints the SHA-256 of what it serialized, so each case also proves that the bytes we converted
 are exactly the C++ ones.
 
@@ -109,7 +109,7 @@ NSEC = 456_789_012
 
 
 def header(frame: str, sec: int = SEC, nsec: int = NSEC, extra: str = "") -> str:
-    """A text gz.msgs.Header with a ``seq`` entry first (ignored by the bridge, §8)."""
+    """A text gz.msgs.Header with a ``seq`` entry first (ignored by the bridge, §1.3)."""
     return (
         f'header {{ stamp {{ sec: {sec} nsec: {nsec} }} data {{ key: "seq" value: "7" }} '
         f'data {{ key: "frame_id" value: "{frame}" }} {extra}}}'
@@ -263,7 +263,7 @@ def check_imu_fortress(ros: Any) -> None:
     assert isinstance(ros, Imu)
     assert_header(ros, "imu/link")
     assert xyzw(ros.orientation) == (0.5, -0.5, 0.5, -0.5)
-    # Fortress layout: field 4 is angular_velocity and 5 linear_acceleration (gz-msgs-versions).
+    # Fortress layout: 4 is angular_velocity and 5 linear_acceleration (docs/protocol.md §9.4).
     assert xyz(ros.angular_velocity) == (0.25, -0.125, 3.5)
     assert xyz(ros.linear_acceleration) == (0.5, 0.75, -9.81)
     # No covariances exist in the Fortress layout: all stay zero (§3.5 Imu, §1.5).

@@ -44,7 +44,7 @@ PACKAGES = (
 
 TF_MESSAGE_HASH = "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087"
 # Hashes found in rosidl-generated sources (*__description.c) of third-party workspaces that
-# built the upstream packages; TFMessage's is also in shared/spec/environment.md §2.
+# built the upstream packages; TFMessage's is also in docs/environment.md §1.
 PUBLISHED_HASHES = {
     "tf2_msgs/msg/TFMessage": TF_MESSAGE_HASH,
     "ros_gz_interfaces/msg/Entity": (

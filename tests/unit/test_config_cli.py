@@ -1,4 +1,4 @@
-"""parameter_bridge argument parsing: behaviour spec 2.1-2.4 and the README inline forms."""
+"""parameter_bridge argument parsing: docs/behaviour.md §2.1-§2.4 and the README inline forms."""
 
 from __future__ import annotations
 

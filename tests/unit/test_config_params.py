@@ -1,4 +1,4 @@
-"""Parameter-defined bridges (bridge_names + bridges.<name>.*), behaviour spec 3.2."""
+"""Parameter-defined bridges (bridge_names + bridges.<name>.*), docs/behaviour.md §3.2."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Bridge YAML files: the C++ config test cases (spec 7 item 1), real configs, located errors."""
+"""Bridge YAML files: the C++ config tests (docs/behaviour.md §4.4), real files, located errors."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The Zenoh session configuration, chosen exactly as gz-transport 15 chooses it (§4.2).
+"""The Zenoh session configuration, chosen as gz-transport 15 chooses it (docs/protocol.md §4.2).
 
 1. ``ZENOH_CONFIG`` names a config file; if it is set but is not a readable regular file that
    parses, an error is logged and Zenoh's default configuration is used.

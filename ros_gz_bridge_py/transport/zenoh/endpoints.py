@@ -28,7 +28,8 @@ class ZenohPublisher(Publisher):
 
     def __init__(self, node: ZenohGzNode, topic: str, fqn: str, msg_type: str) -> None:
         super().__init__(node, topic, fqn, msg_type)
-        #: The attachment of a put in each spelling: the type name as raw bytes (§4.5).
+        #: The attachment of a put in each spelling: the type name as raw bytes
+        #: (docs/protocol.md §4.5).
         self.attachments = {name: name.encode() for name in self.names}
         #: The Zenoh publisher and the MP token, in declaration order.
         self.entities: list[Any] = []

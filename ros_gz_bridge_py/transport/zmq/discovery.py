@@ -1,4 +1,4 @@
-"""The UDP discovery protocol as a sans-IO state machine (gz-transport-protocol.md §2.3-§2.7).
+"""The UDP discovery protocol as a sans-IO state machine (docs/protocol.md §2.3-§2.7).
 
 One :class:`DiscoveryEngine` serves one discovery port (a node runs one for topics on the
 msg port and one for services on the srv port, §2.1). It owns no socket and no clock: the

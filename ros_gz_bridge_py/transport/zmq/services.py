@@ -1,4 +1,6 @@
-"""The service side of a :class:`~ros_gz_bridge_py.transport.zmq.node.ZmqGzNode` (§2.9).
+"""The service side of a :class:`~ros_gz_bridge_py.transport.zmq.node.ZmqGzNode`.
+
+The protocol: docs/protocol.md §2.9.
 
 :class:`ServiceRouter` keeps the node's service offers, its calls waiting for a provider, a
 route or a response, and the ROUTER sends retried until their peer is routable. It runs on the

@@ -1,4 +1,4 @@
-"""Byte layouts of the ZeroMQ backend, pure functions (gz-transport-protocol.md §2.3, §2.8.2, §2.9).
+"""Byte layouts of the ZeroMQ backend, pure functions (docs/protocol.md §2.3, §2.8.2, §2.9).
 
 * Discovery datagram: little-endian uint16 body length + protobuf ``Discovery`` (§2.3).
 * Data message: 4 ZMQ frames [FQN, sender PUB endpoint, payload, type name] (§2.8.2).
@@ -21,7 +21,7 @@ from ros_gz_bridge_py.errors import LocalProtocolError, RemoteProtocolError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.api import Scope
 
-#: Discovery wire version of every line from ign-transport8 to gz-transport15 (§0).
+#: Discovery wire version of every line from ign-transport8 to gz-transport15 (§3).
 WIRE_VERSION = 10
 #: Largest datagram gz-transport receives or sends (kMaxRcvStr, §2.3).
 MAX_DATAGRAM = 65535

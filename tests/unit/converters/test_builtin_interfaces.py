@@ -1,4 +1,7 @@
-"""builtin_interfaces/msg/Time <-> gz.msgs.Time: integer copy with C++ wrap-around (§1.2)."""
+"""builtin_interfaces/msg/Time <-> gz.msgs.Time: integer copy with C++ wrap-around.
+
+The rules: docs/conversions.md §1.2.
+"""
 
 from __future__ import annotations
 

@@ -1,4 +1,7 @@
-"""nav_msgs/msg/Odometry with gz.msgs.Odometry and gz.msgs.OdometryWithCovariance (§3.4)."""
+"""nav_msgs/msg/Odometry with gz.msgs.Odometry and gz.msgs.OdometryWithCovariance.
+
+The rules: docs/conversions.md §3.4.
+"""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""ros_gz_interfaces message pairs (conversions.md §3.13) and the four services (§3.14)."""
+"""ros_gz_interfaces message pairs and the four services (docs/conversions.md §3.13, §3.14)."""
 
 from __future__ import annotations
 
@@ -861,7 +861,7 @@ def test_log_playback_statistics_to_gz_keeps_start_and_end_apart() -> None:
     gz = m.log_playback_statistics_to_gz(ros)
     assert_stamped(gz.header, sec=61, frame="log")
     assert (gz.start_time.sec, gz.start_time.nsec) == (1_700_000_000, 250)
-    # nanosec is reinterpreted as int32 (conversions.md §1.2).
+    # nanosec is reinterpreted as int32 (docs/conversions.md §1.2).
     assert (gz.end_time.sec, gz.end_time.nsec) == (1_700_000_360, 4_000_000_000 - 2**32)
     assert m.log_playback_statistics_to_ros(gz) == ros
 

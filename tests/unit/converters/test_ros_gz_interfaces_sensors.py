@@ -135,7 +135,7 @@ def test_logical_camera_image_to_ros_converts_camera_pose_and_each_model_in_orde
     assert pose_numbers(ros.pose) == (-1.0, -2.0, -3.0, 0.6, 0.0, 0.0, 0.8)
     assert [m.name for m in ros.model] == ["cone_yellow", "cone_blue"]
     assert pose_numbers(ros.model[0].pose) == (4.5, 5.5, 6.5, 0.0, 0.0, -0.6, 0.8)
-    # No orientation on the wire: proto3 w is 0, not the ROS identity (conversions.md §1.4).
+    # No orientation on the wire: proto3 w is 0, not the ROS identity (docs/conversions.md §1.4).
     assert pose_numbers(ros.model[1].pose) == (0.0, 7.25, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 

@@ -1,4 +1,7 @@
-"""rosgraph_msgs/msg/Clock <-> gz.msgs.Clock: only ``sim``, normalised in G→R (§3.8)."""
+"""rosgraph_msgs/msg/Clock <-> gz.msgs.Clock: only ``sim``, normalised in G→R.
+
+The rules: docs/conversions.md §3.8.
+"""
 
 from __future__ import annotations
 

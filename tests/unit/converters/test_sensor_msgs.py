@@ -1,4 +1,7 @@
-"""sensor_msgs pairs (§3.5) except Image/CameraInfo and LaserScan/Range/PointCloud2."""
+"""sensor_msgs pairs except Image/CameraInfo and LaserScan/Range/PointCloud2.
+
+The rules: docs/conversions.md §3.5.
+"""
 
 from __future__ import annotations
 

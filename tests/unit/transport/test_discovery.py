@@ -1,4 +1,4 @@
-"""The sans-IO discovery engine with an injected clock (gz-transport-protocol.md §2.4-§2.7)."""
+"""The sans-IO discovery engine with an injected clock (docs/protocol.md §2.4-§2.7)."""
 
 from __future__ import annotations
 
@@ -151,7 +151,7 @@ def test_received_scope_filter() -> None:
 
 
 def test_new_connection_contents() -> None:
-    """§2.4/§6(a): the publisher's record, our uuids, ctrl = publisher's process uuid."""
+    """§2.4, §2.8.1 step 5: the publisher's record, our uuids, ctrl = publisher's process uuid."""
     engine = DiscoveryEngine(ME, 0.0)
     (message,) = sent(engine.connect(record(), MY_NODE))
     assert message.type == DiscoveryType.NEW_CONNECTION

@@ -1,4 +1,4 @@
-"""Fully qualified names and validity rules (gz-transport-protocol.md §1.1)."""
+"""Fully qualified names and validity rules (docs/protocol.md §1.1)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Environment settings with GZ_/IGN_ fallbacks (gz-transport-protocol.md §1.2, §1.4)."""
+"""Environment settings with GZ_/IGN_ fallbacks (docs/protocol.md §1.2, §1.4)."""
 
 from __future__ import annotations
 

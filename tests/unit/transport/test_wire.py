@@ -1,5 +1,7 @@
-"""Datagram and ZMQ frame codecs against golden bytes (gz-transport-protocol.md §2.3.2,
-shared/reference/discovery_dump.txt, captured from ign-transport 11.0.0)."""
+"""Datagram and ZMQ frame codecs against golden bytes captured from ign-transport 11.0.0.
+
+The layouts: docs/protocol.md §2.3, §2.8.2, §2.9; the captures: §2.3.2.
+"""
 
 from __future__ import annotations
 

@@ -30,7 +30,7 @@ def wait_until(condition: Callable[[], bool], timeout: float = 10.0) -> bool:
 
 def publish_until(publish: Callable[[], None], condition: Callable[[], bool]) -> bool:
     """Publish until ``condition``: a NEW_CONNECTION can overtake the SUB's TCP handshake
-    (the ZMQ slow joiner, §2.8.1), so the first message may be lost, as with gz."""
+    (the ZMQ slow joiner, docs/protocol.md §2.8.1), so the first message may be lost, as with gz."""
     deadline = time.monotonic() + 10.0
     while not condition():
         if time.monotonic() > deadline:
