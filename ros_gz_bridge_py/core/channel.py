@@ -193,10 +193,6 @@ class Channel(abc.ABC):
         self._close_output()
         self.state = ChannelState.CLOSED
 
-    @property
-    def input_open(self) -> bool:
-        return self.state is ChannelState.ACTIVE
-
     def _conversion_failed(self, err: Exception) -> None:
         self.stats.conversion_errors += 1
         self.stats.last_error = str(err)

@@ -123,10 +123,6 @@ class DiscoveryEngine:
 
     # --- queries -------------------------------------------------------------------------
 
-    def initialized(self, now: float) -> bool:
-        """True once two heartbeat cycles have passed, so listings are complete."""
-        return now - self.started >= INIT_DELAY
-
     def remote_publishers(self, topic: str) -> list[PublisherRecord]:
         """Known remote records for the FQN ``topic``."""
         return [r for records in self._remote.get(topic, {}).values() for r in records]
