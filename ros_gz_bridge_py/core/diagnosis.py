@@ -41,6 +41,9 @@ class Finding:
     #: Stable while the cause lasts: what "once per cause" is counted by.
     key: str
     text: str
+    #: A misconfiguration (raises the channel's status to WARN); False for a side that is
+    #: simply not there yet (the channel waits, as it should).
+    fault: bool = True
 
 
 @dataclass(frozen=True)
@@ -254,6 +257,7 @@ def _absent_finding(situation: Situation, role: str) -> Finding:
         f"gz-absent:{role}",
         f"no Gazebo {role} of {situation.gz_topic} in partition '{situation.partition}' "
         f"({situation.gz_peers} Gazebo processes heard){hint}",
+        fault=False,
     )
 
 

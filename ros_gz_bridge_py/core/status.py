@@ -11,9 +11,10 @@ periods.
 Each channel also shows its flow state (waiting for Gazebo, waiting for ROS, flowing, stalled)
 and, when something keeps it from carrying messages, why (``explain.py``).
 
-Levels: WARN when the channel has a cause to explain, or when conversion errors, queue drops or
-failed service calls happened in the period; STALE for a lazy channel whose input side is closed
-(nobody reads its output); OK otherwise.
+Levels: WARN when a cause is a misconfiguration (another type, another partition, no Gazebo
+process at all, incompatible QoS), or when conversion errors, queue drops or failed service
+calls happened in the period; STALE for a lazy channel whose input side is closed (nobody reads
+its output); OK otherwise (a side that is not there yet is explained, not warned about).
 
 :func:`serve` is how both executables run a built bridge: spinning, with the table on SIGUSR1.
 """
@@ -76,6 +77,8 @@ class ChannelStatus:
     flow: str = ""
     #: Why the channel carries nothing, one cause per line ("" when nothing is wrong).
     why: str = ""
+    #: One of the causes is a misconfiguration (not just a side that is not there yet).
+    fault: bool = False
 
     @property
     def name(self) -> str:
@@ -83,7 +86,7 @@ class ChannelStatus:
 
     @property
     def level(self) -> bytes:
-        if self.why or self.new_problems:
+        if self.fault or self.new_problems:
             return WARN
         if self.state == ChannelState.LAZY_IDLE.value:
             return STALE
@@ -184,6 +187,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
         last_error=stats.last_error,
         flow=channel.flow.value if channel.flow is not None else "",
         why="\n".join(finding.text for finding in channel.findings),
+        fault=any(finding.fault for finding in channel.findings),
     )
 
 
