@@ -37,7 +37,12 @@ from ros_gz_bridge_py.app.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
-from ros_gz_bridge_py.app.settings import ImageBridgeParameters, declare_image_bridge_parameters
+from ros_gz_bridge_py.app.settings import (
+    ImageBridgeParameters,
+    Switches,
+    declare_image_bridge_parameters,
+    read_switches,
+)
 from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
 from ros_gz_bridge_py.config.gz_version import check_gz_version
@@ -77,9 +82,11 @@ def bridge_specs(
     return list(with_qos(specs, profile))
 
 
-def build_bridge(node: Node, topics: Sequence[ImageTopic]) -> Bridge | None:
+def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -> Bridge | None:
     """The running bridge, or None (logged) when the parameters leave nothing to bridge."""
     logger = node.get_logger()
+    for warning in switches.warnings:
+        logger.warning(warning)
     params = declare_image_bridge_parameters(node)
     try:
         gz_type = check_gz_type(params.gz_type)
@@ -96,24 +103,24 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic]) -> Bridge | None:
         return None
     bridge = Bridge(
         node,
-        options=params.shared.bridge_options(gz_version=gz_version),
+        options=params.shared.bridge_options(switches, gz_version=gz_version),
         gz_options=params.shared.gz_node_options(),
     )
     bridge.add_all(specs)
     return bridge
 
 
-def run(topics: Sequence[ImageTopic], stop: StopSignal) -> int:
+def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> int:
     """Bridge until ``stop`` or rclpy shutdown; the node and bridge are closed on the way out."""
     node = Node(NODE_NAME)
     bridge: Bridge | None = None
     try:
-        bridge = build_bridge(node, topics)
+        bridge = build_bridge(node, topics, switches)
         if bridge is None:
             return USAGE_EXIT
         if stop.requested:
             return 0
-        serve(node, bridge, stop)
+        serve(node, bridge, stop, events_executor=switches.events_executor)
     finally:
         if bridge is not None:
             bridge.close()
@@ -144,12 +151,13 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
 
     if stop is not None and stop.requested:
         return 0
-    apply_speed_settings()
+    switches = read_switches()
+    apply_speed_settings(fastdds_profile=switches.fastdds_profile)
     rclpy.init(args=[argv[0], *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     if stop is not None:
-        return run(topics, stop)
+        return run(topics, switches, stop)
     with StopSignal() as own:
-        return run(topics, own)
+        return run(topics, switches, own)
 
 
 if __name__ == "__main__":

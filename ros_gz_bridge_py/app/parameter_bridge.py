@@ -24,7 +24,9 @@ from ros_gz_bridge_py.app.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
 from ros_gz_bridge_py.app.check import Sides, run_check
 from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
+    Switches,
     declare_parameter_bridge_parameters,
+    read_switches,
 )
 from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.config import (
@@ -124,7 +126,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
 
     if stop is not None and stop.requested:
         return 0
-    apply_speed_settings()
+    switches = read_switches()
+    apply_speed_settings(fastdds_profile=switches.fastdds_profile)
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     with contextlib.ExitStack() as scope:
         if stop is None:
@@ -137,10 +140,10 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             if stop.requested:
                 return 0
             if check_seconds is not None:
-                return check(node, cli, params, check_seconds)
-            bridge = build_bridge(node, cli, params)
+                return check(node, cli, params, switches, check_seconds)
+            bridge = build_bridge(node, cli, params, switches)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
-            serve(node, bridge, stop)
+            serve(node, bridge, stop, events_executor=switches.events_executor)
         finally:
             if diagnostics is not None:
                 diagnostics.close()
@@ -189,7 +192,13 @@ def collect_sources(
     return sources
 
 
-def check(node: Node, cli: ParseResult, params: ParameterBridgeParameters, seconds: float) -> int:
+def check(
+    node: Node,
+    cli: ParseResult,
+    params: ParameterBridgeParameters,
+    switches: Switches,
+    seconds: float,
+) -> int:
     """``--check``: report on every entry without bridging (:mod:`ros_gz_bridge_py.app.check`)."""
     sources = collect_sources(node, cli, params)
     specs = [spec for source in sources for spec in source.specs]
@@ -197,7 +206,7 @@ def check(node: Node, cli: ParseResult, params: ParameterBridgeParameters, secon
     if not specs and not errors:
         print("parameter_bridge --check: no entries to check (give topics or config_file)")
         return USAGE_EXIT
-    executor = make_executor()
+    executor = make_executor(events=switches.events_executor)
     executor.add_node(node)
     with create_node(params.shared.gz_node_options()) as gz_node:
         sides = Sides(node, gz_node, default_registry())
@@ -207,9 +216,13 @@ def check(node: Node, cli: ParseResult, params: ParameterBridgeParameters, secon
     return 1 if errors else status
 
 
-def build_bridge(node: Node, cli: ParseResult, params: ParameterBridgeParameters) -> Bridge:
+def build_bridge(
+    node: Node, cli: ParseResult, params: ParameterBridgeParameters, switches: Switches
+) -> Bridge:
     """Collect every configuration source, report its problems, and create the bridges."""
     logger = node.get_logger()
+    for warning in switches.warnings:
+        logger.warning(warning)
     sources = collect_sources(node, cli, params)
     try:
         gz_version = check_gz_version(params.shared.gz_version)
@@ -219,7 +232,7 @@ def build_bridge(node: Node, cli: ParseResult, params: ParameterBridgeParameters
     bridge = Bridge(
         node,
         options=params.shared.bridge_options(
-            gz_version=gz_version, service_timeout=params.service_timeout
+            switches, gz_version=gz_version, service_timeout=params.service_timeout
         ),
         gz_options=params.shared.gz_node_options(),
     )

@@ -1,8 +1,15 @@
-"""The node parameters of the executables, declared once for both, into frozen dataclasses.
+"""Every setting of the executables, read once at start, into frozen dataclasses.
 
-``parameter_bridge`` and ``image_bridge`` declare the parameters they share
-(:class:`SharedParameters`) here, with one name, type and default; ``GZ_VERSION`` is the default
-of ``gz_version``. README: "Node parameters".
+``parameter_bridge`` and ``image_bridge`` read the environment here and nowhere else: the
+``ROS_GZ_BRIDGE_*`` switches (:func:`read_switches`) and ``GZ_VERSION``, the default of the
+``gz_version`` parameter. Their node parameters are declared here too, the ones they share
+(:class:`SharedParameters`) with one name, type and default. The executables then hand the
+library :class:`~ros_gz_bridge_py.core.bridge.Bridge` its :class:`BridgeOptions` and the runtime
+helpers plain arguments (README: "Node parameters", "Speed settings and switches").
+
+One rule per kind of value: a switch is off when set to ``off``, ``0``, ``false`` or ``no``; a
+choice compares its value case-blind; an integer that is not one is reported (variable, value,
+fallback) and the default is used.
 """
 
 from __future__ import annotations
@@ -17,12 +24,91 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.parameter import Parameter
 
 from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV
-from ros_gz_bridge_py.core.bridge import BridgeOptions
+from ros_gz_bridge_py.core.options import BULK_THREAD_NICE, BridgeOptions
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.transport import NodeOptions
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
+
+#: Values (any case, surrounding spaces ignored) that turn a switch off.
+OFF_VALUES = frozenset({"off", "0", "false", "no"})
+
+#: ``single``: rclpy's SingleThreadedExecutor instead of the EventsExecutor.
+EXECUTOR_ENV = "ROS_GZ_BRIDGE_EXECUTOR"
+#: A switch: off keeps Fast DDS's own transports (no profile of ours).
+FASTDDS_PROFILE_ENV = "ROS_GZ_BRIDGE_FASTDDS_PROFILE"
+#: A switch: off sends images and point clouds through protobuf and rclpy's message objects.
+BULK_PATH_ENV = "ROS_GZ_BRIDGE_BULK_PATH"
+#: ``rclpy``: the bulk path publishes through rclpy (GIL held) instead of through rcl.
+SERIALIZED_PUBLISH_ENV = "ROS_GZ_BRIDGE_SERIALIZED_PUBLISH"
+#: An integer: the nice offset of bulk-path delivery threads (0: none).
+BULK_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
+#: A switch: off makes ROS->Gazebo channels take rclpy's message objects.
+LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
+
+
+@dataclass(frozen=True)
+class Switches:
+    """The ``ROS_GZ_BRIDGE_*`` environment switches; the defaults are the fast settings."""
+
+    #: False with ``ROS_GZ_BRIDGE_EXECUTOR=single``.
+    events_executor: bool = True
+    #: False with ``ROS_GZ_BRIDGE_FASTDDS_PROFILE=off``.
+    fastdds_profile: bool = True
+    #: False with ``ROS_GZ_BRIDGE_BULK_PATH=off``.
+    bulk_path: bool = True
+    #: False with ``ROS_GZ_BRIDGE_SERIALIZED_PUBLISH=rclpy``.
+    rcl_serialized_publish: bool = True
+    #: ``ROS_GZ_BRIDGE_BULK_NICE``.
+    bulk_nice: int = BULK_THREAD_NICE
+    #: False with ``ROS_GZ_BRIDGE_LIGHT_READ=off``.
+    light_read: bool = True
+    #: What was wrong with a value, one sentence each: the executables log them once their
+    #: node exists (the switches are read before ``rclpy.init``).
+    warnings: tuple[str, ...] = ()
+
+
+def switched_off(name: str, env: Mapping[str, str]) -> bool:
+    """True when the variable ``name`` of ``env`` says off."""
+    return env.get(name, "").strip().lower() in OFF_VALUES
+
+
+def _chosen(name: str, value: str, env: Mapping[str, str]) -> bool:
+    """True when the variable ``name`` of ``env`` is ``value`` (any case, spaces ignored)."""
+    return env.get(name, "").strip().lower() == value
+
+
+def _integer(name: str, default: int, hint: str, env: Mapping[str, str]) -> tuple[int, str]:
+    """(the integer in the variable ``name``, or ``default``; a warning when the value is not
+    an integer, else ''). Unset or blank is ``default`` without a warning."""
+    text = env.get(name, "").strip()
+    if not text:
+        return default, ""
+    try:
+        return int(text), ""
+    except ValueError:
+        return default, f"{name}={text!r} is not an integer; using {default} ({hint})"
+
+
+def read_switches(env: Mapping[str, str] | None = None) -> Switches:
+    """The switches of ``env`` (default: the process's environment)."""
+    env = os.environ if env is None else env
+    bulk_nice, nice_warning = _integer(
+        BULK_NICE_ENV,
+        BULK_THREAD_NICE,
+        "set a whole number, 0 to keep image threads at normal priority",
+        env,
+    )
+    return Switches(
+        events_executor=not _chosen(EXECUTOR_ENV, "single", env),
+        fastdds_profile=not switched_off(FASTDDS_PROFILE_ENV, env),
+        bulk_path=not switched_off(BULK_PATH_ENV, env),
+        rcl_serialized_publish=not _chosen(SERIALIZED_PUBLISH_ENV, "rclpy", env),
+        bulk_nice=bulk_nice,
+        light_read=not switched_off(LIGHT_READ_ENV, env),
+        warnings=(nice_warning,) if nice_warning else (),
+    )
 
 
 @dataclass(frozen=True)
@@ -45,16 +131,20 @@ class SharedParameters:
         return NodeOptions(implementation=self.gz_transport_implementation or None)
 
     def bridge_options(
-        self, *, gz_version: str, service_timeout: float = DEFAULT_TIMEOUT
+        self, switches: Switches, *, gz_version: str, service_timeout: float = DEFAULT_TIMEOUT
     ) -> BridgeOptions:
-        """The bridge's options: these parameters, and ``gz_version`` as checked by
-        :func:`~ros_gz_bridge_py.config.gz_version.check_gz_version`."""
+        """The bridge's options: these parameters, ``switches``, and ``gz_version`` as checked
+        by :func:`~ros_gz_bridge_py.config.gz_version.check_gz_version`."""
         return BridgeOptions(
             lazy=self.lazy,
             heartbeat=max(self.subscription_heartbeat, 1) / 1000.0,
             override_timestamps_with_wall_time=self.override_timestamps_with_wall_time,
             override_frame_id=self.override_frame_id,
             service_timeout=service_timeout,
+            bulk_path=switches.bulk_path,
+            rcl_serialized_publish=switches.rcl_serialized_publish,
+            bulk_nice=switches.bulk_nice,
+            light_read=switches.light_read,
             gz_version=gz_version,
         )
 

@@ -1,9 +1,10 @@
-"""The executables' node parameters, declared in one place, and the options they make."""
+"""The one reader of the executables' settings: every switch, the node parameters, the options."""
 
 from __future__ import annotations
 
+import dataclasses
 import uuid
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 import pytest
@@ -12,17 +13,128 @@ from rclpy.context import Context
 from rclpy.parameter import Parameter
 
 from ros_gz_bridge_py.app.settings import (
+    BULK_NICE_ENV,
+    BULK_PATH_ENV,
+    EXECUTOR_ENV,
+    FASTDDS_PROFILE_ENV,
+    LIGHT_READ_ENV,
+    SERIALIZED_PUBLISH_ENV,
     ImageBridgeParameters,
     ParameterBridgeParameters,
     SharedParameters,
+    Switches,
     declare_image_bridge_parameters,
     declare_parameter_bridge_parameters,
+    read_switches,
 )
 from ros_gz_bridge_py.core.bridge import BridgeOptions
+from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.transport import NodeOptions
 
+#: Each on/off switch and the field it sets.
+OFF_SWITCHES = {
+    FASTDDS_PROFILE_ENV: "fastdds_profile",
+    BULK_PATH_ENV: "bulk_path",
+    LIGHT_READ_ENV: "light_read",
+}
+#: Each choice switch, the value that chooses, and the field it sets False.
+CHOICES = {
+    EXECUTOR_ENV: ("single", "events_executor"),
+    SERIALIZED_PUBLISH_ENV: ("rclpy", "rcl_serialized_publish"),
+}
 
-def test_bridge_options_from_parameters() -> None:
+
+def switched(field: str) -> Switches:
+    """The defaults with ``field`` False."""
+    changes: dict[str, Any] = {field: False}
+    return dataclasses.replace(Switches(), **changes)
+
+
+def test_nothing_set_is_the_fast_defaults() -> None:
+    assert read_switches({}) == Switches()
+    assert read_switches({}) == Switches(
+        events_executor=True,
+        fastdds_profile=True,
+        bulk_path=True,
+        rcl_serialized_publish=True,
+        bulk_nice=BULK_THREAD_NICE,
+        light_read=True,
+        warnings=(),
+    )
+
+
+def test_reads_the_process_environment_by_default(monkeypatch: pytest.MonkeyPatch) -> None:
+    for name in [*OFF_SWITCHES, *CHOICES, BULK_NICE_ENV]:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv(BULK_PATH_ENV, "off")
+    monkeypatch.setenv(BULK_NICE_ENV, "3")
+    assert read_switches() == Switches(bulk_path=False, bulk_nice=3)
+
+
+@pytest.mark.parametrize("name", list(OFF_SWITCHES))
+@pytest.mark.parametrize("value", ["off", "OFF", " off ", "0", "false", "False", "no"])
+def test_each_switch_turns_off(name: str, value: str) -> None:
+    assert read_switches({name: value}) == switched(OFF_SWITCHES[name])
+
+
+@pytest.mark.parametrize("name", list(OFF_SWITCHES))
+@pytest.mark.parametrize("value", ["", "on", "1", "true", "yes", "offf", "single"])
+def test_other_values_leave_a_switch_on(name: str, value: str) -> None:
+    assert read_switches({name: value}) == Switches()
+
+
+@pytest.mark.parametrize("name", list(CHOICES))
+@pytest.mark.parametrize(
+    "spell", [str.lower, str.upper, lambda v: f" {v.title()} "], ids=["lower", "upper", "spaced"]
+)
+def test_each_choice_takes_its_value_in_any_case(name: str, spell: Callable[[str], str]) -> None:
+    value, field = CHOICES[name]
+    assert read_switches({name: spell(value)}) == switched(field)
+
+
+@pytest.mark.parametrize("name", list(CHOICES))
+@pytest.mark.parametrize("value", ["", "events", "off", "ctypes", "multi"])
+def test_other_values_leave_a_choice_at_its_default(name: str, value: str) -> None:
+    assert read_switches({name: value}) == Switches()
+
+
+@pytest.mark.parametrize(
+    ("value", "nice"), [("", 10), ("  ", 10), ("0", 0), (" 5 ", 5), ("-3", -3)]
+)
+def test_bulk_nice_integers(value: str, nice: int) -> None:
+    assert read_switches({BULK_NICE_ENV: value}) == Switches(bulk_nice=nice)
+
+
+@pytest.mark.parametrize("value", ["low", "1.5", "ten", "5x"])
+def test_bulk_nice_that_is_not_an_integer_is_named_with_its_fallback(value: str) -> None:
+    switches = read_switches({BULK_NICE_ENV: value})
+    assert switches.bulk_nice == BULK_THREAD_NICE
+    assert switches.warnings == (
+        f"ROS_GZ_BRIDGE_BULK_NICE={value!r} is not an integer; using 10 "
+        "(set a whole number, 0 to keep image threads at normal priority)",
+    )
+
+
+def test_every_switch_at_once() -> None:
+    env = {
+        EXECUTOR_ENV: "single",
+        FASTDDS_PROFILE_ENV: "no",
+        BULK_PATH_ENV: "0",
+        SERIALIZED_PUBLISH_ENV: "rclpy",
+        BULK_NICE_ENV: "0",
+        LIGHT_READ_ENV: "false",
+    }
+    assert read_switches(env) == Switches(
+        events_executor=False,
+        fastdds_profile=False,
+        bulk_path=False,
+        rcl_serialized_publish=False,
+        bulk_nice=0,
+        light_read=False,
+    )
+
+
+def test_bridge_options_from_parameters_and_switches() -> None:
     shared = SharedParameters(
         lazy=True,
         subscription_heartbeat=250,
@@ -30,13 +142,18 @@ def test_bridge_options_from_parameters() -> None:
         override_frame_id="cam",
         gz_version="GARDEN",
     )
-    options = shared.bridge_options(gz_version="garden", service_timeout=1.5)
+    switches = Switches(bulk_path=False, rcl_serialized_publish=False, bulk_nice=2)
+    options = shared.bridge_options(switches, gz_version="garden", service_timeout=1.5)
     assert options == BridgeOptions(
         lazy=True,
         heartbeat=0.25,
         override_timestamps_with_wall_time=True,
         override_frame_id="cam",
         service_timeout=1.5,
+        bulk_path=False,
+        rcl_serialized_publish=False,
+        bulk_nice=2,
+        light_read=True,
         gz_version="garden",
     )
 
@@ -44,7 +161,7 @@ def test_bridge_options_from_parameters() -> None:
 @pytest.mark.parametrize(("milliseconds", "seconds"), [(1000, 1.0), (0, 0.001), (-5, 0.001)])
 def test_heartbeat_is_at_least_one_millisecond(milliseconds: int, seconds: float) -> None:
     shared = SharedParameters(subscription_heartbeat=milliseconds)
-    assert shared.bridge_options(gz_version="").heartbeat == seconds
+    assert shared.bridge_options(Switches(), gz_version="").heartbeat == seconds
 
 
 @pytest.mark.parametrize(("value", "implementation"), [("", None), ("zenoh", "zenoh")])
