@@ -24,6 +24,7 @@ from benchmarks.payloads import KINDS
 from benchmarks.transport import STATS_LINE
 from benchmarks.workers import MATCH_WAIT
 from benchmarks.workers import SETTLE as PUBLISH_SETTLE
+from ros_gz_bridge_py.app.settings import read_switches
 from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
 from tests.gzpeer import PeerProcess, peer_binary, start_process, stop_processes, wait_for_line
 
@@ -59,7 +60,7 @@ def bench_env(backend: str = "zeromq") -> dict[str, str]:
     env.setdefault("ROS_DOMAIN_ID", str(os.getpid() % 100 + 101))
     for name in ("GZ_RELAY", "IGN_RELAY", "GZ_TRANSPORT_IMPLEMENTATION"):
         env.pop(name, None)
-    apply_fastdds_profile(env)
+    apply_fastdds_profile(env, enabled=read_switches(env).fastdds_profile)
     if backend == "zenoh":
         env["GZ_TRANSPORT_IMPLEMENTATION"] = "zenoh"
     return env

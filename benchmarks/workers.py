@@ -90,10 +90,11 @@ def _publish_loop(seconds: float, hz: float, send: Callable[[], None]) -> None:
 
 
 def _ros_start() -> Any:
-    from ros_gz_bridge_py.ros.runtime import tune_allocator  # noqa: PLC0415 - loads rclpy
+    from ros_gz_bridge_py.app.settings import read_switches  # noqa: PLC0415 - loads rclpy
+    from ros_gz_bridge_py.ros.runtime import tune_allocator  # noqa: PLC0415
 
     tune_allocator()
-    apply_fastdds_profile()
+    apply_fastdds_profile(enabled=read_switches().fastdds_profile)
     import rclpy  # noqa: PLC0415
     from rclpy.signals import SignalHandlerOptions  # noqa: PLC0415
 
@@ -138,6 +139,7 @@ def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | 
     rclpy = _ros_start()
     from rclpy.task import Future  # noqa: PLC0415
 
+    from ros_gz_bridge_py.app.settings import read_switches  # noqa: PLC0415
     from ros_gz_bridge_py.ros.runtime import make_executor  # noqa: PLC0415
 
     node = rclpy.create_node(f"bench_sub_{os.getpid()}")
@@ -151,7 +153,7 @@ def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | 
     _announce_match(lambda: node.count_publishers(topic) > 0)
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    executor = make_executor()
+    executor = make_executor(events=read_switches().events_executor)
     executor.add_node(node)
     never: Future = Future(executor=executor)
 

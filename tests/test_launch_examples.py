@@ -4,8 +4,8 @@ ROS ``launch`` is not installed here, so the files are compiled and read as synt
 imported. Checked: every ``Node(...)`` runs an executable of this package (a console script in
 pyproject.toml, which colcon installs to lib/ros_gz_bridge_py); every parameter it sets (in
 ``parameters=[{...}]`` or as ``-p name:=value``) is one that executable declares, read from a
-real node that ran the executable's ``declare_parameters``; every ``.yaml`` path named exists
-relative to the package root and bridges every entry.
+real node that declared the executable's parameters (``app/settings.py``); every ``.yaml`` path
+named exists relative to the package root and bridges every entry.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.utilities import try_shutdown
 
-from ros_gz_bridge_py.app import image_bridge, parameter_bridge
+from ros_gz_bridge_py.app import settings
 from ros_gz_bridge_py.config import read_yaml_file
 
 pytestmark = [pytest.mark.ros]
@@ -33,8 +33,8 @@ ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = "ros_gz_bridge_py"
 LAUNCH_FILES = sorted((ROOT / "launch_examples").glob("*.launch.py"))
 DECLARERS: dict[str, Callable[[Any], object]] = {
-    "parameter_bridge": parameter_bridge.declare_parameters,
-    "image_bridge": image_bridge.declare_parameters,
+    "parameter_bridge": settings.declare_parameter_bridge_parameters,
+    "image_bridge": settings.declare_image_bridge_parameters,
 }
 #: Parameter families the executables accept without declaring each name up front.
 PREFIXES = ("qos_overrides.",)
@@ -47,7 +47,7 @@ def console_scripts() -> set[str]:
 
 @functools.cache
 def declared_parameters(executable: str) -> frozenset[str]:
-    """The names a real node has after the executable's ``declare_parameters``."""
+    """The names a real node has after declaring the executable's parameters."""
     context = Context()
     rclpy.init(context=context)
     try:

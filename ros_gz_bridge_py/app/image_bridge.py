@@ -17,10 +17,8 @@ the raw topic is published.
 
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import rclpy
 from rclpy.node import Node
@@ -39,61 +37,27 @@ from ros_gz_bridge_py.app.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
+from ros_gz_bridge_py.app.settings import (
+    ImageBridgeParameters,
+    Switches,
+    declare_image_bridge_parameters,
+    read_switches,
+)
 from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
-from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV, check_gz_version
-from ros_gz_bridge_py.core.bridge import Bridge, BridgeOptions
+from ros_gz_bridge_py.config.gz_version import check_gz_version
+from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.status import serve
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings
-from ros_gz_bridge_py.transport import NodeOptions
 
 NODE_NAME = "ros_gz_image"
 #: Exit status for bad arguments, as ros_gz_image (``return -1``).
 USAGE_EXIT = 255
 
 
-@dataclass(frozen=True)
-class Settings:
-    """The node parameters, read once at start."""
-
-    qos: str
-    camera_info: bool
-    config_file: str
-    lazy: bool
-    subscription_heartbeat: int
-    gz_type: str
-    override_frame_id: str
-    override_timestamps_with_wall_time: bool
-    gz_transport_implementation: str
-    gz_version: str
-
-
-def declare_parameters(node: Node) -> Settings:
-    defaults = Settings(
-        qos="default",
-        camera_info=False,
-        config_file="",
-        lazy=False,
-        subscription_heartbeat=1000,
-        gz_type="gz.msgs.Image",
-        # parameter_bridge's: replace header.frame_id (e.g. by the camera's optical frame) and
-        # header.stamp (by wall time) of every bridged message.
-        override_frame_id="",
-        override_timestamps_with_wall_time=False,
-        # Ours, as in parameter_bridge: "zeromq" or "zenoh"; empty = GZ_TRANSPORT_IMPLEMENTATION.
-        gz_transport_implementation="",
-        # Ours, as in parameter_bridge: the simulator's Gazebo line when it must be said.
-        gz_version=os.environ.get(GZ_VERSION_ENV, ""),
-    )
-    values = {
-        name: node.declare_parameter(name, value).value for name, value in vars(defaults).items()
-    }
-    return Settings(**values)
-
-
 def bridge_specs(
-    node: Node, topics: Sequence[TopicBridgeSpec], settings: Settings
+    node: Node, topics: Sequence[TopicBridgeSpec], params: ImageBridgeParameters
 ) -> list[TopicBridgeSpec]:
     """Every bridge to create: the topic arguments, the config file's entries, camera infos.
 
@@ -101,65 +65,62 @@ def bridge_specs(
     """
     logger = node.get_logger()
     specs = list(topics)
-    if settings.config_file:
-        config = select_config_entries(read_yaml_file(settings.config_file))
+    if params.shared.config_file:
+        config = select_config_entries(read_yaml_file(params.shared.config_file))
         for warning in config.warnings:
             logger.warning(warning)
         for error in config.errors:
             logger.error(str(error))
         specs += [spec for spec in config.specs if isinstance(spec, TopicBridgeSpec)]
-    if settings.camera_info:
+    if params.camera_info:
         specs = list(with_camera_info(specs))
     try:
-        profile = qos_profile_name(settings.qos)
+        profile = qos_profile_name(params.qos)
     except ConfigError as err:
         logger.error(str(err))
         profile = None
     return list(with_qos(specs, profile))
 
 
-def build_bridge(node: Node, topics: Sequence[ImageTopic]) -> Bridge | None:
+def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -> Bridge | None:
     """The running bridge, or None (logged) when the parameters leave nothing to bridge."""
-    settings = declare_parameters(node)
+    logger = node.get_logger()
+    for warning in switches.warnings:
+        logger.warning(warning)
+    params = declare_image_bridge_parameters(node)
     try:
-        gz_type = check_gz_type(settings.gz_type)
-        gz_version = check_gz_version(settings.gz_version)
+        gz_type = check_gz_type(params.gz_type)
+        gz_version = check_gz_version(params.shared.gz_version)
     except ConfigError as err:
-        node.get_logger().error(str(err))
+        logger.error(str(err))
         return None
-    specs = bridge_specs(node, topic_specs(topics, gz_type), settings)
+    specs = bridge_specs(node, topic_specs(topics, gz_type), params)
     if not specs:
-        node.get_logger().error(
+        logger.error(
             "No image topics to bridge: give topic arguments or -p config_file:=<yaml> "
             "(image_bridge -h shows the syntax)"
         )
         return None
     bridge = Bridge(
         node,
-        options=BridgeOptions(
-            lazy=settings.lazy,
-            heartbeat=max(settings.subscription_heartbeat, 1) / 1000.0,
-            override_timestamps_with_wall_time=settings.override_timestamps_with_wall_time,
-            override_frame_id=settings.override_frame_id,
-            gz_version=gz_version,
-        ),
-        gz_options=NodeOptions(implementation=settings.gz_transport_implementation or None),
+        options=params.shared.bridge_options(switches, gz_version=gz_version),
+        gz_options=params.shared.gz_node_options(),
     )
     bridge.add_all(specs)
     return bridge
 
 
-def run(topics: Sequence[ImageTopic], stop: StopSignal) -> int:
+def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> int:
     """Bridge until ``stop`` or rclpy shutdown; the node and bridge are closed on the way out."""
     node = Node(NODE_NAME)
     bridge: Bridge | None = None
     try:
-        bridge = build_bridge(node, topics)
+        bridge = build_bridge(node, topics, switches)
         if bridge is None:
             return USAGE_EXIT
         if stop.requested:
             return 0
-        serve(node, bridge, stop)
+        serve(node, bridge, stop, events_executor=switches.events_executor)
     finally:
         if bridge is not None:
             bridge.close()
@@ -190,12 +151,13 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
 
     if stop is not None and stop.requested:
         return 0
-    apply_speed_settings()
+    switches = read_switches()
+    apply_speed_settings(fastdds_profile=switches.fastdds_profile)
     rclpy.init(args=[argv[0], *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     if stop is not None:
-        return run(topics, stop)
+        return run(topics, switches, stop)
     with StopSignal() as own:
-        return run(topics, own)
+        return run(topics, switches, own)
 
 
 if __name__ == "__main__":

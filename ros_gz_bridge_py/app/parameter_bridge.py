@@ -11,20 +11,23 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import os
 import sys
 from collections.abc import Sequence
-from typing import Any
 
 import rclpy
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
 from ros_gz_bridge_py.app.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
 from ros_gz_bridge_py.app.check import Sides, run_check
+from ros_gz_bridge_py.app.settings import (
+    ParameterBridgeParameters,
+    Switches,
+    declare_parameter_bridge_parameters,
+    read_switches,
+)
 from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.config import (
     USAGE,
@@ -37,14 +40,13 @@ from ros_gz_bridge_py.config import (
     parse_parameter_bridges,
     read_yaml_file,
 )
-from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV, check_gz_version
+from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.converters.registry import default_registry
-from ros_gz_bridge_py.core.bridge import Bridge, BridgeOptions
-from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
-from ros_gz_bridge_py.transport import NodeOptions, create_gz_node
+from ros_gz_bridge_py.transport import create_gz_node
 
 NODE_NAME = "ros_gz_bridge"
 #: ``parameter_bridge --check [SECONDS]``: report on the entries instead of bridging them.
@@ -66,31 +68,6 @@ BRIDGE_PARAMETER_KEYS = (
     "gz_req_type_name",
     "gz_rep_type_name",
 )
-
-
-def declare_parameters(node: Node) -> dict[str, Any]:
-    """Declare the node parameters of the C++ bridge (and ours) and return their values."""
-    defaults: dict[str, Any] = {
-        "config_file": "",
-        "expand_gz_topic_names": False,
-        "lazy": False,
-        "subscription_heartbeat": 1000,
-        "override_timestamps_with_wall_time": False,
-        "override_frame_id": "",
-        # Ours: seconds a ROS service call waits for Gazebo before answering success=false.
-        "service_timeout": DEFAULT_TIMEOUT,
-        # Ours: "zeromq" or "zenoh"; empty = GZ_TRANSPORT_IMPLEMENTATION, as gz-transport does.
-        "gz_transport_implementation": "",
-        # Ours: the simulator's Gazebo line, when it must be said (only "garden" matters).
-        "gz_version": os.environ.get(GZ_VERSION_ENV, ""),
-    }
-    values = {name: node.declare_parameter(name, value).value for name, value in defaults.items()}
-    names = node.declare_parameter("bridge_names", Parameter.Type.STRING_ARRAY).value
-    values["bridge_names"] = list(names or [])
-    # Ours: seconds between two /diagnostics status messages (0 = none); int or float.
-    any_number = ParameterDescriptor(dynamic_typing=True)
-    values["status_period"] = node.declare_parameter("status_period", 0.0, any_number).value
-    return values
 
 
 def parameter_bridge_specs(node: Node, names: Sequence[str]) -> ParseResult:
@@ -149,7 +126,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
 
     if stop is not None and stop.requested:
         return 0
-    apply_speed_settings()
+    switches = read_switches()
+    apply_speed_settings(fastdds_profile=switches.fastdds_profile)
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     with contextlib.ExitStack() as scope:
         if stop is None:
@@ -158,14 +136,14 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         bridge: Bridge | None = None
         diagnostics: DiagnosticsPublisher | None = None
         try:
-            params = declare_parameters(node)
+            params = declare_parameter_bridge_parameters(node)
             if stop.requested:
                 return 0
             if check_seconds is not None:
-                return check(node, cli, params, check_seconds)
-            bridge = build_bridge(node, cli, params)
-            diagnostics = start_diagnostics(node, bridge, params["status_period"])
-            serve(node, bridge, stop)
+                return check(node, cli, params, switches, check_seconds)
+            bridge = build_bridge(node, cli, params, switches)
+            diagnostics = start_diagnostics(node, bridge, params.status_period)
+            serve(node, bridge, stop, events_executor=switches.events_executor)
         finally:
             if diagnostics is not None:
                 diagnostics.close()
@@ -200,21 +178,27 @@ def split_check_option(args: Sequence[str]) -> tuple[float | None, list[str]]:
     return seconds, rest
 
 
-def collect_sources(node: Node, cli: ParseResult, params: dict[str, Any]) -> list[ParseResult]:
+def collect_sources(
+    node: Node, cli: ParseResult, params: ParameterBridgeParameters
+) -> list[ParseResult]:
     """Every configuration source, its problems reported."""
     sources = [cli]
-    if params["config_file"]:
-        sources.append(expand_if(read_yaml_file(params["config_file"]), node, params))
-    if params["bridge_names"]:
-        sources.append(
-            expand_if(parameter_bridge_specs(node, params["bridge_names"]), node, params)
-        )
+    if params.shared.config_file:
+        sources.append(expand_if(read_yaml_file(params.shared.config_file), node, params))
+    if params.bridge_names:
+        sources.append(expand_if(parameter_bridge_specs(node, params.bridge_names), node, params))
     for source in sources:
         report(node, source)
     return sources
 
 
-def check(node: Node, cli: ParseResult, params: dict[str, Any], seconds: float) -> int:
+def check(
+    node: Node,
+    cli: ParseResult,
+    params: ParameterBridgeParameters,
+    switches: Switches,
+    seconds: float,
+) -> int:
     """``--check``: report on every entry without bridging (:mod:`ros_gz_bridge_py.app.check`)."""
     sources = collect_sources(node, cli, params)
     specs = [spec for source in sources for spec in source.specs]
@@ -222,10 +206,9 @@ def check(node: Node, cli: ParseResult, params: dict[str, Any], seconds: float) 
     if not specs and not errors:
         print("parameter_bridge --check: no entries to check (give topics or config_file)")
         return USAGE_EXIT
-    options = NodeOptions(implementation=params["gz_transport_implementation"] or None)
-    executor = make_executor()
+    executor = make_executor(events=switches.events_executor)
     executor.add_node(node)
-    with create_gz_node(options) as gz_node:
+    with create_gz_node(params.shared.gz_node_options()) as gz_node:
         sides = Sides(node, gz_node, default_registry())
         status = run_check(sides, specs, seconds, out=sys.stdout, spin_once=executor.spin_once)
     if errors:
@@ -233,37 +216,37 @@ def check(node: Node, cli: ParseResult, params: dict[str, Any], seconds: float) 
     return 1 if errors else status
 
 
-def build_bridge(node: Node, cli: ParseResult, params: dict[str, Any]) -> Bridge:
+def build_bridge(
+    node: Node, cli: ParseResult, params: ParameterBridgeParameters, switches: Switches
+) -> Bridge:
     """Collect every configuration source, report its problems, and create the bridges."""
+    logger = node.get_logger()
+    for warning in switches.warnings:
+        logger.warning(warning)
     sources = collect_sources(node, cli, params)
     try:
-        gz_version = check_gz_version(params["gz_version"])
+        gz_version = check_gz_version(params.shared.gz_version)
     except ConfigError as err:
-        node.get_logger().error(str(err))
+        logger.error(str(err))
         gz_version = ""
     bridge = Bridge(
         node,
-        options=BridgeOptions(
-            lazy=params["lazy"],
-            heartbeat=max(params["subscription_heartbeat"], 1) / 1000.0,
-            override_timestamps_with_wall_time=params["override_timestamps_with_wall_time"],
-            override_frame_id=params["override_frame_id"],
-            service_timeout=params["service_timeout"],
-            gz_version=gz_version,
+        options=params.shared.bridge_options(
+            switches, gz_version=gz_version, service_timeout=params.service_timeout
         ),
-        gz_options=NodeOptions(implementation=params["gz_transport_implementation"] or None),
+        gz_options=params.shared.gz_node_options(),
     )
     bridge.add_all(spec for source in sources for spec in source.specs)
     if not bridge.handles:
-        node.get_logger().warning(
+        logger.warning(
             "No bridges are running: give topic arguments, or -p config_file:=<yaml>, "
             "or bridge_names parameters (parameter_bridge -h shows the syntax)"
         )
     return bridge
 
 
-def expand_if(result: ParseResult, node: Node, params: dict[str, Any]) -> ParseResult:
-    return expand_gz_names(result, node) if params["expand_gz_topic_names"] else result
+def expand_if(result: ParseResult, node: Node, params: ParameterBridgeParameters) -> ParseResult:
+    return expand_gz_names(result, node) if params.expand_gz_topic_names else result
 
 
 if __name__ == "__main__":

@@ -5,21 +5,20 @@ milliseconds during which no other Python thread of the bridge runs (``/clock`` 
 ``rcl_publish_serialized_message`` called through :mod:`ctypes` releases the GIL for the call,
 like any ctypes foreign call. The rcl publisher is the one rclpy created (``handle.pointer``),
 kept alive during the call by entering its handle. When librcl cannot be loaded this way, or
-``ROS_GZ_BRIDGE_SERIALIZED_PUBLISH=rclpy`` is set, publishing goes through rclpy's own
-serialized publish instead (same bytes on the wire, GIL held).
+the caller asks for it (the bridge's ``rcl_serialized_publish`` option; the executables'
+``ROS_GZ_BRIDGE_SERIALIZED_PUBLISH=rclpy``), publishing goes through rclpy's own serialized
+publish instead (same bytes on the wire, GIL held).
 """
 
 from __future__ import annotations
 
 import ctypes
 import functools
-import os
 from dataclasses import dataclass
 from typing import Any
 
 from ros_gz_bridge_py.errors import BridgeError
 
-ENV_MODE = "ROS_GZ_BRIDGE_SERIALIZED_PUBLISH"
 #: rcl's return code for success.
 _RCL_RET_OK = 0
 
@@ -44,8 +43,6 @@ class _Rcl:
 @functools.cache
 def _rcl() -> _Rcl | None:
     """The rcl functions from the librcl rclpy already loaded, or None."""
-    if os.environ.get(ENV_MODE, "").lower() == "rclpy":
-        return None
     try:
         publish = ctypes.CDLL("librcl.so").rcl_publish_serialized_message
         reset_error = ctypes.CDLL("librcutils.so").rcutils_reset_error
@@ -59,13 +56,17 @@ def _rcl() -> _Rcl | None:
 
 
 class SerializedPublisher:
-    """Publishes CDR bytes (with their encapsulation header) on an rclpy publisher."""
+    """Publishes CDR bytes (with their encapsulation header) on an rclpy publisher.
 
-    def __init__(self, publisher: Any) -> None:
+    ``through_rcl``: write through rcl with the GIL released when librcl can be loaded; False
+    publishes through rclpy.
+    """
+
+    def __init__(self, publisher: Any, *, through_rcl: bool) -> None:
         self._publisher = publisher
         self._handle = publisher.handle
         self._pointer: int = publisher.handle.pointer
-        self._rcl = _rcl()
+        self._rcl = _rcl() if through_rcl else None
 
     def publish(self, cdr: bytes) -> None:
         """Publish one serialized message; ``cdr`` is not copied before rcl takes it."""

@@ -17,13 +17,13 @@ Embedding::
     bridge.close()
 
 The bridge creates a wall-clock (steady) timer on the node that re-evaluates lazy channels every
-``heartbeat`` seconds, as the C++ bridge does with ``subscription_heartbeat``.
+``heartbeat`` seconds, as the C++ bridge does with ``subscription_heartbeat``. Its settings are
+the :class:`BridgeOptions` it is given; it reads no environment variable.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import os
 import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -31,35 +31,28 @@ from typing import Any
 
 from rclpy.clock import Clock, ClockType
 
-from ros_gz_bridge_py.app.switches import switched_off
 from ros_gz_bridge_py.config import (
     BridgeSpec,
     Direction,
     ServiceBridgeSpec,
     TopicBridgeSpec,
 )
-from ros_gz_bridge_py.config.gz_version import GARDEN
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.core.channel import (
-    BULK_THREAD_NICE,
     Channel,
     ChannelContext,
     GzToRosChannel,
     RosToGzChannel,
 )
 from ros_gz_bridge_py.core.explain import EXPLAIN_PERIOD, Explainer
-from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT, ServiceBridge
+from ros_gz_bridge_py.core.options import BridgeOptions
+from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.ros.side_node import SideNode, side_node_name
 from ros_gz_bridge_py.transport import GzNode, NodeOptions, create_gz_node
 
-#: Environment switch: ``off`` sends images and point clouds through the object path.
-BULK_PATH_ENV = "ROS_GZ_BRIDGE_BULK_PATH"
-#: Environment switch: ``off`` makes ROS->Gazebo channels take rclpy's message objects.
-LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
-#: Environment setting: the nice offset of bulk-path delivery threads (an integer, 0: none).
-BULK_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
+__all__ = ["Bridge", "BridgeHandle", "BridgeOptions"]
 
 
 @dataclass
@@ -69,31 +62,6 @@ class BridgeHandle:
     spec: BridgeSpec
     channels: list[Channel] = field(default_factory=list)
     service: ServiceBridge | None = None
-
-
-@dataclass(frozen=True)
-class BridgeOptions:
-    """Node-wide settings (the C++ node parameters of the same names)."""
-
-    lazy: bool = False
-    heartbeat: float = 1.0
-    override_timestamps_with_wall_time: bool = False
-    override_frame_id: str = ""
-    service_timeout: float = DEFAULT_TIMEOUT
-    #: Images and point clouds on the bulk path (``ROS_GZ_BRIDGE_BULK_PATH=off`` also disables).
-    bulk_path: bool = True
-    #: ROS->Gazebo channels read serialized messages with ros_cdr
-    #: (``ROS_GZ_BRIDGE_LIGHT_READ=off`` also disables).
-    light_read: bool = True
-    #: The simulator's Gazebo line when the user names it (``gz_version``, ``GZ_VERSION``);
-    #: only ``garden`` changes anything: its ``gz.msgs.*`` have Fortress layouts and names.
-    gz_version: str = ""
-    #: Evaluate every channel and log why it carries nothing (``explain.py``).
-    explain: bool = True
-
-    @property
-    def garden(self) -> bool:
-        return self.gz_version == GARDEN
 
 
 class Bridge:
@@ -128,11 +96,7 @@ class Bridge:
                     (side_node_name(ros_node), ros_node.get_namespace()),
                 }
             ),
-            wall_time_stamps=self.options.override_timestamps_with_wall_time,
-            override_frame_id=self.options.override_frame_id,
-            bulk_path=self.options.bulk_path and not switched_off(BULK_PATH_ENV),
-            light_read=self.options.light_read and not switched_off(LIGHT_READ_ENV),
-            bulk_nice=_bulk_nice(ros_node.get_logger()),
+            options=self.options,
         )
         self._logger = ros_node.get_logger()
         self._lock = threading.RLock()
@@ -314,18 +278,3 @@ def _close_handle(handle: BridgeHandle) -> None:
         channel.close()
     if handle.service is not None:
         handle.service.close()
-
-
-def _bulk_nice(logger: Any) -> int:
-    """:data:`BULK_NICE_ENV` as an integer; a value that is not one is reported, not used."""
-    text = os.environ.get(BULK_NICE_ENV, "").strip()
-    if not text:
-        return BULK_THREAD_NICE
-    try:
-        return int(text)
-    except ValueError:
-        logger.warning(
-            f"{BULK_NICE_ENV}={text!r} is not an integer; using {BULK_THREAD_NICE} "
-            f"(set a whole number, 0 to keep image threads at normal priority)"
-        )
-        return BULK_THREAD_NICE

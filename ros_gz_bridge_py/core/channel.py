@@ -18,11 +18,11 @@ of images still keeps only the newest ~10 frames. (The C++ bridge blocks its rec
 instead, so ZeroMQ buffers up to 1000 messages of every topic behind a slow one; our queue
 holds as many, per topic.)
 
-Pairs with a bulk path (Image, PointCloud2) take it unless ``ChannelContext.bulk_path`` is off:
+Pairs with a bulk path (Image, PointCloud2) take it unless ``BridgeOptions.bulk_path`` is off:
 serialized messages on the ROS side, the bulk bytes copied once, and the DDS write made with
 the GIL released (see :mod:`ros_gz_bridge_py.bulk`). The other ROS->Gazebo channels take the
 serialized message too and read it with :mod:`ros_gz_bridge_py.ros.light_reader` (several
-times cheaper than rclpy's message objects) unless ``ChannelContext.light_read`` is off.
+times cheaper than rclpy's message objects) unless ``BridgeOptions.light_read`` is off.
 """
 
 from __future__ import annotations
@@ -46,6 +46,7 @@ from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.diagnosis import Finding, Flow
 from ros_gz_bridge_py.core.loop_guard import OwnPublications
+from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros import light_reader
@@ -62,8 +63,6 @@ ERROR_LOG_PERIOD = 5.0
 #: Fewest messages a Gazebo->ROS delivery queue holds: ZeroMQ's default high-water mark, so
 #: 200 ms at 5 kHz (measured: with 100, a 5 kHz Odometry channel dropped 5-9% on 2 busy cores).
 MIN_DELIVERY_QUEUE = 1000
-#: How much lower the CPU priority (nice) of bulk-path delivery threads is, by default.
-BULK_THREAD_NICE = 10
 
 
 class ChannelState(enum.Enum):
@@ -107,22 +106,15 @@ def _own_publications_table() -> Callable[[str], OwnPublications]:
 
 @dataclass
 class ChannelContext:
-    """What channels share: the nodes and the node-wide options."""
+    """What channels share: the nodes and the bridge's options."""
 
     ros_node: Any
     gz_node: GzNode
     #: The bridge's side node (created on first use), for subscriptions that need message info.
     side_node: Callable[[], Any]
+    options: BridgeOptions
     #: (name, namespace) of the bridge's own ROS nodes, left out when counting readers.
     own_nodes: frozenset[tuple[str, str]] = frozenset()
-    wall_time_stamps: bool = False
-    override_frame_id: str = ""
-    #: Take the bulk path for pairs that have one (off: always the object path).
-    bulk_path: bool = True
-    #: ROS->Gazebo: read serialized messages with ros_cdr (off: rclpy's message objects).
-    light_read: bool = True
-    #: Nice offset of bulk-path delivery threads (0 keeps their priority).
-    bulk_nice: int = BULK_THREAD_NICE
     #: OwnPublications per resolved ROS topic, shared by the two halves of a bidirectional bridge.
     own_publications: Callable[[str], OwnPublications] = field(
         default_factory=_own_publications_table
@@ -157,7 +149,7 @@ class Channel(abc.ABC):
         self.ros_topic = ctx.resolve(spec.ros_topic)
         self._logger = ctx.ros_node.get_logger()
         self._last_error_log = 0.0
-        self.bulk: BulkPath | None = self.pair.bulk if ctx.bulk_path else None
+        self.bulk: BulkPath | None = self.pair.bulk if ctx.options.bulk_path else None
 
     def start(self) -> None:
         """Open the output side, and the input side unless the channel is lazy."""
@@ -273,8 +265,8 @@ class GzToRosChannel(Channel):
 
     def _make_finisher(self) -> Callable[[Any], None] | None:
         """The per-message header rewrite the node options ask for, bound once."""
-        frame_id = self.spec.frame_id or self.ctx.override_frame_id
-        stamp = self.ctx.wall_time_stamps
+        frame_id = self.spec.frame_id or self.ctx.options.override_frame_id
+        stamp = self.ctx.options.override_timestamps_with_wall_time
         if not (frame_id or stamp) or not has_top_level_header(self.pair.ros_class):
             return None
 
@@ -296,7 +288,13 @@ class GzToRosChannel(Channel):
             self._qos,
             qos_overriding_options=PUBLISHER_OVERRIDES,
         )
-        publisher = self._publisher if self.bulk is None else SerializedPublisher(self._publisher)
+        publisher = (
+            self._publisher
+            if self.bulk is None
+            else SerializedPublisher(
+                self._publisher, through_rcl=self.ctx.options.rcl_serialized_publish
+            )
+        )
         self._publish = self.ctx.own_publications(self.ros_topic).wrap(publisher)
 
     def _close_output(self) -> None:
@@ -315,7 +313,7 @@ class GzToRosChannel(Channel):
             ignore_local=True,
             queue_size=depth,
             copy=False,
-            on_delivery_start=(lambda: yield_cpu_to_light_topics(self.ctx.bulk_nice))
+            on_delivery_start=(lambda: yield_cpu_to_light_topics(self.ctx.options.bulk_nice))
             if bulk
             else None,
         )
@@ -387,7 +385,7 @@ class RosToGzChannel(Channel):
         self._own = ctx.own_publications(self.ros_topic)
         self._gz_publisher: Publisher | None = None
         self._light = (
-            ctx.light_read
+            ctx.options.light_read
             and self.bulk is None
             and light_reader.reader_for(self.pair.ros_class) is not None
         )

@@ -307,10 +307,11 @@ def table_on_signal(
         signal.signal(signum, previous)
 
 
-def serve(ros_node: Any, bridge: Bridge, stop: StopSignal) -> None:
+def serve(ros_node: Any, bridge: Bridge, stop: StopSignal, *, events_executor: bool) -> None:
     """What both executables do once their bridges exist: spin ``ros_node`` until ``stop`` or
-    rclpy shutdown, printing the status table on SIGUSR1 meanwhile."""
-    executor = make_executor()
+    rclpy shutdown, printing the status table on SIGUSR1 meanwhile. ``events_executor``: see
+    :func:`~ros_gz_bridge_py.ros.runtime.make_executor`."""
+    executor = make_executor(events=events_executor)
     executor.add_node(ros_node)
     with table_on_signal(bridge):
         spin_until_stopped(executor, stop)

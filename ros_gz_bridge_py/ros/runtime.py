@@ -1,6 +1,8 @@
 """Process-level plumbing shared by the executables: speed settings, executor, clean shutdown.
 
-Speed settings (``../shared/spec/environment.md`` §5, measured on the project machines):
+What the user switched off comes in as arguments: the executables read the switches
+(:mod:`ros_gz_bridge_py.app.settings`). Speed settings (``../shared/spec/environment.md`` §5,
+measured on the project machines):
 
 * The allocator: glibc maps every 1-6 MB buffer with mmap and unmaps it again, so each image is
   page-faulted anew. Raising the mmap and trim thresholds (what ``MALLOC_MMAP_THRESHOLD_`` and
@@ -8,12 +10,12 @@ Speed settings (``../shared/spec/environment.md`` §5, measured on the project m
   unless the user set either variable.
 * The executor: rclpy's ``SingleThreadedExecutor`` costs ~250 µs per callback;
   ``rclpy.experimental.EventsExecutor`` is about four times faster and is the default
-  (``ROS_GZ_BRIDGE_EXECUTOR=single`` switches back). In the Jazzy wheels its plain ``spin()``
-  busy-waits holding the GIL, ``spin_until_future_complete`` ignores its timeout, and
-  subscription callbacks that take message info fail (``spin_once`` with a timeout works
-  and idles at ~0% CPU, ``spin_until_future_complete`` busy-waits at 60% of a core); so we
-  spin it step by step with ``spin_once`` and keep message-info callbacks on the side node
-  (``side_node.py``).
+  (``make_executor(events=False)`` switches back; ``ROS_GZ_BRIDGE_EXECUTOR=single`` for the
+  executables). In the Jazzy wheels its plain ``spin()`` busy-waits holding the GIL,
+  ``spin_until_future_complete`` ignores its timeout, and subscription callbacks that take
+  message info fail (``spin_once`` with a timeout works and idles at ~0% CPU,
+  ``spin_until_future_complete`` busy-waits at 60% of a core); so we spin it step by step with
+  ``spin_once`` and keep message-info callbacks on the side node (``side_node.py``).
 """
 
 from __future__ import annotations
@@ -47,11 +49,12 @@ def tune_threads() -> None:
     sys.setswitchinterval(SWITCH_INTERVAL)
 
 
-def apply_speed_settings() -> None:
-    """Everything the executables set before ``rclpy.init``: allocator, GIL, Fast DDS profile."""
+def apply_speed_settings(*, fastdds_profile: bool) -> None:
+    """Everything the executables set before ``rclpy.init``: allocator, GIL, and the Fast DDS
+    profile unless ``fastdds_profile`` is False."""
     tune_allocator()
     tune_threads()
-    apply_fastdds_profile()
+    apply_fastdds_profile(enabled=fastdds_profile)
 
 
 def tune_allocator() -> bool:
@@ -71,9 +74,10 @@ def tune_allocator() -> bool:
     return bool(ok_mmap and ok_trim)
 
 
-def make_executor() -> Any:
-    """The executor the executables spin: EventsExecutor unless ROS_GZ_BRIDGE_EXECUTOR=single."""
-    if os.environ.get("ROS_GZ_BRIDGE_EXECUTOR", "events").lower() == "single":
+def make_executor(*, events: bool) -> Any:
+    """The executor the executables spin: the EventsExecutor, or with ``events`` False rclpy's
+    SingleThreadedExecutor."""
+    if not events:
         return SingleThreadedExecutor()
     from rclpy.experimental import EventsExecutor  # noqa: PLC0415 - experimental, load on use
 

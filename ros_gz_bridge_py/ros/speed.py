@@ -5,7 +5,8 @@ fragmented UDP; measured on the project machines (``environment.md`` §5) a 64 M
 1080p rclpy throughput from ~40 to ~270 msg/s. The profile (``resources/fastdds_shm_profile.xml``)
 is applied only when the user has not chosen otherwise: the RMW is Fast DDS (unset or
 ``rmw_fastrtps_cpp``), neither ``FASTRTPS_DEFAULT_PROFILES_FILE`` nor
-``FASTDDS_DEFAULT_PROFILES_FILE`` is set, and ``ROS_GZ_BRIDGE_FASTDDS_PROFILE`` is not ``off``.
+``FASTDDS_DEFAULT_PROFILES_FILE`` is set, and it is not switched off (``enabled=False``; the
+executables' ``ROS_GZ_BRIDGE_FASTDDS_PROFILE=off``, read by :mod:`ros_gz_bridge_py.app.settings`).
 
 The profile replaces Fast DDS's built-in transports with SHM + UDPv4. With
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` / ``ROS_LOCALHOST_ONLY=1`` the bridge plus an rclpy
@@ -20,11 +21,7 @@ from collections.abc import Mapping, MutableMapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ros_gz_bridge_py.app.switches import switched_off
-
 PROFILE = Path(__file__).resolve().parent / "resources" / "fastdds_shm_profile.xml"
-#: Set to off/0/false/no to keep Fast DDS's own transports.
-OPT_OUT_ENV = "ROS_GZ_BRIDGE_FASTDDS_PROFILE"
 PROFILE_ENVS = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")
 FAST_DDS_RMW = "rmw_fastrtps_cpp"
 
@@ -39,10 +36,11 @@ class ProfileDecision:
     reason: str
 
 
-def decide(env: Mapping[str, str]) -> ProfileDecision:
-    """The decision for the environment ``env`` (no side effects)."""
-    if switched_off(OPT_OUT_ENV, env):
-        return ProfileDecision(False, f"{OPT_OUT_ENV}={env[OPT_OUT_ENV]}")
+def decide(env: Mapping[str, str], *, enabled: bool) -> ProfileDecision:
+    """The decision for the environment ``env`` (no side effects); ``enabled`` False: the user
+    switched our profile off."""
+    if not enabled:
+        return ProfileDecision(False, "switched off by ROS_GZ_BRIDGE_FASTDDS_PROFILE")
     rmw = env.get("RMW_IMPLEMENTATION", "").strip()
     if rmw and rmw != FAST_DDS_RMW:
         return ProfileDecision(False, f"RMW_IMPLEMENTATION={rmw} is not Fast DDS")
@@ -52,13 +50,16 @@ def decide(env: Mapping[str, str]) -> ProfileDecision:
     return ProfileDecision(True, f"Fast DDS with no user profile: applying {PROFILE}")
 
 
-def apply_fastdds_profile(env: MutableMapping[str, str] | None = None) -> str | None:
+def apply_fastdds_profile(
+    env: MutableMapping[str, str] | None = None, *, enabled: bool
+) -> str | None:
     """Point Fast DDS at our profile when :func:`decide` says so; the path applied, or None.
 
-    Call before ``rclpy.init``: Fast DDS reads the variable when the first participant is made.
+    ``env``: the Fast DDS variables to read and set (default: the process's). Call before
+    ``rclpy.init``: Fast DDS reads the variable when the first participant is made.
     """
     target = os.environ if env is None else env
-    decision = decide(target)
+    decision = decide(target, enabled=enabled)
     _LOG.debug("Fast DDS shared-memory profile: %s", decision.reason)
     if not decision.apply:
         return None

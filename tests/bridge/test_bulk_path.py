@@ -20,9 +20,9 @@ import pytest
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import Image, PointCloud2, PointField
 
+from ros_gz_bridge_py.app.settings import BULK_PATH_ENV as BULK_ENV
 from ros_gz_bridge_py.converters.registry import default_registry
-from ros_gz_bridge_py.core.bridge import BULK_PATH_ENV as BULK_ENV
-from ros_gz_bridge_py.core.channel import BULK_THREAD_NICE
+from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import GzNode

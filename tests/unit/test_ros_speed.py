@@ -6,6 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
+from ros_gz_bridge_py.app.settings import read_switches
 from ros_gz_bridge_py.ros.speed import PROFILE, apply_fastdds_profile, decide
 
 NS = {"f": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
@@ -14,7 +15,7 @@ NS = {"f": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
 @pytest.mark.parametrize("rmw", [None, "rmw_fastrtps_cpp", " rmw_fastrtps_cpp "])
 def test_applied_for_fast_dds_without_user_profile(rmw: str | None) -> None:
     env = {"ROS_DOMAIN_ID": "3"} if rmw is None else {"RMW_IMPLEMENTATION": rmw}
-    assert apply_fastdds_profile(env) == str(PROFILE)
+    assert apply_fastdds_profile(env, enabled=True) == str(PROFILE)
     assert env["FASTRTPS_DEFAULT_PROFILES_FILE"] == str(PROFILE)
 
 
@@ -31,17 +32,19 @@ def test_applied_for_fast_dds_without_user_profile(rmw: str | None) -> None:
     ],
 )
 def test_user_choices_win(env: dict[str, str], why: str) -> None:
+    """The switch is read from the same environment, as the executables do."""
     before = dict(env)
-    decision = decide(env)
+    enabled = read_switches(env).fastdds_profile
+    decision = decide(env, enabled=enabled)
     assert not decision.apply
     assert why in decision.reason
-    assert apply_fastdds_profile(env) is None
+    assert apply_fastdds_profile(env, enabled=enabled) is None
     assert env == before
 
 
 def test_empty_profile_variable_counts_as_unset() -> None:
     env = {"FASTDDS_DEFAULT_PROFILES_FILE": "", "ROS_GZ_BRIDGE_FASTDDS_PROFILE": "on"}
-    assert apply_fastdds_profile(env) == str(PROFILE)
+    assert apply_fastdds_profile(env, enabled=read_switches(env).fastdds_profile) == str(PROFILE)
 
 
 def test_profile_is_a_default_participant_with_a_large_shm_segment() -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from ros_gz_bridge_py.app.switches import switched_off
+from ros_gz_bridge_py.app.settings import read_switches, switched_off
 
 NAME = "ROS_GZ_BRIDGE_SOMETHING"
 
@@ -23,31 +23,17 @@ def test_unset_is_on() -> None:
     assert not switched_off(NAME, {})
 
 
-class _Logger:
-    def __init__(self) -> None:
-        self.warnings: list[str] = []
-
-    def warning(self, text: str) -> None:
-        self.warnings.append(text)
-
-
 @pytest.mark.parametrize(("value", "nice"), [("", 10), ("0", 0), (" 5 ", 5), ("-3", -3)])
-def test_bulk_nice_values(monkeypatch: pytest.MonkeyPatch, value: str, nice: int) -> None:
-    from ros_gz_bridge_py.core.bridge import BULK_NICE_ENV, _bulk_nice  # noqa: PLC0415
-
-    monkeypatch.setenv(BULK_NICE_ENV, value)
-    logger = _Logger()
-    assert _bulk_nice(logger) == nice
-    assert logger.warnings == []
+def test_bulk_nice_values(value: str, nice: int) -> None:
+    switches = read_switches({"ROS_GZ_BRIDGE_BULK_NICE": value})
+    assert switches.bulk_nice == nice
+    assert switches.warnings == ()
 
 
-def test_bulk_nice_that_is_not_a_number_is_reported(monkeypatch: pytest.MonkeyPatch) -> None:
-    from ros_gz_bridge_py.core.bridge import BULK_NICE_ENV, _bulk_nice  # noqa: PLC0415
-
-    monkeypatch.setenv(BULK_NICE_ENV, "low")
-    logger = _Logger()
-    assert _bulk_nice(logger) == 10
-    assert logger.warnings == [
+def test_bulk_nice_that_is_not_a_number_is_reported() -> None:
+    switches = read_switches({"ROS_GZ_BRIDGE_BULK_NICE": "low"})
+    assert switches.bulk_nice == 10
+    assert switches.warnings == (
         "ROS_GZ_BRIDGE_BULK_NICE='low' is not an integer; using 10 "
-        "(set a whole number, 0 to keep image threads at normal priority)"
-    ]
+        "(set a whole number, 0 to keep image threads at normal priority)",
+    )

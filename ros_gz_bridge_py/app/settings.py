@@ -1,0 +1,218 @@
+"""Every setting of the executables, read once at start, into frozen dataclasses.
+
+``parameter_bridge`` and ``image_bridge`` read the environment here and nowhere else: the
+``ROS_GZ_BRIDGE_*`` switches (:func:`read_switches`) and ``GZ_VERSION``, the default of the
+``gz_version`` parameter. Their node parameters are declared here too, the ones they share
+(:class:`SharedParameters`) with one name, type and default. The executables then hand the
+library :class:`~ros_gz_bridge_py.core.bridge.Bridge` its :class:`BridgeOptions` and the runtime
+helpers plain arguments (README: "Node parameters", "Speed settings and switches").
+
+One rule per kind of value: a switch is off when set to ``off``, ``0``, ``false`` or ``no``; a
+choice compares its value case-blind; an integer that is not one is reported (variable, value,
+fallback) and the default is used.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Collection, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, TypeVar
+
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.parameter import Parameter
+
+from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV
+from ros_gz_bridge_py.core.options import BULK_THREAD_NICE, BridgeOptions
+from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.transport import NodeOptions
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+#: Values (any case, surrounding spaces ignored) that turn a switch off.
+OFF_VALUES = frozenset({"off", "0", "false", "no"})
+
+#: ``single``: rclpy's SingleThreadedExecutor instead of the EventsExecutor.
+EXECUTOR_ENV = "ROS_GZ_BRIDGE_EXECUTOR"
+#: A switch: off keeps Fast DDS's own transports (no profile of ours).
+FASTDDS_PROFILE_ENV = "ROS_GZ_BRIDGE_FASTDDS_PROFILE"
+#: A switch: off sends images and point clouds through protobuf and rclpy's message objects.
+BULK_PATH_ENV = "ROS_GZ_BRIDGE_BULK_PATH"
+#: ``rclpy``: the bulk path publishes through rclpy (GIL held) instead of through rcl.
+SERIALIZED_PUBLISH_ENV = "ROS_GZ_BRIDGE_SERIALIZED_PUBLISH"
+#: An integer: the nice offset of bulk-path delivery threads (0: none).
+BULK_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
+#: A switch: off makes ROS->Gazebo channels take rclpy's message objects.
+LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
+
+
+@dataclass(frozen=True)
+class Switches:
+    """The ``ROS_GZ_BRIDGE_*`` environment switches; the defaults are the fast settings."""
+
+    #: False with ``ROS_GZ_BRIDGE_EXECUTOR=single``.
+    events_executor: bool = True
+    #: False with ``ROS_GZ_BRIDGE_FASTDDS_PROFILE=off``.
+    fastdds_profile: bool = True
+    #: False with ``ROS_GZ_BRIDGE_BULK_PATH=off``.
+    bulk_path: bool = True
+    #: False with ``ROS_GZ_BRIDGE_SERIALIZED_PUBLISH=rclpy``.
+    rcl_serialized_publish: bool = True
+    #: ``ROS_GZ_BRIDGE_BULK_NICE``.
+    bulk_nice: int = BULK_THREAD_NICE
+    #: False with ``ROS_GZ_BRIDGE_LIGHT_READ=off``.
+    light_read: bool = True
+    #: What was wrong with a value, one sentence each: the executables log them once their
+    #: node exists (the switches are read before ``rclpy.init``).
+    warnings: tuple[str, ...] = ()
+
+
+def switched_off(name: str, env: Mapping[str, str]) -> bool:
+    """True when the variable ``name`` of ``env`` says off."""
+    return env.get(name, "").strip().lower() in OFF_VALUES
+
+
+def _chosen(name: str, value: str, env: Mapping[str, str]) -> bool:
+    """True when the variable ``name`` of ``env`` is ``value`` (any case, spaces ignored)."""
+    return env.get(name, "").strip().lower() == value
+
+
+def _integer(name: str, default: int, hint: str, env: Mapping[str, str]) -> tuple[int, str]:
+    """(the integer in the variable ``name``, or ``default``; a warning when the value is not
+    an integer, else ''). Unset or blank is ``default`` without a warning."""
+    text = env.get(name, "").strip()
+    if not text:
+        return default, ""
+    try:
+        return int(text), ""
+    except ValueError:
+        return default, f"{name}={text!r} is not an integer; using {default} ({hint})"
+
+
+def read_switches(env: Mapping[str, str] | None = None) -> Switches:
+    """The switches of ``env`` (default: the process's environment)."""
+    env = os.environ if env is None else env
+    bulk_nice, nice_warning = _integer(
+        BULK_NICE_ENV,
+        BULK_THREAD_NICE,
+        "set a whole number, 0 to keep image threads at normal priority",
+        env,
+    )
+    return Switches(
+        events_executor=not _chosen(EXECUTOR_ENV, "single", env),
+        fastdds_profile=not switched_off(FASTDDS_PROFILE_ENV, env),
+        bulk_path=not switched_off(BULK_PATH_ENV, env),
+        rcl_serialized_publish=not _chosen(SERIALIZED_PUBLISH_ENV, "rclpy", env),
+        bulk_nice=bulk_nice,
+        light_read=not switched_off(LIGHT_READ_ENV, env),
+        warnings=(nice_warning,) if nice_warning else (),
+    )
+
+
+@dataclass(frozen=True)
+class SharedParameters:
+    """The node parameters both executables declare (the C++ bridge's, and ours)."""
+
+    config_file: str = ""
+    lazy: bool = False
+    #: Milliseconds between two lazy re-checks.
+    subscription_heartbeat: int = 1000
+    override_timestamps_with_wall_time: bool = False
+    override_frame_id: str = ""
+    #: Ours: "zeromq" or "zenoh"; empty = GZ_TRANSPORT_IMPLEMENTATION, as gz-transport does.
+    gz_transport_implementation: str = ""
+    #: Ours: the simulator's Gazebo line, when it must be said (only "garden" matters);
+    #: declared with ``GZ_VERSION`` as its default.
+    gz_version: str = ""
+
+    def gz_node_options(self) -> NodeOptions:
+        return NodeOptions(implementation=self.gz_transport_implementation or None)
+
+    def bridge_options(
+        self, switches: Switches, *, gz_version: str, service_timeout: float = DEFAULT_TIMEOUT
+    ) -> BridgeOptions:
+        """The bridge's options: these parameters, ``switches``, and ``gz_version`` as checked
+        by :func:`~ros_gz_bridge_py.config.gz_version.check_gz_version`."""
+        return BridgeOptions(
+            lazy=self.lazy,
+            heartbeat=max(self.subscription_heartbeat, 1) / 1000.0,
+            override_timestamps_with_wall_time=self.override_timestamps_with_wall_time,
+            override_frame_id=self.override_frame_id,
+            service_timeout=service_timeout,
+            bulk_path=switches.bulk_path,
+            rcl_serialized_publish=switches.rcl_serialized_publish,
+            bulk_nice=switches.bulk_nice,
+            light_read=switches.light_read,
+            gz_version=gz_version,
+        )
+
+
+@dataclass(frozen=True)
+class ParameterBridgeParameters:
+    """``parameter_bridge``'s node parameters."""
+
+    shared: SharedParameters
+    expand_gz_topic_names: bool = False
+    #: Ours: seconds a ROS service call waits for Gazebo before answering success=false.
+    service_timeout: float = DEFAULT_TIMEOUT
+    #: The ``bridges.<name>.*`` groups to read (a string array parameter with no default).
+    bridge_names: tuple[str, ...] = ()
+    #: Ours: seconds between two /diagnostics status messages (0 = none). Any type may be
+    #: given; ``start_diagnostics`` takes an int or a float and reports anything else.
+    status_period: object = 0.0
+
+
+@dataclass(frozen=True)
+class ImageBridgeParameters:
+    """``image_bridge``'s node parameters: the shared ones and ros_gz_image's own."""
+
+    shared: SharedParameters
+    qos: str = "default"
+    camera_info: bool = False
+    gz_type: str = "gz.msgs.Image"
+
+
+_Parameters = TypeVar("_Parameters", bound="DataclassInstance")
+
+
+def _declare_fields(node: Any, defaults: _Parameters, skip: Collection[str]) -> _Parameters:
+    """Declare a parameter per field of ``defaults`` but those in ``skip``, each defaulting to
+    its value (which sets its type); ``defaults`` with the declared values."""
+    values = {
+        field.name: node.declare_parameter(field.name, getattr(defaults, field.name)).value
+        for field in dataclasses.fields(defaults)
+        if field.name not in skip
+    }
+    return dataclasses.replace(defaults, **values)
+
+
+def declare_shared_parameters(node: Any, env: Mapping[str, str] | None = None) -> SharedParameters:
+    """Declare the shared parameters on ``node``; ``gz_version`` defaults to ``GZ_VERSION`` of
+    ``env`` (default: the process's environment)."""
+    env = os.environ if env is None else env
+    return _declare_fields(node, SharedParameters(gz_version=env.get(GZ_VERSION_ENV, "")), ())
+
+
+def declare_parameter_bridge_parameters(
+    node: Any, env: Mapping[str, str] | None = None
+) -> ParameterBridgeParameters:
+    """Declare ``parameter_bridge``'s parameters on ``node`` and return their values."""
+    declared = _declare_fields(
+        node,
+        ParameterBridgeParameters(declare_shared_parameters(node, env)),
+        ("shared", "bridge_names", "status_period"),
+    )
+    names = node.declare_parameter("bridge_names", Parameter.Type.STRING_ARRAY).value
+    any_type = ParameterDescriptor(dynamic_typing=True)
+    period = node.declare_parameter("status_period", declared.status_period, any_type).value
+    return dataclasses.replace(declared, bridge_names=tuple(names or ()), status_period=period)
+
+
+def declare_image_bridge_parameters(
+    node: Any, env: Mapping[str, str] | None = None
+) -> ImageBridgeParameters:
+    """Declare ``image_bridge``'s parameters on ``node`` and return their values."""
+    shared = declare_shared_parameters(node, env)
+    return _declare_fields(node, ImageBridgeParameters(shared), ("shared",))

@@ -1,0 +1,46 @@
+"""The node-wide options of a :class:`~ros_gz_bridge_py.core.bridge.Bridge`.
+
+The bridge and its channels read their settings here and nowhere else; in particular they read
+no environment variable. The executables turn their node parameters and ``ROS_GZ_BRIDGE_*``
+switches into these options (:mod:`ros_gz_bridge_py.app.settings`); a program that embeds the
+bridge passes its own.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ros_gz_bridge_py.config.gz_version import GARDEN
+from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
+
+#: How much lower the CPU priority (nice) of bulk-path delivery threads is, by default.
+BULK_THREAD_NICE = 10
+
+
+@dataclass(frozen=True)
+class BridgeOptions:
+    """Node-wide settings (the C++ node parameters of the same names, and how messages travel)."""
+
+    lazy: bool = False
+    heartbeat: float = 1.0
+    override_timestamps_with_wall_time: bool = False
+    override_frame_id: str = ""
+    service_timeout: float = DEFAULT_TIMEOUT
+    #: Images and point clouds on the bulk path (False: protobuf and rclpy message objects).
+    bulk_path: bool = True
+    #: Bulk path: publish serialized messages through rcl with the GIL released (False: through
+    #: rclpy's own publish, GIL held).
+    rcl_serialized_publish: bool = True
+    #: Nice offset of bulk-path delivery threads (0 keeps their priority).
+    bulk_nice: int = BULK_THREAD_NICE
+    #: ROS->Gazebo channels read serialized messages with ros_cdr (False: rclpy's objects).
+    light_read: bool = True
+    #: The simulator's Gazebo line when the user names it (``gz_version``, ``GZ_VERSION``);
+    #: only ``garden`` changes anything: its ``gz.msgs.*`` have Fortress layouts and names.
+    gz_version: str = ""
+    #: Evaluate every channel and log why it carries nothing (``explain.py``).
+    explain: bool = True
+
+    @property
+    def garden(self) -> bool:
+        return self.gz_version == GARDEN

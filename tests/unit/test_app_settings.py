@@ -1,0 +1,306 @@
+"""The one reader of the executables' settings: every switch, the node parameters, the options."""
+
+from __future__ import annotations
+
+import dataclasses
+import uuid
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
+
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.parameter import Parameter
+
+from ros_gz_bridge_py.app.settings import (
+    BULK_NICE_ENV,
+    BULK_PATH_ENV,
+    EXECUTOR_ENV,
+    FASTDDS_PROFILE_ENV,
+    LIGHT_READ_ENV,
+    SERIALIZED_PUBLISH_ENV,
+    ImageBridgeParameters,
+    ParameterBridgeParameters,
+    SharedParameters,
+    Switches,
+    declare_image_bridge_parameters,
+    declare_parameter_bridge_parameters,
+    read_switches,
+)
+from ros_gz_bridge_py.core.bridge import BridgeOptions
+from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
+from ros_gz_bridge_py.transport import NodeOptions
+
+#: Each on/off switch and the field it sets.
+OFF_SWITCHES = {
+    FASTDDS_PROFILE_ENV: "fastdds_profile",
+    BULK_PATH_ENV: "bulk_path",
+    LIGHT_READ_ENV: "light_read",
+}
+#: Each choice switch, the value that chooses, and the field it sets False.
+CHOICES = {
+    EXECUTOR_ENV: ("single", "events_executor"),
+    SERIALIZED_PUBLISH_ENV: ("rclpy", "rcl_serialized_publish"),
+}
+
+
+def switched(field: str) -> Switches:
+    """The defaults with ``field`` False."""
+    changes: dict[str, Any] = {field: False}
+    return dataclasses.replace(Switches(), **changes)
+
+
+def test_nothing_set_is_the_fast_defaults() -> None:
+    assert read_switches({}) == Switches()
+    assert read_switches({}) == Switches(
+        events_executor=True,
+        fastdds_profile=True,
+        bulk_path=True,
+        rcl_serialized_publish=True,
+        bulk_nice=BULK_THREAD_NICE,
+        light_read=True,
+        warnings=(),
+    )
+
+
+def test_reads_the_process_environment_by_default(monkeypatch: pytest.MonkeyPatch) -> None:
+    for name in [*OFF_SWITCHES, *CHOICES, BULK_NICE_ENV]:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv(BULK_PATH_ENV, "off")
+    monkeypatch.setenv(BULK_NICE_ENV, "3")
+    assert read_switches() == Switches(bulk_path=False, bulk_nice=3)
+
+
+@pytest.mark.parametrize("name", list(OFF_SWITCHES))
+@pytest.mark.parametrize("value", ["off", "OFF", " off ", "0", "false", "False", "no"])
+def test_each_switch_turns_off(name: str, value: str) -> None:
+    assert read_switches({name: value}) == switched(OFF_SWITCHES[name])
+
+
+@pytest.mark.parametrize("name", list(OFF_SWITCHES))
+@pytest.mark.parametrize("value", ["", "on", "1", "true", "yes", "offf", "single"])
+def test_other_values_leave_a_switch_on(name: str, value: str) -> None:
+    assert read_switches({name: value}) == Switches()
+
+
+@pytest.mark.parametrize("name", list(CHOICES))
+@pytest.mark.parametrize(
+    "spell", [str.lower, str.upper, lambda v: f" {v.title()} "], ids=["lower", "upper", "spaced"]
+)
+def test_each_choice_takes_its_value_in_any_case(name: str, spell: Callable[[str], str]) -> None:
+    value, field = CHOICES[name]
+    assert read_switches({name: spell(value)}) == switched(field)
+
+
+@pytest.mark.parametrize("name", list(CHOICES))
+@pytest.mark.parametrize("value", ["", "events", "off", "ctypes", "multi"])
+def test_other_values_leave_a_choice_at_its_default(name: str, value: str) -> None:
+    assert read_switches({name: value}) == Switches()
+
+
+@pytest.mark.parametrize(
+    ("value", "nice"), [("", 10), ("  ", 10), ("0", 0), (" 5 ", 5), ("-3", -3)]
+)
+def test_bulk_nice_integers(value: str, nice: int) -> None:
+    assert read_switches({BULK_NICE_ENV: value}) == Switches(bulk_nice=nice)
+
+
+@pytest.mark.parametrize("value", ["low", "1.5", "ten", "5x"])
+def test_bulk_nice_that_is_not_an_integer_is_named_with_its_fallback(value: str) -> None:
+    switches = read_switches({BULK_NICE_ENV: value})
+    assert switches.bulk_nice == BULK_THREAD_NICE
+    assert switches.warnings == (
+        f"ROS_GZ_BRIDGE_BULK_NICE={value!r} is not an integer; using 10 "
+        "(set a whole number, 0 to keep image threads at normal priority)",
+    )
+
+
+def test_every_switch_at_once() -> None:
+    env = {
+        EXECUTOR_ENV: "single",
+        FASTDDS_PROFILE_ENV: "no",
+        BULK_PATH_ENV: "0",
+        SERIALIZED_PUBLISH_ENV: "rclpy",
+        BULK_NICE_ENV: "0",
+        LIGHT_READ_ENV: "false",
+    }
+    assert read_switches(env) == Switches(
+        events_executor=False,
+        fastdds_profile=False,
+        bulk_path=False,
+        rcl_serialized_publish=False,
+        bulk_nice=0,
+        light_read=False,
+    )
+
+
+def test_bridge_options_from_parameters_and_switches() -> None:
+    shared = SharedParameters(
+        lazy=True,
+        subscription_heartbeat=250,
+        override_timestamps_with_wall_time=True,
+        override_frame_id="cam",
+        gz_version="GARDEN",
+    )
+    switches = Switches(bulk_path=False, rcl_serialized_publish=False, bulk_nice=2)
+    options = shared.bridge_options(switches, gz_version="garden", service_timeout=1.5)
+    assert options == BridgeOptions(
+        lazy=True,
+        heartbeat=0.25,
+        override_timestamps_with_wall_time=True,
+        override_frame_id="cam",
+        service_timeout=1.5,
+        bulk_path=False,
+        rcl_serialized_publish=False,
+        bulk_nice=2,
+        light_read=True,
+        gz_version="garden",
+    )
+
+
+@pytest.mark.parametrize(("milliseconds", "seconds"), [(1000, 1.0), (0, 0.001), (-5, 0.001)])
+def test_heartbeat_is_at_least_one_millisecond(milliseconds: int, seconds: float) -> None:
+    shared = SharedParameters(subscription_heartbeat=milliseconds)
+    assert shared.bridge_options(Switches(), gz_version="").heartbeat == seconds
+
+
+@pytest.mark.parametrize(("value", "implementation"), [("", None), ("zenoh", "zenoh")])
+def test_gz_node_options(value: str, implementation: str | None) -> None:
+    shared = SharedParameters(gz_transport_implementation=value)
+    assert shared.gz_node_options() == NodeOptions(implementation=implementation)
+
+
+# The node parameters, declared on a real rclpy node.
+
+
+@pytest.fixture
+def context() -> Iterator[Context]:
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        yield context
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+def make_node(context: Context, overrides: Sequence[Parameter] = ()) -> Any:
+    return rclpy.create_node(
+        f"settings_{uuid.uuid4().hex[:8]}", context=context, parameter_overrides=list(overrides)
+    )
+
+
+@pytest.mark.ros
+def test_parameter_bridge_defaults(context: Context) -> None:
+    node = make_node(context)
+    try:
+        params = declare_parameter_bridge_parameters(node, {})
+    finally:
+        node.destroy_node()
+    assert params == ParameterBridgeParameters(
+        SharedParameters(
+            config_file="",
+            lazy=False,
+            subscription_heartbeat=1000,
+            override_timestamps_with_wall_time=False,
+            override_frame_id="",
+            gz_transport_implementation="",
+            gz_version="",
+        ),
+        expand_gz_topic_names=False,
+        service_timeout=5.0,
+        bridge_names=(),
+        status_period=0.0,
+    )
+
+
+@pytest.mark.ros
+def test_parameter_bridge_values(context: Context) -> None:
+    node = make_node(
+        context,
+        [
+            Parameter("config_file", value="/b.yaml"),
+            Parameter("lazy", value=True),
+            Parameter("subscription_heartbeat", value=200),
+            Parameter("override_timestamps_with_wall_time", value=True),
+            Parameter("override_frame_id", value="base"),
+            Parameter("gz_transport_implementation", value="zenoh"),
+            Parameter("gz_version", value="fortress"),
+            Parameter("expand_gz_topic_names", value=True),
+            Parameter("service_timeout", value=0.5),
+            Parameter("bridge_names", value=["a", "b"]),
+            Parameter("status_period", value=2),
+        ],
+    )
+    try:
+        params = declare_parameter_bridge_parameters(node, {"GZ_VERSION": "garden"})
+    finally:
+        node.destroy_node()
+    assert params == ParameterBridgeParameters(
+        SharedParameters("/b.yaml", True, 200, True, "base", "zenoh", "fortress"),
+        expand_gz_topic_names=True,
+        service_timeout=0.5,
+        bridge_names=("a", "b"),
+        status_period=2,
+    )
+
+
+@pytest.mark.ros
+def test_status_period_takes_any_type(context: Context) -> None:
+    """Checked and reported by start_diagnostics, not refused at declaration."""
+    node = make_node(context, [Parameter("status_period", value="often")])
+    try:
+        assert declare_parameter_bridge_parameters(node, {}).status_period == "often"
+    finally:
+        node.destroy_node()
+
+
+@pytest.mark.ros
+def test_image_bridge_defaults_share_the_parameter_bridge_pieces(context: Context) -> None:
+    node = make_node(context)
+    try:
+        params = declare_image_bridge_parameters(node, {"GZ_VERSION": "garden"})
+    finally:
+        node.destroy_node()
+    assert params == ImageBridgeParameters(
+        SharedParameters(gz_version="garden"),
+        qos="default",
+        camera_info=False,
+        gz_type="gz.msgs.Image",
+    )
+
+
+@pytest.mark.ros
+def test_image_bridge_values(context: Context) -> None:
+    node = make_node(
+        context,
+        [
+            Parameter("qos", value="sensor_data"),
+            Parameter("camera_info", value=True),
+            Parameter("gz_type", value="ignition.msgs.Image"),
+            Parameter("lazy", value=True),
+            Parameter("override_frame_id", value="optical"),
+            Parameter("gz_version", value=""),
+        ],
+    )
+    try:
+        params = declare_image_bridge_parameters(node, {"GZ_VERSION": "garden"})
+    finally:
+        node.destroy_node()
+    assert params == ImageBridgeParameters(
+        SharedParameters(lazy=True, override_frame_id="optical", gz_version=""),
+        qos="sensor_data",
+        camera_info=True,
+        gz_type="ignition.msgs.Image",
+    )
+
+
+@pytest.mark.ros
+def test_gz_version_defaults_to_the_process_environment(
+    context: Context, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("GZ_VERSION", "harmonic")
+    node = make_node(context)
+    try:
+        assert declare_image_bridge_parameters(node).shared.gz_version == "harmonic"
+    finally:
+        node.destroy_node()
