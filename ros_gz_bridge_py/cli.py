@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 
 def parameter_bridge_main() -> None:

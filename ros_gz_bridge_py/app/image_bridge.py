@@ -43,13 +43,13 @@ from ros_gz_bridge_py.app.settings import (
     declare_image_bridge_parameters,
     read_switches,
 )
-from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
 from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.status import serve
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 NODE_NAME = "ros_gz_image"
 #: Exit status for bad arguments, as ros_gz_image (``return -1``).

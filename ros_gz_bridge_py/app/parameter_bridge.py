@@ -28,7 +28,6 @@ from ros_gz_bridge_py.app.settings import (
     declare_parameter_bridge_parameters,
     read_switches,
 )
-from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.config import (
     USAGE,
     BridgeSpec,
@@ -46,6 +45,7 @@ from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import create_gz_node
 
 NODE_NAME = "ros_gz_bridge"

@@ -38,14 +38,11 @@ from ros_gz_bridge_py.config import (
     TopicBridgeSpec,
 )
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
-from ros_gz_bridge_py.core.channel import (
-    Channel,
-    ChannelContext,
-    GzToRosChannel,
-    RosToGzChannel,
-)
+from ros_gz_bridge_py.core.channel import Channel, ChannelContext
 from ros_gz_bridge_py.core.explain import EXPLAIN_PERIOD, Explainer
+from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.options import BridgeOptions
+from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import Spelling

@@ -20,7 +20,7 @@ from rclpy.qos import LivelinessPolicy, QoSCompatibility, QoSProfile, qos_check_
 
 from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.converters.registry import Registry
-from ros_gz_bridge_py.core.channel import Channel, ChannelState, RosToGzChannel
+from ros_gz_bridge_py.core.channel import Channel, ChannelState
 from ros_gz_bridge_py.core.diagnosis import (
     Finding,
     RosEndpoint,
@@ -29,6 +29,7 @@ from ros_gz_bridge_py.core.diagnosis import (
     findings,
     flow,
 )
+from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.transport import GzNode
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 

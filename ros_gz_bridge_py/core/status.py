@@ -35,11 +35,12 @@ from typing import Any, TextIO
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.clock import Clock, ClockType
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.core.bridge import Bridge
-from ros_gz_bridge_py.core.channel import Channel, ChannelState, GzToRosChannel
+from ros_gz_bridge_py.core.channel import Channel, ChannelState
+from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.ros.runtime import make_executor, spin_until_stopped
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 #: Prefix of every DiagnosticStatus name, as ``ros_gz_bridge: <direction> <ros name>``.
 NAME_PREFIX = "ros_gz_bridge"

@@ -17,9 +17,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.demo import sim, topics
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, MessageInfo, Publisher, create_gz_node
 
 #: Physics steps per second; the publish periods below are in steps.

@@ -1,7 +1,7 @@
 """Process-level plumbing shared by the executables: speed settings, executor, clean shutdown.
 
 What the user switched off comes in as arguments: the executables read the switches
-(:mod:`ros_gz_bridge_py.app.settings`). Speed settings (``../shared/spec/environment.md`` §5,
+(:mod:`ros_gz_bridge_py.app.settings`). Speed settings (docs/environment.md §2,
 measured on the project machines):
 
 * The allocator: glibc maps every 1-6 MB buffer with mmap and unmaps it again, so each image is
@@ -29,8 +29,8 @@ from typing import Any
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import get_default_context
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3

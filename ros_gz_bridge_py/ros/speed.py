@@ -1,7 +1,7 @@
 """The Fast DDS shared-memory profile the executables apply before ``rclpy.init``.
 
 Fast DDS's built-in shared-memory segment is 0.5 MB, so every camera image leaves it for
-fragmented UDP; measured on the project machines (``environment.md`` §5) a 64 MB segment lifts
+fragmented UDP; measured on the project machines (docs/environment.md §2) a 64 MB segment lifts
 1080p rclpy throughput from ~40 to ~270 msg/s. The profile (``resources/fastdds_shm_profile.xml``)
 is applied only when the user has not chosen otherwise: the RMW is Fast DDS (unset or
 ``rmw_fastrtps_cpp``), neither ``FASTRTPS_DEFAULT_PROFILES_FILE`` nor

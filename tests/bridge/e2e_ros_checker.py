@@ -28,7 +28,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 _DISTINCT_PER_TOPIC = 20
 _PUBLISH_PERIOD = 0.2

@@ -14,8 +14,8 @@ import time
 
 from google.protobuf import text_format
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import create_gz_node
 
 REQUEST_TYPE = "gz.msgs.WorldControl"

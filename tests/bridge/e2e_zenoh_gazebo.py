@@ -20,8 +20,8 @@ from typing import Any
 
 from google.protobuf import text_format
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import MessageInfo, create_gz_node
 
 _PUBLISH_PERIOD = 0.2

@@ -12,7 +12,7 @@ import time
 
 import zenoh
 
-from ros_gz_bridge_py.app.stop_signal import StopSignal
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
 
 

@@ -1,0 +1,191 @@
+"""A Gazebo->ROS channel: Gazebo subscription -> converter -> ROS publisher.
+
+Each message is decoded, converted and published on the channel's own delivery thread (see
+:mod:`~ros_gz_bridge_py.core.channel`), in the layout of the spelling it arrived with; images
+and point clouds take the bulk path unless ``BridgeOptions.bulk_path`` is off.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from rclpy.qos import QoSProfile
+
+from ros_gz_bridge_py.bulk.path import gz_to_ros_cdr
+from ros_gz_bridge_py.bulk.serialized_publisher import SerializedPublisher
+from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext
+from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros.qos import PUBLISHER_OVERRIDES, gz_to_ros_publisher_qos
+from ros_gz_bridge_py.transport import MessageInfo, Subscription
+
+
+def has_top_level_header(ros_class: type[Any]) -> bool:
+    fields: dict[str, str] = ros_class.get_fields_and_field_types()
+    return fields.get("header") == "std_msgs/Header"
+
+
+class GzToRosChannel(Channel):
+    """Gazebo subscription -> converter -> ROS publisher.
+
+    Each message is decoded in the layout of the spelling it arrived with (a Fortress
+    ``ignition.msgs.IMU`` is not laid out as a Harmonic ``gz.msgs.IMU``).
+    """
+
+    direction = Direction.GZ_TO_ROS
+
+    def __init__(
+        self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
+    ) -> None:
+        super().__init__(ctx, spec, layouts, lazy)
+        self._gz_class = message_class(self.pair.gz_type)
+        #: Wire type -> (pair, gz message class) to read it with.
+        self._readers = {
+            name: (pair, message_class(pair.gz_type)) for name, pair in layouts.items()
+        }
+        self._qos = gz_to_ros_publisher_qos(self.ros_topic, spec.qos_profile, spec.publisher_queue)
+        self._publisher: Any = None
+        self._publish: Callable[[Any], None] = _closed_publish
+        self._subscription: Subscription | None = None
+        self._finish = self._make_finisher()
+
+    def describe(self) -> str:
+        return (
+            f"GZ->ROS [{self.spec.gz_topic} ({self.spec.gz_type}) -> "
+            f"{self.ros_topic} ({self.spec.ros_type})]"
+        )
+
+    @property
+    def dropped(self) -> int:
+        return self._subscription.dropped if self._subscription is not None else 0
+
+    @property
+    def qos(self) -> QoSProfile:
+        return self._qos
+
+    def _make_finisher(self) -> Callable[[Any], None] | None:
+        """The per-message header rewrite the node options ask for, bound once."""
+        frame_id = self.spec.frame_id or self.ctx.options.override_frame_id
+        stamp = self.ctx.options.override_timestamps_with_wall_time
+        if not (frame_id or stamp) or not has_top_level_header(self.pair.ros_class):
+            return None
+
+        def finish(msg: Any) -> None:
+            if frame_id:
+                msg.header.frame_id = frame_id
+            if stamp:
+                sec, nanosec = divmod(time.time_ns(), 1_000_000_000)
+                msg.header.stamp.sec = sec
+                msg.header.stamp.nanosec = nanosec
+
+        return finish
+
+    def _open_output(self) -> None:
+        node = self.ctx.ros_node
+        self._publisher = node.create_publisher(
+            self.pair.ros_class,
+            self.spec.ros_topic,
+            self._qos,
+            qos_overriding_options=PUBLISHER_OVERRIDES,
+        )
+        publisher = (
+            self._publisher
+            if self.bulk is None
+            else SerializedPublisher(
+                self._publisher, through_rcl=self.ctx.options.rcl_serialized_publish
+            )
+        )
+        self._publish = self.ctx.own_publications(self.ros_topic).wrap(publisher)
+
+    def _close_output(self) -> None:
+        self._publish = _closed_publish
+        if self._publisher is not None:
+            self.ctx.ros_node.destroy_publisher(self._publisher)
+            self._publisher = None
+
+    def _open_input(self) -> None:
+        depth = max(self._qos.depth, MIN_DELIVERY_QUEUE)
+        bulk = self.bulk is not None
+        self._subscription = self.ctx.gz_node.subscribe(
+            self.spec.gz_topic,
+            self._on_gz_payload if bulk else self._on_gz_message,
+            self.spec.gz_type,
+            ignore_local=True,
+            queue_size=depth,
+            copy=False,
+            on_delivery_start=(lambda: yield_cpu_to_light_topics(self.ctx.options.bulk_nice))
+            if bulk
+            else None,
+        )
+
+    def _close_input(self) -> None:
+        if self._subscription is not None:
+            self._subscription.close()
+            self._subscription = None
+
+    def _output_has_subscribers(self) -> bool:
+        return any(
+            (info.node_name, info.node_namespace) not in self.ctx.own_nodes
+            for info in self.ctx.ros_node.get_subscriptions_info_by_topic(self.ros_topic)
+        )
+
+    def _on_gz_message(self, payload: Any, info: MessageInfo) -> None:
+        self.stats.received += 1
+        pair, gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))
+        try:
+            gz_msg = gz_class.FromString(payload)
+        except Exception as err:
+            self._conversion_failed(
+                ConversionError(
+                    f"undecodable {info.msg_type} payload of {len(payload)} bytes: {err}"
+                )
+            )
+            return
+        try:
+            ros_msg = pair.to_ros(gz_msg)
+            if self._finish is not None:
+                self._finish(ros_msg)
+        except Exception as err:
+            self._conversion_failed(err)
+            return
+        self._publish(ros_msg)
+        self.stats.published += 1
+
+    def _on_gz_payload(self, payload: Any, info: MessageInfo) -> None:
+        """The bulk path: Gazebo payload straight to a serialized ROS message."""
+        self.stats.received += 1
+        assert self.bulk is not None  # subscribed this way only with a bulk path
+        gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))[1]
+        try:
+            cdr = gz_to_ros_cdr(self.bulk, gz_class, memoryview(payload), self._finish)
+        except Exception as err:
+            self._conversion_failed(err)
+            return
+        self._publish(cdr)
+        self.stats.published += 1
+
+
+def yield_cpu_to_light_topics(nice: int) -> None:
+    """Lower the calling thread's CPU priority by ``nice`` (Linux, per thread; 0: unchanged).
+
+    The delivery thread of an image or point cloud channel spends milliseconds of CPU per
+    message (copies, the DDS write); on a busy machine that would delay ``/clock`` and the
+    other light topics, in this process and in the processes that receive them. Raising a
+    thread's own nice value needs no privilege; where it is not possible nothing changes.
+    """
+    if nice <= 0:
+        return
+    with contextlib.suppress(OSError, AttributeError):
+        tid = threading.get_native_id()
+        os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + nice)
+
+
+def _closed_publish(_msg: Any) -> None:
+    """Publishing after close: nothing to do (a late message from the delivery thread)."""

@@ -1,0 +1,161 @@
+"""A ROS->Gazebo channel: ROS subscription -> converter -> Gazebo publisher.
+
+Messages arrive on the executor as serialized CDR (read with the light reader, or through the
+bulk path for images and point clouds) or as rclpy's message objects; where the Gazebo lines
+lay a message out differently (the IMU), each spelling a subscriber needs is converted on its
+own (docs/protocol.md §9.4).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from rclpy.qos import QoSProfile
+from rclpy.serialization import deserialize_message
+
+from ros_gz_bridge_py.bulk.path import ros_cdr_to_gz
+from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.core.channel import Channel, ChannelContext, ChannelState
+from ros_gz_bridge_py.ros import light_reader
+from ros_gz_bridge_py.ros.qos import SUBSCRIPTION_OVERRIDES, endpoint_qos
+from ros_gz_bridge_py.transport import Publisher
+
+
+class RosToGzChannel(Channel):
+    """ROS subscription -> converter -> Gazebo publisher.
+
+    With the loop guard on (the bridge also publishes this ROS topic from Gazebo), the
+    subscription takes rclpy's message info to skip the bridge's own publications; such
+    callbacks run on the side node, because the EventsExecutor cannot call them.
+    """
+
+    direction = Direction.ROS_TO_GZ
+
+    def __init__(
+        self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
+    ) -> None:
+        super().__init__(ctx, spec, layouts, lazy)
+        #: Where the spellings differ in layout (the IMU), each is converted on its own.
+        self._per_spelling = len({id(pair) for pair in layouts.values()}) > 1
+        self._qos = endpoint_qos(spec.qos_profile, spec.subscriber_queue)
+        self._own = ctx.own_publications(self.ros_topic)
+        self._gz_publisher: Publisher | None = None
+        self._light = (
+            ctx.options.light_read
+            and self.bulk is None
+            and light_reader.reader_for(self.pair.ros_class) is not None
+        )
+        self._subscription: Any = None
+        self._subscription_node: Any = None
+        self._announced = False
+        self.loop_guard = False
+
+    def enable_loop_guard(self) -> None:
+        """Start skipping the bridge's own publications (re-subscribing if open)."""
+        if self.loop_guard:
+            return
+        self.loop_guard = True
+        if self.state is ChannelState.ACTIVE:
+            self._close_input()
+            self._open_input()
+
+    def describe(self) -> str:
+        return (
+            f"ROS->GZ [{self.ros_topic} ({self.spec.ros_type}) -> "
+            f"{self.spec.gz_topic} ({self.spec.gz_type})]"
+        )
+
+    def _open_output(self) -> None:
+        self._gz_publisher = self.ctx.gz_node.advertise(self.spec.gz_topic, self.spec.gz_type)
+
+    def _close_output(self) -> None:
+        if self._gz_publisher is not None:
+            self._gz_publisher.close()
+            self._gz_publisher = None
+
+    def _open_input(self) -> None:
+        callback: Callable[..., None]
+        if self.loop_guard:
+            node, callback = self.ctx.side_node(), self._on_ros_message_guarded
+        else:
+            node, callback = self.ctx.ros_node, self._on_ros_message
+        self._subscription = node.create_subscription(
+            self.pair.ros_class,
+            self.spec.ros_topic,
+            callback,
+            self._qos,
+            qos_overriding_options=SUBSCRIPTION_OVERRIDES,
+            raw=self.bulk is not None or self._light,
+        )
+        self._subscription_node = node
+
+    def _close_input(self) -> None:
+        if self._subscription is not None:
+            self._subscription_node.destroy_subscription(self._subscription)
+            self._subscription = None
+
+    @property
+    def qos(self) -> QoSProfile:
+        return self._qos
+
+    def gazebo_subscribed(self) -> bool:
+        """True while some remote Gazebo subscriber takes this channel's messages."""
+        return self._gz_publisher is not None and bool(self._gz_publisher.wire_types())
+
+    def _output_has_subscribers(self) -> bool:
+        return self._gz_publisher is not None and self._gz_publisher.has_connections()
+
+    def _on_ros_message_guarded(self, ros_msg: Any, info: Any) -> None:
+        if self._own.is_own(info):
+            self.stats.own_skipped += 1
+            return
+        self._on_ros_message(ros_msg)
+
+    def _on_ros_message(self, ros_msg: Any) -> None:
+        """``ros_msg`` is a message object, or its CDR bytes (bulk path, light read)."""
+        self.stats.received += 1
+        publisher = self._gz_publisher
+        if publisher is None:
+            return
+        try:
+            if self.bulk is not None:
+                self._publish_serialized(publisher, ros_msg)
+            else:
+                msg = self._read(ros_msg) if self._light else ros_msg
+                if self._per_spelling:
+                    self._publish_per_spelling(publisher, msg)
+                else:
+                    publisher.publish(self.pair.to_gz(msg))
+        except Exception as err:
+            self._conversion_failed(err)
+            return
+        self.stats.published += 1
+        if not self._announced:
+            self._announced = True
+            self._logger.info(
+                f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
+                "(showing msg only once per type)"
+            )
+
+    def _publish_per_spelling(self, publisher: Publisher, msg: Any) -> None:
+        """Convert once per layout the subscribers need (and the configured one, for local
+        subscribers), each sent only in its spelling."""
+        for wire_type in publisher.wire_types() | {publisher.msg_type}:
+            payload = self.layouts[wire_type].to_gz(msg).SerializeToString()
+            publisher.publish_raw(payload, as_type=wire_type)
+
+    def _read(self, cdr: bytes) -> Any:
+        """The message in ``cdr`` for ``to_gz``: a light tree, or rclpy's message when the
+        encapsulation is not plain little-endian CDR."""
+        tree = light_reader.read(cdr, self.pair.ros_class)
+        return tree if tree is not None else deserialize_message(cdr, self.pair.ros_class)
+
+    def _publish_serialized(self, publisher: Publisher, cdr: bytes) -> None:
+        assert self.bulk is not None  # subscribed raw only with a bulk path
+        payload = ros_cdr_to_gz(self.bulk, self.pair.ros_class, cdr)
+        if payload is None:  # not plain CDR: the object path
+            publisher.publish(self.pair.to_gz(self._read(cdr)))
+        else:
+            publisher.publish_raw(payload)
