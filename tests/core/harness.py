@@ -220,7 +220,9 @@ class Rig:
         """One lazy re-check, as the bridge's timer makes it."""
         self.world.run(self.bridge.heartbeat)
 
-    def gazebo(self, *, native: Spelling | None = None, partition: str | None = None) -> Any:
+    def gazebo(
+        self, *, native: Spelling | None = None, partition: str | None = None
+    ) -> MemoryGzNode:
         """A Gazebo process on the bridge's network (closed with the rig)."""
         peer = MemoryGzNode(partition=partition, network=self.network, native=native)
         self._peers.append(peer)
