@@ -25,7 +25,7 @@ from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.core.channel import Channel
 from ros_gz_bridge_py.core.diagnosis import Flow
 from ros_gz_bridge_py.core.explain import CONFIRM_AFTER, WARM_UP, Explainer
-from ros_gz_bridge_py.core.status import WARN, StatusTracker
+from ros_gz_bridge_py.core.status import OK, WARN, StatusTracker
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.ros.side_node import side_node_name
@@ -206,7 +206,7 @@ def test_no_gazebo_at_all_is_said_once_for_the_bridge(rig: Rig) -> None:
     )
 
 
-def test_an_absent_topic_suggests_similar_names(rig: Rig) -> None:
+def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> None:
     stem = f"odom_{uuid.uuid4().hex[:8]}"
     channel = gz_to_ros(rig.add(string_spec(f"/{stem}", Direction.GZ_TO_ROS)))
     rig.gazebo().advertise(f"/robot/{stem}", STRING)
@@ -215,6 +215,9 @@ def test_an_absent_topic_suggests_similar_names(rig: Rig) -> None:
         f"no Gazebo publisher of /{stem} in partition '{rig.gz.partition}' "
         f"(1 Gazebo processes heard); similar topics: /robot/{stem}"
     ]
+    # A side that is not there yet is explained, not warned about.
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert (status.level, status.message()) == (OK, f"waiting for Gazebo: {texts(channel)[0]}")
 
 
 def test_ros_to_gazebo_waits_for_gazebo_then_ros_then_flows(rig: Rig, world: RosWorld) -> None:
