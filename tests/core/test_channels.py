@@ -34,6 +34,8 @@ from tests.core.harness import (
     wait_until,
 )
 
+pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
+
 STRING, IGN_STRING = "gz.msgs.StringMsg", "ignition.msgs.StringMsg"
 GzString = message_class(STRING)
 GzTwist = message_class("gz.msgs.Twist")

@@ -41,6 +41,8 @@ from tests.core.harness import (
     wait_until,
 )
 
+pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
+
 STRING = "gz.msgs.StringMsg"
 GzString = message_class(STRING)
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import pytest
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
@@ -27,6 +28,8 @@ from tests.core.harness import (
     unique,
     wait_until,
 )
+
+pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
 
 STRING = "gz.msgs.StringMsg"
 GzString = message_class(STRING)

@@ -26,6 +26,8 @@ from tests.core.harness import (
     wait_until,
 )
 
+pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
+
 STRING = "gz.msgs.StringMsg"
 RELIABLE, BEST_EFFORT = ReliabilityPolicy.RELIABLE, ReliabilityPolicy.BEST_EFFORT
 VOLATILE, TRANSIENT_LOCAL = DurabilityPolicy.VOLATILE, DurabilityPolicy.TRANSIENT_LOCAL

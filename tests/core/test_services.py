@@ -21,6 +21,8 @@ from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import Spelling, respell
 from tests.core.harness import WAIT, Rig, RosWorld, options, unique, wait_until
 
+pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
+
 SERVICE_TIMEOUT = 0.3
 CONTROL_WORLD = "ros_gz_interfaces/srv/ControlWorld"
 GzWorldControl = message_class("gz.msgs.WorldControl")

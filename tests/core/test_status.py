@@ -13,6 +13,7 @@ import signal
 import threading
 from typing import Any
 
+import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from sensor_msgs.msg import Image
 from std_msgs.msg import String
@@ -43,6 +44,8 @@ from tests.core.harness import (
     unique,
     wait_until,
 )
+
+pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
 
 STRING = "gz.msgs.StringMsg"
 GzString = message_class(STRING)
