@@ -52,7 +52,7 @@ RESTART_EVERY = 20.0
 FUZZ_EVERY = 15.0
 FUZZ_COUNT = 300
 SAMPLE_EVERY = 2.0
-ODOM_TEXT = 'header { stamp { sec: 7 } } pose { position { x: 1.5 } }'
+ODOM_TEXT = "header { stamp { sec: 7 } } pose { position { x: 1.5 } }"
 
 
 @dataclass
