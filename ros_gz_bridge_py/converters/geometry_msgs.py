@@ -283,14 +283,29 @@ def _fill_pair(
     return Pair(f"geometry_msgs/msg/{ros_class.__name__}", gz_name, to_gz, to_ros, ros_class)
 
 
-def _pair(ros_class: type[Any], gz_name: str, to_gz: Any, to_ros: Any) -> Pair:
-    return Pair(f"geometry_msgs/msg/{ros_class.__name__}", gz_name, to_gz, to_ros, ros_class)
+def _pair(
+    ros_class: type[Any],
+    gz_name: str,
+    to_gz: Any,
+    to_ros: Any,
+    *,
+    default_for_gz_type: bool = False,
+) -> Pair:
+    name = f"geometry_msgs/msg/{ros_class.__name__}"
+    return Pair(name, gz_name, to_gz, to_ros, ros_class, default_for_gz_type=default_for_gz_type)
 
 
 PAIRS = (
     _fill_pair(Point, "gz.msgs.Vector3d", fill_gz_vector3, fill_ros_vector3),
     _fill_pair(Pose, "gz.msgs.Pose", fill_gz_pose, fill_ros_pose),
-    _pair(PoseArray, "gz.msgs.Pose_V", _pose_array_to_gz, _pose_array_to_ros),
+    # tf2_msgs/msg/TFMessage pairs with gz.msgs.Pose_V too.
+    _pair(
+        PoseArray,
+        "gz.msgs.Pose_V",
+        _pose_array_to_gz,
+        _pose_array_to_ros,
+        default_for_gz_type=True,
+    ),
     _pair(PoseStamped, "gz.msgs.Pose", _pose_stamped_to_gz, _pose_stamped_to_ros),
     _fill_pair(
         PoseWithCovariance,

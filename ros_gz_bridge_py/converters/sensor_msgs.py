@@ -253,10 +253,18 @@ def nav_sat_fix_to_ros(gz: Any) -> Any:
 
 
 def _pair(
-    ros_class: type[Any], gz_type: str, to_gz: Any, to_ros: Any, bulk: BulkPath | None = None
+    ros_class: type[Any],
+    gz_type: str,
+    to_gz: Any,
+    to_ros: Any,
+    bulk: BulkPath | None = None,
+    *,
+    default_for_gz_type: bool = False,
 ) -> Pair:
     name = f"sensor_msgs/msg/{ros_class.__name__}"
-    return Pair(name, gz_type, to_gz, to_ros, ros_class, bulk=bulk)
+    return Pair(
+        name, gz_type, to_gz, to_ros, ros_class, bulk=bulk, default_for_gz_type=default_for_gz_type
+    )
 
 
 PAIRS = (
@@ -270,7 +278,14 @@ PAIRS = (
     _pair(Joy, "gz.msgs.Joy", joy_to_gz, joy_to_ros),
     _pair(LaserScan, "gz.msgs.LaserScan", laser_scan_to_gz, laser_scan_to_ros),
     _pair(MagneticField, "gz.msgs.Magnetometer", magnetic_field_to_gz, magnetic_field_to_ros),
-    _pair(NavSatFix, "gz.msgs.NavSat", nav_sat_fix_to_gz, nav_sat_fix_to_ros),
+    # gps_msgs/msg/GPSFix pairs with gz.msgs.NavSat too.
+    _pair(
+        NavSatFix,
+        "gz.msgs.NavSat",
+        nav_sat_fix_to_gz,
+        nav_sat_fix_to_ros,
+        default_for_gz_type=True,
+    ),
     _pair(
         NavSatFix,
         "gz.msgs.NavSatWithCovariance",
