@@ -61,6 +61,29 @@ class Pair:
     #: This pair's ROS type is the default for its Gazebo type, which other modules pair too.
     default_for_gz_type: bool = field(default=False, compare=False)
 
+    @classmethod
+    def of(
+        cls,
+        ros_class: type[Any],
+        gz_type: str,
+        to_gz: Callable[[Any], Any],
+        to_ros: Callable[[Any], Any],
+        *,
+        bulk: BulkPath | None = None,
+        default_for_gz_type: bool = False,
+    ) -> Pair:
+        """The pair for ``ros_class``, whose ROS type name (``pkg/msg/Name``) it bears."""
+        ros_type = f"{_package_of(ros_class)}/msg/{ros_class.__name__}"
+        return cls(
+            ros_type,
+            gz_type,
+            to_gz,
+            to_ros,
+            ros_class,
+            bulk=bulk,
+            default_for_gz_type=default_for_gz_type,
+        )
+
 
 @dataclass(frozen=True)
 class ServicePair:
@@ -180,6 +203,11 @@ class Registry:
         if ros_options:
             return f"{text}; [{gz_type}] pairs with: {', '.join(ros_options)}"
         return f"{text}; run `bridge_types --print-pairs` to list the supported pairs"
+
+
+def _package_of(ros_class: type[Any]) -> str:
+    """``std_msgs`` for ``std_msgs.msg.Bool`` (whose module is ``std_msgs.msg._bool``)."""
+    return ros_class.__module__.split(".", 1)[0]
 
 
 def _with_origin(item: Any, origin: str) -> Any:
