@@ -10,10 +10,13 @@ wrapped in a Fill.
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from operator import attrgetter
 from typing import Any
+
+import numpy as np
 
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.msgs import message_class
@@ -76,6 +79,48 @@ def fields(*entries: Entry) -> Fill:
             step(gz, ros)
 
     return Fill(to_gz, to_ros)
+
+
+def each(fill: Fill, new_ros: Callable[[], Any]) -> Fill:
+    """The Fill of a list of submessages: one gz element added per ROS item, and the ROS list
+    replaced by one new item (``new_ros()``) per gz element."""
+
+    def to_gz(ros_items: Any, gz_items: Any) -> None:
+        for item in ros_items:
+            fill.to_gz(item, gz_items.add())
+
+    def to_ros(gz_items: Any, ros_items: Any) -> None:
+        ros_items[:] = [_filled(fill, element, new_ros()) for element in gz_items]
+
+    return Fill(to_gz, to_ros)
+
+
+def repeated(read: Callable[[Any], Any]) -> Fill:
+    """The Fill of a list of plain values: R→G extends the gz repeated field; G→R replaces the
+    ROS list (or array) by ``read(gz_values)``."""
+
+    def to_gz(ros_values: Any, gz_values: Any) -> None:
+        gz_values.extend(ros_values)
+
+    def to_ros(gz_values: Any, ros_values: Any) -> None:
+        ros_values[:] = read(gz_values)
+
+    return Fill(to_gz, to_ros)
+
+
+def numbers(typecode: str) -> Fill:
+    """:func:`repeated` for a ROS ``array(typecode)``; numpy reads the gz repeated field as one
+    buffer (~300x faster than iterating it)."""
+    return repeated(lambda values: array(typecode, np.asarray(values, dtype=typecode).tobytes()))
+
+
+#: :func:`repeated` for a ROS ``string[]``.
+STRINGS = repeated(list)
+
+
+def _filled(fill: Fill, gz: Any, ros: Any) -> Any:
+    fill.to_ros(gz, ros)
+    return ros
 
 
 def converters(

@@ -30,10 +30,8 @@ from geometry_msgs.msg import (
     WrenchStamped,
 )
 
-from ros_gz_bridge_py.converters._fields import WHOLE, Fill, fields, fill_pair
-from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.converters._fields import WHOLE, Fill, each, fields, fill_pair
 from ros_gz_bridge_py.converters.std_msgs import FRAMES, HEADER
-from ros_gz_bridge_py.msgs import message_class
 
 
 def fill_gz_vector3(ros: Any, gz: Any) -> None:
@@ -94,35 +92,15 @@ POSE_WITH_COVARIANCE = fields(("pose", POSE), ("covariance", COVARIANCE))
 TWIST_WITH_COVARIANCE = fields(("twist", TWIST), ("covariance", COVARIANCE))
 
 
-GzPoseV = message_class("gz.msgs.Pose_V")
-
-
-def _pose_array_to_gz(ros: Any) -> Any:
-    gz = GzPoseV()
-    HEADER.to_gz(ros.header, gz.header)
-    for pose in ros.poses:
-        POSE.to_gz(pose, gz.pose.add())
-    return gz
-
-
-def _pose_array_to_ros(gz: Any) -> Any:
-    ros = PoseArray()
-    HEADER.to_ros(gz.header, ros.header)
-    poses = []
-    for gz_pose in gz.pose:
-        pose = Pose()
-        POSE.to_ros(gz_pose, pose)
-        poses.append(pose)
-    ros.poses = poses
-    return ros
-
-
 PAIRS = (
     fill_pair(Point, "gz.msgs.Vector3d", VECTOR3),
     fill_pair(Pose, "gz.msgs.Pose", POSE),
     # tf2_msgs/msg/TFMessage pairs with gz.msgs.Pose_V too.
-    Pair.of(
-        PoseArray, "gz.msgs.Pose_V", _pose_array_to_gz, _pose_array_to_ros, default_for_gz_type=True
+    fill_pair(
+        PoseArray,
+        "gz.msgs.Pose_V",
+        fields(("header", HEADER), ("poses", "pose", each(POSE, Pose))),
+        default_for_gz_type=True,
     ),
     fill_pair(PoseStamped, "gz.msgs.Pose", fields(("header", HEADER), ("pose", WHOLE, POSE))),
     fill_pair(PoseWithCovariance, "gz.msgs.PoseWithCovariance", POSE_WITH_COVARIANCE),
