@@ -4,8 +4,10 @@ Most conversions are a list of field copies that would be written twice, R→G a
 second a mirror of the first. Here the list is written once. A :class:`Fill` holds both
 directions of one conversion into an existing message; :func:`fields` makes the Fill that goes
 through a table of fields, each copied as it is, through a :class:`Value` function, or through
-another Fill (a submessage). Hot leaves (vectors, quaternions, headers) stay plain functions,
-wrapped in a Fill.
+another Fill (a submessage); :func:`each` and :func:`repeated` are the Fills of lists.
+:func:`converters` and :func:`fill_pair` turn a Fill into whole-message converters and a pair.
+Hot leaves (vectors, quaternions, headers) stay plain functions, wrapped in a Fill: as tables
+they would cost a quarter more on TF and Twist.
 """
 
 from __future__ import annotations
