@@ -32,7 +32,7 @@ from sensor_msgs.msg import (
     Range,
 )
 
-from ros_gz_bridge_py.converters._fields import TO_GZ_ONLY, Value, converters, fields
+from ros_gz_bridge_py.converters._fields import TO_GZ_ONLY, Value, converters, fields, numbers
 from ros_gz_bridge_py.converters.geometry_msgs import COVARIANCE, QUATERNION, VECTOR3
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.converters.sensor_msgs_image import (
@@ -61,7 +61,6 @@ from ros_gz_bridge_py.converters.std_msgs import HEADER
 from ros_gz_bridge_py.msgs import message_class
 
 GzModel = message_class("gz.msgs.Model")
-GzJoy = message_class("gz.msgs.Joy")
 
 
 def _known_power_supply_status(status: int) -> int:
@@ -144,21 +143,11 @@ def joint_state_to_ros(gz: Any) -> Any:
     return ros
 
 
-def joy_to_gz(ros: Any) -> Any:
-    gz = GzJoy()
-    HEADER.to_gz(ros.header, gz.header)
-    gz.axes.extend(ros.axes)
-    gz.buttons.extend(ros.buttons)
-    return gz
-
-
-def joy_to_ros(gz: Any) -> Any:
-    ros = Joy()
-    HEADER.to_ros(gz.header, ros.header)
-    ros.axes = array("f", gz.axes)
-    ros.buttons = array("i", gz.buttons)
-    return ros
-
+joy_to_gz, joy_to_ros = converters(
+    fields(("header", HEADER), ("axes", numbers("f")), ("buttons", numbers("i"))),
+    Joy,
+    "gz.msgs.Joy",
+)
 
 #: magnetic_field_covariance has no gz counterpart and is dropped.
 magnetic_field_to_gz, magnetic_field_to_ros = converters(
