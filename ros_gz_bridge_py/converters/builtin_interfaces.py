@@ -1,4 +1,4 @@
-"""builtin_interfaces/msg/Time <-> gz.msgs.Time (conversions.md §1.2).
+"""builtin_interfaces/msg/Time <-> gz.msgs.Time (docs/conversions.md §1.2).
 
 Times are copied field by field with C++ integer semantics and no normalisation: seconds
 narrow to int32 and nanoseconds are reinterpreted between uint32 and int32.

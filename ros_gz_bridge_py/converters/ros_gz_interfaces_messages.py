@@ -1,4 +1,4 @@
-"""Converters for the ros_gz_interfaces messages (conversions.md §3.13).
+"""Converters for the ros_gz_interfaces messages (docs/conversions.md §3.13).
 
 The pair table and the services live in ``ros_gz_interfaces``; this module holds the
 conversions, each declared once for both directions where it is a list of fields, and the

@@ -7,7 +7,7 @@ states the mapping: header, diff_pressure, temperature).
 ``gz.msgs.AirSpeed`` exists from Harmonic (gz-msgs 10) on; ``LogicalCameraImage`` also in
 Fortress, under ``ignition.msgs.LogicalCameraImage`` with the same fields.
 
-Differences from ros_gz_bridge: none known. As for every pose (conversions.md §1.4), a gz
+Differences from ros_gz_bridge: none known. As for every pose (docs/conversions.md §1.4), a gz
 orientation that is absent reads as the quaternion (0, 0, 0, 0), not the identity.
 """
 

@@ -1,6 +1,6 @@
 """sensor_msgs/msg/NavSatFix <-> gz.msgs.NavSatWithCovariance (Jetty, gz-msgs 12).
 
-ros_gz_bridge has no such pair; this one extends its NavSat conversion (conversions.md §3.5,
+ros_gz_bridge has no such pair; this one extends its NavSat conversion (docs/conversions.md §3.5,
 ``sensor_msgs.py``) with the position covariance that NavSatFix can carry:
 
 - Position, header and frame_id as for ``gz.msgs.NavSat``: G→R takes ``header.frame_id`` from

@@ -1,6 +1,6 @@
 """vision_msgs Detection2D/3D(Array) <-> gz.msgs.AnnotatedAxisAligned2DBox/Oriented3DBox(_V).
 
-conversions.md §3.11, vision_msgs 4.x layout. Only ``results[0].hypothesis.class_id`` survives,
+docs/conversions.md §3.11, vision_msgs 4.x layout. Only ``results[0].hypothesis.class_id`` survives,
 parsed as an integer label like C++ ``std::stoi``; G→R reports one hypothesis with score 1.0.
 
 Differences from ros_gz_bridge:
