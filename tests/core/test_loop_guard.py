@@ -11,6 +11,8 @@ from __future__ import annotations
 import time
 from typing import Any
 
+import pytest
+
 from ros_gz_bridge_py.core.loop_guard import HISTORY, OwnPublications
 
 
@@ -82,3 +84,41 @@ def test_only_the_recent_history_is_remembered() -> None:
         publish(index)
     remembered = [own.is_own(sample) for sample in publisher.samples]
     assert remembered == [False, False] + [True] * HISTORY
+
+
+def test_a_sample_seen_before_publish_returns_is_own() -> None:
+    """With the write made with the GIL released, our subscription may take the sample while
+    ``publish`` has not returned yet."""
+    own = OwnPublications()
+    seen: list[bool] = []
+
+    class SeenDuringPublish(StampingPublisher):
+        def publish(self, msg: Any) -> None:
+            super().publish(msg)
+            seen.append(own.is_own(self.samples[-1]))
+
+    publish = own.wrap(SeenDuringPublish())
+    publish("a")
+    publish("b")
+    assert seen == [True, True]
+
+
+def test_a_publish_that_raises_uses_no_sequence_number() -> None:
+    own = OwnPublications()
+    publisher = StampingPublisher()
+    refusing = True
+
+    class SometimesRefusing:
+        def publish(self, msg: Any) -> None:
+            if refusing:
+                raise ValueError(msg)
+            publisher.publish(msg)
+
+    publish = own.wrap(SometimesRefusing())
+    with pytest.raises(ValueError, match="x"):
+        publish("x")
+    refusing = False
+    publish("y")
+    (sample,) = publisher.samples
+    assert own.is_own(sample)
+    assert not own.is_own({**sample, "publication_sequence_number": 2})
