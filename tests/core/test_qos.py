@@ -150,12 +150,6 @@ def test_qos_overrides_parameters_apply_per_topic(make_rig: Any, world: RosWorld
     assert shown(world.publishers(untouched)) == (RELIABLE, VOLATILE)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known gap: a bidirectional entry subscribes on the bridge's side node, which "
-    "does not have the bridge node's own parameters (parameter_overrides, a params file "
-    "written for the node's name); a global -p on the command line does reach it",
-)
 def test_a_subscription_override_reaches_a_bidirectional_entry(
     make_rig: Any, world: RosWorld
 ) -> None:
@@ -165,3 +159,6 @@ def test_a_subscription_override_reaches_a_bidirectional_entry(
     assert ros_to_gz(rig.add(string_spec(topic))).loop_guard  # so it is on the side node
     wait_until(lambda: len(world.subscribers(topic)) == 1, "the bridge's subscription")
     assert shown(world.subscribers(topic)) == (BEST_EFFORT, VOLATILE)
+    # Declared where the user wrote it, as for every other entry.
+    parameter = f"qos_overrides.{topic}.subscription.reliability"
+    assert rig.node.get_parameter(parameter).value == "best_effort"
