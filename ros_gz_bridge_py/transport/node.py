@@ -408,6 +408,13 @@ class GzNode(abc.ABC):
         other processes have, in every partition discovery reaches."""
 
     @abc.abstractmethod
+    def graph(self) -> list[GraphEndpoint]:
+        """Every publisher and subscriber that other processes have, of every topic, in every
+        partition discovery reaches: :meth:`observe` for all topics at once (discovered
+        bridging reads it; filter by ``partition``). A subscriber whose type its protocol
+        does not tell (gz-transport 11/12) has ``msg_type`` ``""``."""
+
+    @abc.abstractmethod
     def peer_processes(self) -> int:
         """How many other Gazebo Transport processes this node hears."""
 

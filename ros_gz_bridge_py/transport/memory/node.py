@@ -400,27 +400,32 @@ class MemoryGzNode(GzNode):
 
     def observe(self, topic: str) -> list[GraphEndpoint]:
         """Every other node's publishers and subscriptions of ``topic``, every partition."""
-        fqn = self.fqn(topic)
-        name = (decompose(fqn) or ("", topic))[1]
+        return self._endpoints((decompose(self.fqn(topic)) or ("", topic))[1])
+
+    def graph(self) -> list[GraphEndpoint]:
+        """Every other node's publishers and subscriptions, every topic and partition."""
+        return self._endpoints(None)
+
+    def _endpoints(self, name: str | None) -> list[GraphEndpoint]:
         found = []
         with self.network.lock:
             nodes = [n for n in self.network.nodes if n is not self]
             announcements = list(self.network.announcements)
         for a in announcements:
             partition, a_name = decompose(a.fqn) or ("", a.fqn)
-            if a_name == name and a.node is not self:
-                found.append(GraphEndpoint(PUBLISHER, partition.removeprefix("/"), name,
+            if name in (None, a_name) and a.node is not self:
+                found.append(GraphEndpoint(PUBLISHER, partition.removeprefix("/"), a_name,
                                            a.msg_type, a.node.process_uuid, a.address))  # fmt: skip
-        registered = self._registered.get(fqn, {})
         for node in nodes:
             for subs in list(node._subscriptions.values()):
                 for sub in subs:
                     partition, s_name = decompose(sub.fqn) or ("", sub.fqn)
-                    if s_name == name:
+                    if name in (None, s_name):
+                        registered = self._registered.get(sub.fqn, {})
                         taken = (node.process_uuid, node.node_uuid) in registered
-                        found.append(GraphEndpoint(SUBSCRIBER, partition.removeprefix("/"), name,
-                                                   sub.msg_type, node.process_uuid, node.address,
-                                                   registered=taken))  # fmt: skip
+                        found.append(GraphEndpoint(SUBSCRIBER, partition.removeprefix("/"),
+                                                   s_name, sub.msg_type, node.process_uuid,
+                                                   node.address, registered=taken))  # fmt: skip
         return found
 
     def ask_subscribers(self) -> None:

@@ -57,13 +57,14 @@ class ZenohGraph:
             if t.kind == kind and t.fqn == fqn
         ]  # fmt: skip
 
-    def observe(self, name: str) -> list[GraphEndpoint]:
-        """Other processes' publishers and subscribers of topic ``name``, every partition."""
+    def observe(self, name: str | None = None) -> list[GraphEndpoint]:
+        """Other processes' publishers and subscribers of topic ``name`` (None: of every
+        topic), every partition."""
         return [
-            GraphEndpoint(_ROLES[t.kind], t.partition.removeprefix("/"), name, t.msg_type,
+            GraphEndpoint(_ROLES[t.kind], t.partition.removeprefix("/"), t.topic, t.msg_type,
                           t.process_uuid, "")
             for t in self.tokens()
-            if t.kind in _ROLES and t.topic == name and not self._ours(t)
+            if t.kind in _ROLES and name in (None, t.topic) and not self._ours(t)
         ]  # fmt: skip
 
     def peer_processes(self) -> int:

@@ -3,8 +3,7 @@
 Each :class:`ZenohGzNode` opens its own Zenoh session and looks like one gz process (own
 process and node UUIDs). Topics and services are Zenoh keys equal to their fully qualified
 name; the message type travels as the sample attachment; the graph is the set of ``@gz/…``
-liveliness tokens (MP publishers, MS subscriptions, SS services) seen by one liveliness
-subscriber on ``@gz/**`` with history.
+tokens (MP publishers, MS subscriptions, SS services) a liveliness subscriber with history sees.
 
 As in gz: a publisher puts only while some *other* process holds an MS token for its topic
 with its type or ``google.protobuf.Message`` (gating); a service call is sent only once an
@@ -210,8 +209,7 @@ class ZenohGzNode(GzNode):
         return ZenohSubscription(self, topic, fqn, msg_type, deliver, ignore_local=ignore_local)
 
     def _open_subscription(self, sub: Subscription) -> None:
-        """The Zenoh subscriber first (once a gz publisher sees the token it may put), then
-        the MS token."""
+        """The Zenoh subscriber, then the MS token (a gz publisher may put once it sees it)."""
         entities = cast(ZenohSubscription, sub).entities
         fqn = sub.fqn
         entities.append(
@@ -439,9 +437,11 @@ class ZenohGzNode(GzNode):
         return self._graph.infos(EntityKind.SERVICE, self.fqn(service))
 
     def observe(self, topic: str) -> list[GraphEndpoint]:
-        """Publishers (MP) and subscribers (MS) of ``topic`` in other processes, from their
-        liveliness tokens, in every partition."""
+        """Publishers (MP) and subscribers (MS) of ``topic`` in other processes, any partition."""
         return self._graph.observe((decompose(self.fqn(topic)) or ("", topic))[1])
+
+    def graph(self) -> list[GraphEndpoint]:  # GzNode.graph, from the same tokens
+        return self._graph.observe()
 
     def ask_subscribers(self) -> None:
         """Nothing to ask: subscription tokens carry their types."""

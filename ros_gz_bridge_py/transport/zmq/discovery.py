@@ -141,6 +141,10 @@ class DiscoveryEngine:
             for (process, node), types in self._subscribers.get(topic, {}).items()
         )
 
+    def registered_topics(self) -> list[str]:
+        """Our FQNs that remote nodes registered with (NEW_CONNECTION)."""
+        return list(self._subscribers)
+
     def subscribe_sightings(self) -> dict[str, dict[str, str]]:
         """FQN -> process -> source IP, for every SUBSCRIBE heard (any partition)."""
         return {topic: dict(seen) for topic, seen in self._subscribe_seen.items()}

@@ -1,7 +1,8 @@
 """What the ZeroMQ discovery engines know, as listings and graph endpoints (pure functions).
 
 ``gz topic -l``/``-i`` and ``gz service -l``/``-i`` rows (docs/protocol.md §1.1, §5), and the
-publishers and subscribers of a topic in every partition for explanations: publishers from
+publishers and subscribers of one topic or of all, in every partition, for explanations and
+discovered bridging: publishers from
 ADVERTISE, subscribers from SUBSCRIBE (no type: gz-transport 11/12 subscribers tell nothing
 else), SUBSCRIBERS_REP (13+, with the type) and NEW_CONNECTION to our own publishers.
 """
@@ -46,40 +47,48 @@ def infos(engine: DiscoveryEngine, fqn: str) -> list[TopicInfo]:
 
 def observe(engine: DiscoveryEngine, fqn: str, own_process: str) -> list[GraphEndpoint]:
     """Every other process's publisher and subscriber of ``fqn``'s name, in every partition."""
-    own_partition, name = decompose(fqn) or ("", fqn)
-    own_partition = own_partition.removeprefix("/")
+    return endpoints(engine, own_process, (decompose(fqn) or ("", fqn))[1])
 
-    def partition_of(other: str) -> str | None:
+
+def endpoints(
+    engine: DiscoveryEngine, own_process: str, name: str | None = None
+) -> list[GraphEndpoint]:
+    """Every other process's publisher and subscriber of topic ``name`` (None: of every
+    topic), in every partition."""
+
+    def split(other: str) -> tuple[str, str] | None:
         parts = decompose(other)
-        return parts[0].removeprefix("/") if parts is not None and parts[1] == name else None
+        if parts is None or (name is not None and parts[1] != name):
+            return None
+        return parts[0].removeprefix("/"), parts[1]
 
     found = [
-        GraphEndpoint(PUBLISHER, partition, name, record.msg_type, record.process_uuid,
-                      record.address)
+        GraphEndpoint(PUBLISHER, *where, record.msg_type, record.process_uuid, record.address)
         for record in engine.all_publishers()
         if record.msg is not None
         and record.process_uuid != own_process
-        and (partition := partition_of(record.topic)) is not None
-    ]  # fmt: skip
-    # Per (partition, process), the best we know: SUBSCRIBE (no type), then a listing (its
-    # type), then a registration with our publisher (the spellings it took).
-    subscribers: dict[tuple[str, str], GraphEndpoint] = {}
+        and (where := split(record.topic)) is not None
+    ]
+    # Per (partition, topic, process), the best we know: SUBSCRIBE (no type), then a listing
+    # (its type), then a registration with our publisher (the spellings it took).
+    subscribers: dict[tuple[str, str, str], GraphEndpoint] = {}
     for topic, seen in engine.subscribe_sightings().items():
-        if (partition := partition_of(topic)) is not None:
+        if (where := split(topic)) is not None:
             for process, ip in seen.items():
-                subscribers[partition, process] = GraphEndpoint(
-                    SUBSCRIBER, partition, name, "", process, ip
-                )
+                subscribers[(*where, process)] = GraphEndpoint(SUBSCRIBER, *where, "", process, ip)
     for record in engine.listed_subscribers():
-        if (partition := partition_of(record.topic)) is not None:
-            subscribers[partition, record.process_uuid] = GraphEndpoint(
-                SUBSCRIBER, partition, name, record.msg_type, record.process_uuid, record.address
+        if (where := split(record.topic)) is not None:
+            subscribers[(*where, record.process_uuid)] = GraphEndpoint(
+                SUBSCRIBER, *where, record.msg_type, record.process_uuid, record.address
             )
-    for remote in engine.remote_subscribers(fqn):
-        msg_type = next(iter(remote.types)) if len(remote.types) == 1 else GENERIC_TYPE
-        known = subscribers.get((own_partition, remote.process_uuid))
-        subscribers[own_partition, remote.process_uuid] = GraphEndpoint(
-            SUBSCRIBER, own_partition, name, msg_type, remote.process_uuid,
-            known.location if known else "", registered=True,
-        )  # fmt: skip
+    for topic in engine.registered_topics():
+        if (where := split(topic)) is None:
+            continue
+        for remote in engine.remote_subscribers(topic):
+            msg_type = next(iter(remote.types)) if len(remote.types) == 1 else GENERIC_TYPE
+            known = subscribers.get((*where, remote.process_uuid))
+            subscribers[(*where, remote.process_uuid)] = GraphEndpoint(
+                SUBSCRIBER, *where, msg_type, remote.process_uuid,
+                known.location if known else "", registered=True,
+            )  # fmt: skip
     return found + [s for s in subscribers.values() if s.process_uuid != own_process]

@@ -371,8 +371,10 @@ class ZmqGzNode(GzNode):
 
     def observe(self, topic: str) -> list[GraphEndpoint]:
         """Publishers and subscribers of ``topic`` in other processes, every partition."""
-        fqn = self.fqn(topic)
-        return self._call(lambda: graph.observe(self._msg, fqn, self.process_uuid))
+        return self._call(lambda: graph.observe(self._msg, self.fqn(topic), self.process_uuid))
+
+    def graph(self) -> list[GraphEndpoint]:  # GzNode.graph: observe for every topic
+        return self._call(lambda: graph.endpoints(self._msg, self.process_uuid))
 
     def peer_processes(self) -> int:
         """Other processes heard on either discovery port and not yet expired."""

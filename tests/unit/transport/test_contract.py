@@ -342,6 +342,35 @@ def test_observe_sees_other_processes_in_every_partition(pair: tuple[GzNode, GzN
     assert a.partition in a.listening()
 
 
+def test_graph_lists_every_topic_of_other_processes(pair: tuple[GzNode, GzNode]) -> None:
+    a, b = pair
+    published, subscribed = unique("graph_pub"), unique("graph_sub")
+    pub = a.advertise(published, GZ)
+    sub = a.subscribe_typed(subscribed, StringMsg, Inbox())
+
+    def seen_by_b() -> set[tuple[str, str, str]]:
+        return {(e.role, e.topic, e.process_uuid) for e in b.graph()}
+
+    assert wait_until(
+        lambda: (
+            {(PUBLISHER, published, a.process_uuid), (SUBSCRIBER, subscribed, a.process_uuid)}
+            <= seen_by_b()
+        )
+    )
+    mine = [e for e in b.graph() if e.process_uuid == a.process_uuid]
+    assert all(e.partition == a.partition for e in mine)
+    assert all(
+        same_message(e.msg_type, GZ) for e in mine if e.role == PUBLISHER
+    )  # typed subscribers' types: where the protocol tells (Zenoh, memory; ZeroMQ 13+ on asking)
+    assert not any(e.process_uuid == b.process_uuid for e in b.graph())
+    assert {(e.role, e.process_uuid) for e in b.observe(published)} <= {
+        (e.role, e.process_uuid) for e in b.graph() if e.topic == published
+    }
+    pub.close()
+    sub.close()
+    assert wait_until(lambda: (PUBLISHER, published, a.process_uuid) not in seen_by_b())
+
+
 def test_closing_is_idempotent_and_each_handle_closes_only_itself(
     pair: tuple[GzNode, GzNode],
 ) -> None:
