@@ -9,8 +9,10 @@ argument C++ answers with the usage text, and the two it gets wrong silently, ra
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
+from ros_gz_bridge_py.config import templates
 from ros_gz_bridge_py.config.model import (
     BridgeSpec,
     Direction,
@@ -20,6 +22,7 @@ from ros_gz_bridge_py.config.model import (
     UsageError,
     ros_type_hint,
 )
+from ros_gz_bridge_py.errors import ConfigError
 
 USAGE = (
     """\
@@ -152,16 +155,37 @@ def _parse_arg(arg: str, position: int) -> tuple[BridgeSpec, list[str]]:
     return TopicBridgeSpec(name, name, ros_type, after, direction, source=source), warnings
 
 
-def parse_cli_args(args: Sequence[str]) -> ParseResult:
+def cli_placeholders(args: Sequence[str]) -> dict[str, tuple[str, ...]]:
+    """The placeholder values given as ``NAME=VALUE`` arguments (``templates.py``)."""
+    assignments = [arg for arg in args if templates.is_assignment(arg)]
+    return templates.parse_assignments(assignments, "argument")
+
+
+def parse_cli_args(
+    args: Sequence[str], placeholders: templates.Placeholders | None = None
+) -> ParseResult:
     """Parse ``parameter_bridge`` positional arguments (ROS arguments already removed).
 
-    Raises :class:`UsageError` for the first argument that cannot be parsed, as C++ stops
-    there. An empty ``args`` is a valid, empty result (bridges may come from a YAML file).
+    ``NAME=VALUE`` arguments are placeholder values (:func:`cli_placeholders`) and skipped;
+    an argument with ``${name}`` placeholders makes one bridge per value. Raises
+    :class:`UsageError` for the first argument that cannot be parsed, as C++ stops there. An
+    empty ``args`` is a valid, empty result (bridges may come from a YAML file).
     """
     specs: list[BridgeSpec] = []
     warnings: list[str] = []
     for position, arg in enumerate(args, start=1):
-        spec, arg_warnings = _parse_arg(arg, position)
-        specs.append(spec)
-        warnings.extend(arg_warnings)
+        if templates.is_assignment(arg):
+            continue
+        where = f"argument {position} '{arg}'"
+        try:
+            names = templates.names_in([arg])
+            choices = templates.combinations(names, placeholders or {}, where)
+        except ConfigError as err:
+            raise UsageError(err.message.removeprefix("Could not parse entry: "), where) from err
+        for chosen in choices:
+            spec, arg_warnings = _parse_arg(templates.substitute(arg, chosen, where), position)
+            if chosen:
+                spec = dataclasses.replace(spec, source=spec.source + templates.describe(chosen))
+            specs.append(spec)
+            warnings.extend(arg_warnings)
     return ParseResult(tuple(specs), (), tuple(warnings))

@@ -8,9 +8,14 @@ The command line, YAML files and ``bridges.<name>.*`` parameters all produce the
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ros_gz_bridge_py.errors import ConfigError
+
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.config.patterns import TopicPattern
 
 
 class Direction(enum.Enum):
@@ -59,6 +64,9 @@ class TopicBridgeSpec:
     #: One of :data:`QOS_PROFILE_NAMES`.
     qos_profile: str | None = None
     frame_id: str | None = None
+    #: Messages per second the bridge passes on at most (the rest is dropped before
+    #: conversion); None: the node's ``max_rate``; 0: no limit.
+    max_rate: float | None = None
     #: Where it came from, e.g. ``"argument 2"`` or ``"bridge.yaml entry 3 (line 12)"``.
     source: str = ""
 
@@ -88,6 +96,8 @@ class ParseResult:
     specs: tuple[BridgeSpec, ...] = ()
     errors: tuple[ConfigError, ...] = ()
     warnings: tuple[str, ...] = ()
+    #: Entries that discovery completes (wildcards, left-out types): ``patterns.py``.
+    patterns: tuple[TopicPattern, ...] = ()
 
 
 class UsageError(ConfigError):
@@ -128,3 +138,19 @@ def as_queue(key: str, value: object) -> int:
         return int(value.strip())
     msg = f"{key} must be a non-negative integer, got {value!r}"
     raise ConfigError(msg)
+
+
+def as_rate(key: str, value: object) -> float:
+    """``value`` as a rate in Hz: a finite number >= 0 (0: no limit); digit strings too."""
+    number: float | None = None
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        number = float(value)
+    elif isinstance(value, str):
+        try:
+            number = float(value.strip())
+        except ValueError:
+            number = None
+    if number is None or not math.isfinite(number) or number < 0:
+        msg = f"{key} must be a number of messages per second >= 0 (0: no limit), got {value!r}"
+        raise ConfigError(msg)
+    return number

@@ -1,11 +1,14 @@
-"""ROS name expansion, applied to Gazebo topic names when ``expand_gz_topic_names`` is set.
+"""Names: ROS name expansion, applied to Gazebo topic names when ``expand_gz_topic_names`` is
+set, and the ROS name discovered bridging gives a Gazebo topic.
 
-Follows rcl's rules (``rcl_expand_topic_name``): absolute names are unchanged, relative names
-get the namespace, ``~`` is the node's private namespace, ``{node}`` and ``{ns}``/``{namespace}``
-are substituted. Name validation beyond that is left to rclpy.
+Expansion follows rcl's rules (``rcl_expand_topic_name``): absolute names are unchanged,
+relative names get the namespace, ``~`` is the node's private namespace, ``{node}`` and
+``{ns}``/``{namespace}`` are substituted. Name validation beyond that is left to rclpy.
 """
 
 from __future__ import annotations
+
+import re
 
 from ros_gz_bridge_py.errors import ConfigError
 
@@ -39,3 +42,26 @@ def expand_topic_name(name: str, namespace: str, node_name: str) -> str:
     if name.startswith("/"):
         return name
     return f"{ns}/{name}"
+
+
+#: Characters a ROS name token may hold (rmw's topic name rules); the rest become ``_``.
+_NOT_IN_ROS_NAMES = re.compile(r"[^A-Za-z0-9_]")
+
+
+def ros_name_for_gz(gz_topic: str) -> str:
+    """The ROS topic name discovered bridging gives a Gazebo topic (README, "Discovered
+    bridging"): ``::`` (Gazebo's scope separator) becomes ``/``; every other character that
+    ROS names do not allow (``-``, ``.``, ``:``, ...) becomes ``_``; a token that starts with
+    a digit gets a leading ``_``; empty tokens go. A leading ``/`` is kept; "" when nothing
+    is left.
+
+    >>> ros_name_for_gz("/model/my-robot::base_link/3d_scan")
+    '/model/my_robot/base_link/_3d_scan'
+    """
+    tokens = []
+    for written in gz_topic.replace("::", "/").split("/"):
+        token = _NOT_IN_ROS_NAMES.sub("_", written)
+        if token:
+            tokens.append(f"_{token}" if token[0].isdigit() else token)
+    name = "/".join(tokens)
+    return f"/{name}" if name and gz_topic.startswith("/") else name

@@ -20,6 +20,7 @@ from ros_gz_bridge_py.config.model import (
     TopicBridgeSpec,
     as_bool,
     as_queue,
+    as_rate,
     ros_type_hint,
 )
 from ros_gz_bridge_py.errors import ConfigError
@@ -69,6 +70,16 @@ class _Bridge:
             msg = f"has an invalid value: {err.message}; use -1 for the default."
             raise self.error(msg) from err
 
+    def rate(self) -> float | None:
+        value = self.raw("max_rate")
+        if value is None:
+            return None
+        try:
+            return as_rate("max_rate", value)
+        except ConfigError as err:
+            msg = f"has an invalid value: {err.message}."
+            raise self.error(msg) from err
+
     def lazy(self) -> bool | None:
         value = self.raw("lazy")
         if value is None:
@@ -106,6 +117,7 @@ def _parse_topic(bridge: _Bridge, ros_type: str) -> TopicBridgeSpec | None:
         subscriber_queue=bridge.queue("subscriber_queue"),
         qos_profile=qos_profile,
         frame_id=bridge.text("frame_id") or None,
+        max_rate=bridge.rate(),
         source=bridge.source,
     )
 

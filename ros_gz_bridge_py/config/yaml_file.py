@@ -3,6 +3,10 @@
 Keys, precedence and the error texts are the C++ bridge's (docs/behaviour.md §4.1-§4.3); an invalid
 entry is skipped and the others still parse. The file is composed (PyYAML ``SafeLoader``) into
 a node tree rather than loaded, so every error and warning can name the entry and its line.
+
+Ours beyond C++: ``${name}`` placeholders in any value (``templates.py``; an entry is read once
+per combination of values), ``max_rate``, and entries that discovery completes
+(``patterns.py``): a Gazebo name with a wildcard, or a left-out type.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from typing import TypeVar, cast
 import yaml
 from yaml.constructor import SafeConstructor
 
+from ros_gz_bridge_py.config import templates
 from ros_gz_bridge_py.config.model import (
     DEPRECATED_DIRECTIONS,
     QOS_PROFILE_NAMES,
@@ -26,8 +31,10 @@ from ros_gz_bridge_py.config.model import (
     TopicBridgeSpec,
     as_bool,
     as_queue,
+    as_rate,
     ros_type_hint,
 )
+from ros_gz_bridge_py.config.patterns import TopicPattern, check_wildcards, has_wildcard
 from ros_gz_bridge_py.errors import ConfigError
 
 _NAME_KEYS = ("topic_name", "ros_topic_name", "gz_topic_name")
@@ -39,6 +46,7 @@ _TOPIC_ONLY_KEYS = (
     "lazy",
     "qos_profile",
     "frame_id",
+    "max_rate",
 )
 _SERVICE_KEYS = ("service_name", "gz_req_type_name", "gz_rep_type_name")
 #: Humble-era spellings of gz_topic_name and gz_type_name.
@@ -48,6 +56,8 @@ _KNOWN_KEYS = frozenset(
 )
 _NULL_TAG = "tag:yaml.org,2002:null"
 _T = TypeVar("_T")
+#: What one entry (or one combination of its placeholders' values) reads as.
+Parsed = BridgeSpec | TopicPattern
 
 
 def _entry_error(text: str, source: str) -> ConfigError:
@@ -62,6 +72,8 @@ class _Entry:
     ) -> None:
         self._source_name = source_name
         self._index = index
+        #: The placeholder values of the combination being read (``templates.py``).
+        self.chosen: dict[str, str] = {}
         self.location = self.at(node)
         self._warnings = warnings
         self._constructor = SafeConstructor()
@@ -80,7 +92,14 @@ class _Entry:
             self._values[key_node.value] = value_node
 
     def at(self, node: yaml.Node) -> str:
-        return f"{self._source_name} entry {self._index} (line {node.start_mark.line + 1})"
+        where = f"{self._source_name} entry {self._index} (line {node.start_mark.line + 1})"
+        return where + templates.describe(self.chosen)
+
+    def placeholder_names(self) -> list[str]:
+        """The ``${name}`` placeholders of the entry's plain values."""
+        return templates.names_in(
+            node.value for node in self._values.values() if isinstance(node, yaml.ScalarNode)
+        )
 
     def at_value(self, key: str) -> str:
         """The location of ``key``'s value (the entry's when the key is absent)."""
@@ -103,7 +122,7 @@ class _Entry:
             kind = "map" if isinstance(node, yaml.MappingNode) else "list"
             msg = f"{key} must be a string, got a {kind}"
             raise _entry_error(msg, self.at(node))
-        return cast(str, node.value)
+        return templates.substitute(cast(str, node.value), self.chosen, self.at(node))
 
     def value(self, key: str) -> object:
         """The key's value constructed as PyYAML would (int, bool, str, ...); None when unset."""
@@ -111,10 +130,13 @@ class _Entry:
         if node is None:
             return None
         try:
-            return self._constructor.construct_object(node, deep=True)
+            value = self._constructor.construct_object(node, deep=True)
         except yaml.YAMLError as err:
             msg = f"{key}: {err}"
             raise _entry_error(msg, self.at(node)) from err
+        if isinstance(value, str) and self.chosen:
+            return templates.substitute(value, self.chosen, self.at(node))
+        return value
 
     def flag(self, key: str) -> bool | None:
         raw = self.value(key)
@@ -123,6 +145,10 @@ class _Entry:
     def queue(self, key: str) -> int | None:
         raw = self.value(key)
         return None if raw is None else self._checked(key, lambda: as_queue(key, raw))
+
+    def rate(self, key: str) -> float | None:
+        raw = self.value(key)
+        return None if raw is None else self._checked(key, lambda: as_rate(key, raw))
 
     def _checked(self, key: str, convert: Callable[[], _T]) -> _T:
         try:
@@ -181,7 +207,7 @@ def _parse_service(entry: _Entry) -> ServiceBridgeSpec:
     )
 
 
-def _parse_topic(entry: _Entry) -> TopicBridgeSpec:
+def _parse_topic(entry: _Entry) -> TopicBridgeSpec | TopicPattern:
     topic_name = entry.text("topic_name")
     ros_topic = entry.text("ros_topic_name")
     gz_topic = _gz_key(entry, "gz_topic_name")
@@ -193,15 +219,18 @@ def _parse_topic(entry: _Entry) -> TopicBridgeSpec:
     if topic_name and gz_topic:
         msg = "topic_name and gz_topic_name are mutually exclusive"
         raise _entry_error(msg, entry.location)
-    if not ros_type or not gz_type:
-        msg = "both ros_type_name and gz_type_name must be set"
-        raise _entry_error(msg, entry.location)
-    direction = _direction(entry)
+    direction = _direction(entry) if entry.has("direction") else None
     if not (topic_name or ros_topic or gz_topic):
         msg = "one of topic_name, ros_topic_name or gz_topic_name must be set"
         raise _entry_error(msg, entry.location)
-    ros_topic = topic_name or ros_topic or gz_topic
-    gz_topic = topic_name or gz_topic or ros_topic
+    completed_by_discovery = not (ros_type and gz_type) or has_wildcard(topic_name or gz_topic)
+    if completed_by_discovery:
+        gz_topic = topic_name or gz_topic or ros_topic
+        ros_topic = ros_topic if ros_topic != gz_topic else ""
+        check_wildcards(gz_topic, ros_topic, entry.location)
+    else:
+        ros_topic = topic_name or ros_topic or gz_topic
+        gz_topic = topic_name or gz_topic or ros_topic
     qos_profile = entry.text("qos_profile") or None
     if qos_profile is not None and qos_profile not in QOS_PROFILE_NAMES:
         choices = ", ".join(sorted(QOS_PROFILE_NAMES))
@@ -210,24 +239,34 @@ def _parse_topic(entry: _Entry) -> TopicBridgeSpec:
     lazy = entry.flag("lazy")
     publisher_queue = entry.queue("publisher_queue")
     subscriber_queue = entry.queue("subscriber_queue")
-    if hint := ros_type_hint(ros_type):
+    max_rate = entry.rate("max_rate")
+    if ros_type and (hint := ros_type_hint(ros_type)):
         entry.warn(hint)
-    return TopicBridgeSpec(
+    spec = TopicBridgeSpec(
         ros_topic=ros_topic,
         gz_topic=gz_topic,
         ros_type=ros_type,
         gz_type=gz_type,
-        direction=direction,
+        direction=direction or Direction.BIDIRECTIONAL,
         lazy=lazy,
         publisher_queue=publisher_queue,
         subscriber_queue=subscriber_queue,
         qos_profile=qos_profile,
         frame_id=entry.text("frame_id") or None,
+        max_rate=max_rate,
         source=entry.location,
     )
+    return TopicPattern.from_spec(spec, direction) if completed_by_discovery else spec
 
 
-def _parse_entry(node: yaml.Node, source_name: str, index: int, warnings: list[str]) -> BridgeSpec:
+def _parse_entry(
+    node: yaml.Node,
+    source_name: str,
+    index: int,
+    warnings: list[str],
+    placeholders: templates.Placeholders,
+) -> list[Parsed]:
+    """The entry, read once per combination of its placeholders' values."""
     if not isinstance(node, yaml.MappingNode):
         location = f"{source_name} entry {index} (line {node.start_mark.line + 1})"
         msg = "entry must be a YAML map"
@@ -237,13 +276,19 @@ def _parse_entry(node: yaml.Node, source_name: str, index: int, warnings: list[s
         close = difflib.get_close_matches(key, _KNOWN_KEYS, n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         entry.warn(f"unknown key '{key}'{hint} is ignored")
-    if entry.text("service_name"):
-        return _parse_service(entry)
-    return _parse_topic(entry)
+    parsed: list[Parsed] = []
+    for chosen in templates.combinations(entry.placeholder_names(), placeholders, entry.location):
+        entry.chosen = chosen
+        entry.location = entry.at(node)
+        parsed.append(_parse_service(entry) if entry.text("service_name") else _parse_topic(entry))
+    return parsed
 
 
-def parse_yaml(text: str, source_name: str = "<string>") -> ParseResult:
-    """Parse the text of a bridge YAML file: a sequence of topic or service entries."""
+def parse_yaml(
+    text: str, source_name: str = "<string>", placeholders: templates.Placeholders | None = None
+) -> ParseResult:
+    """Parse the text of a bridge YAML file: a sequence of topic or service entries;
+    ``placeholders`` gives the values of ``${name}`` (``templates.py``)."""
     try:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as err:
@@ -259,17 +304,23 @@ def parse_yaml(text: str, source_name: str = "<string>") -> ParseResult:
         message = "Could not parse config: top level must be a YAML sequence"
         return ParseResult(errors=(ConfigError(message, source_name),))
     specs: list[BridgeSpec] = []
+    patterns: list[TopicPattern] = []
     errors: list[ConfigError] = []
     warnings: list[str] = []
     for index, node in enumerate(root.value, start=1):
         try:
-            specs.append(_parse_entry(node, source_name, index, warnings))
+            parsed = _parse_entry(node, source_name, index, warnings, placeholders or {})
         except ConfigError as err:
             errors.append(err)
-    return ParseResult(tuple(specs), tuple(errors), tuple(warnings))
+            continue
+        patterns += [item for item in parsed if isinstance(item, TopicPattern)]
+        specs += [item for item in parsed if not isinstance(item, TopicPattern)]
+    return ParseResult(tuple(specs), tuple(errors), tuple(warnings), tuple(patterns))
 
 
-def read_yaml_file(path: str | os.PathLike[str]) -> ParseResult:
+def read_yaml_file(
+    path: str | os.PathLike[str], placeholders: templates.Placeholders | None = None
+) -> ParseResult:
     """Read and parse a bridge YAML file; a missing, empty or non-UTF-8 file is one error."""
     name = os.fspath(path)
     try:
@@ -285,4 +336,4 @@ def read_yaml_file(path: str | os.PathLike[str]) -> ParseResult:
     except UnicodeDecodeError:
         message = f"Could not parse config: file is not UTF-8 text [{name}]"
         return ParseResult(errors=(ConfigError(message, name),))
-    return parse_yaml(text, name)
+    return parse_yaml(text, name, placeholders)

@@ -82,17 +82,27 @@ def test_full() -> None:
             "\n- topic_name: foo\n  gz_topic_name: bar",
             "Could not parse entry: topic_name and gz_topic_name are mutually exclusive",
         ),
-        (
-            "\n- topic_name: foo\n  ros_type_name: bar",
-            "Could not parse entry: both ros_type_name and gz_type_name must be set",
-        ),
     ],
-    ids=["InvalidSetTwoRos", "InvalidSetTwoGz", "InvalidSetTypes"],
+    ids=["InvalidSetTwoRos", "InvalidSetTwoGz"],
 )
 def test_invalid_sets(yaml_text: str, message: str) -> None:
     result = parse_yaml(yaml_text)
     assert _only_error(result) == message
     assert result.errors[0].source == "<string> entry 1 (line 2)"
+
+
+def test_a_left_out_type_is_completed_by_discovery() -> None:
+    """C++'s InvalidSetTypes case ("both ros_type_name and gz_type_name must be set"): ours
+    takes the missing type from discovery when the bridge runs (README, "Templates and
+    wildcards"), so the entry is a pattern, not an error."""
+    result = parse_yaml("\n- topic_name: foo\n  ros_type_name: bar")
+    assert (result.specs, result.errors) == ((), ())
+    (pattern,) = result.patterns
+    assert (pattern.gz_topic, pattern.ros_topic, pattern.ros_type, pattern.gz_type) == (
+        "foo", "", "bar", ""
+    )  # fmt: skip
+    assert pattern.direction is None
+    assert pattern.source == "<string> entry 1 (line 2)"
 
 
 _ENTRY = """
