@@ -43,6 +43,7 @@ from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.diagnosis import Finding, Flow
 from ros_gz_bridge_py.core.loop_guard import OwnPublications
 from ros_gz_bridge_py.core.options import BridgeOptions
+from ros_gz_bridge_py.core.rate_limit import rate_limiter
 from ros_gz_bridge_py.transport import GzNode
 
 #: Minimum seconds between two log lines about conversion errors of one channel.
@@ -67,6 +68,8 @@ class ChannelStats:
     published: int = 0
     conversion_errors: int = 0
     own_skipped: int = 0
+    #: Dropped by ``max_rate`` before conversion.
+    rate_limited: int = 0
     last_error: str = ""
     started_at: float = field(default_factory=time.monotonic)
 
@@ -76,6 +79,7 @@ class ChannelStats:
             "published": self.published,
             "conversion_errors": self.conversion_errors,
             "own_skipped": self.own_skipped,
+            "rate_limited": self.rate_limited,
             "last_error": self.last_error,
         }
 
@@ -137,6 +141,16 @@ class Channel(abc.ABC):
         self._logger = ctx.ros_node.get_logger()
         self._last_error_log = 0.0
         self.bulk: BulkPath | None = self.pair.bulk if ctx.options.bulk_path else None
+        self._limiter = rate_limiter(spec.max_rate, ctx.options.max_rate)
+
+    def limited(self) -> bool:
+        """Count a received message; True (and counted as rate-limited) when ``max_rate``
+        drops it. Called first for every message, before decoding or converting."""
+        self.stats.received += 1
+        if self._limiter is None or self._limiter.admit():
+            return False
+        self.stats.rate_limited += 1
+        return True
 
     def start(self) -> None:
         """Open the output side, and the input side unless the channel is lazy."""

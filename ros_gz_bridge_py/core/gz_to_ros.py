@@ -140,7 +140,8 @@ class GzToRosChannel(Channel):
         )
 
     def _on_gz_message(self, payload: Any, info: MessageInfo) -> None:
-        self.stats.received += 1
+        if self.limited():
+            return
         pair, gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))
         try:
             gz_msg = gz_class.FromString(payload)
@@ -163,7 +164,8 @@ class GzToRosChannel(Channel):
 
     def _on_gz_payload(self, payload: Any, info: MessageInfo) -> None:
         """The bulk path: Gazebo payload straight to a serialized ROS message."""
-        self.stats.received += 1
+        if self.limited():
+            return
         assert self.bulk is not None  # subscribed this way only with a bulk path
         gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))[1]
         try:

@@ -43,6 +43,8 @@ class BridgeOptions:
     gz_version: str = ""
     #: Evaluate every channel and log why it carries nothing (``explain.py``).
     explain: bool = True
+    #: Messages per second a channel passes at most unless its entry says (0: no limit).
+    max_rate: float = 0.0
 
     @property
     def garden(self) -> bool:

@@ -123,7 +123,8 @@ class RosToGzChannel(Channel):
 
     def _on_ros_message(self, ros_msg: Any) -> None:
         """``ros_msg`` is a message object, or its CDR bytes (bulk path, light read)."""
-        self.stats.received += 1
+        if self.limited():
+            return
         publisher = self._gz_publisher
         if publisher is None:
             return

@@ -13,8 +13,10 @@ and, when something keeps it from carrying messages, why (``explain.py``).
 
 Levels: WARN when a cause is a misconfiguration (another type, another partition, no Gazebo
 process at all, incompatible QoS), or when conversion errors, queue drops or failed service
-calls happened in the period; STALE for a lazy channel whose input side is closed (nobody reads
-its output); OK otherwise (a side that is not there yet is explained, not warned about).
+calls happened in the period (messages ``max_rate`` drops are counted apart, as
+``rate_limited``, and are no problem); STALE for a lazy channel whose input side is closed
+(nobody reads its output); OK otherwise (a side that is not there yet is explained, not warned
+about).
 
 :func:`serve` is how both executables run a built bridge: spinning, with the table on SIGUSR1.
 """
@@ -80,6 +82,8 @@ class ChannelStatus:
     why: str = ""
     #: One of the causes is a misconfiguration (not just a side that is not there yet).
     fault: bool = False
+    #: Messages ``max_rate`` dropped (by design: not a problem).
+    rate_limited: int = 0
 
     @property
     def name(self) -> str:
@@ -120,6 +124,7 @@ class ChannelStatus:
             "published": str(self.published),
             "conversion_errors": str(self.errors),
             "dropped": str(self.dropped),
+            "rate_limited": str(self.rate_limited),
             "rate_hz": f"{self.rate:.2f}",
             "last_error": self.last_error,
             "flow": self.flow,
@@ -189,6 +194,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
         flow=channel.flow.value if channel.flow is not None else "",
         why="\n".join(finding.text for finding in channel.findings),
         fault=any(finding.fault for finding in channel.findings),
+        rate_limited=stats.rate_limited,
     )
 
 
@@ -235,6 +241,7 @@ _COLUMNS = (
     ("OUT", lambda s: str(s.published)),
     ("ERRORS", lambda s: str(s.errors)),
     ("DROPPED", lambda s: str(s.dropped)),
+    ("LIMITED", lambda s: str(s.rate_limited)),
     ("RATE/s", lambda s: f"{s.rate:.1f}"),
     ("FLOW", lambda s: s.flow),
 )
