@@ -9,14 +9,17 @@ Beyond ros_gz_image (ros_gz issues #701, #778, #752): ``GZ_TOPIC:=ROS_TOPIC`` re
 ``config_file`` takes a parameter_bridge YAML (its Image and CameraInfo entries), ``camera_info``
 bridges the camera's CameraInfo too, ``lazy`` subscribes to Gazebo only while ROS listens, and
 no type needs naming for any Gazebo line: ``gz.msgs.Image`` takes Fortress's
-``ignition.msgs.Image`` publishers as well (``gz_type`` stays as an override). A frame whose
-data is shorter than height x width x bytes per pixel, or whose pixel format has no ROS
-encoding, is counted, logged (throttled) and not published. There is no image_transport: only
+``ignition.msgs.Image`` publishers as well (``gz_type`` stays as an override);
+``expand_gz_topic_names`` puts relative Gazebo names in the node namespace, as
+``parameter_bridge`` does (ros_gz issue 778), and ``max_rate`` limits every image stream.
+A frame whose data is shorter than height x width x bytes per pixel, or whose pixel format has
+no ROS encoding, is counted, logged (throttled) and not published. There is no image_transport: only
 the raw topic is published.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from collections.abc import Sequence
 
@@ -40,10 +43,16 @@ from ros_gz_bridge_py.app.image_bridge_args import (
 from ros_gz_bridge_py.app.settings import (
     ImageBridgeParameters,
     Switches,
+    checked_max_rate,
     declare_image_bridge_parameters,
     read_switches,
 )
-from ros_gz_bridge_py.config import TopicBridgeSpec, UsageError, read_yaml_file
+from ros_gz_bridge_py.config import (
+    TopicBridgeSpec,
+    UsageError,
+    expand_topic_name,
+    read_yaml_file,
+)
 from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.status import serve
@@ -72,6 +81,12 @@ def bridge_specs(
         for error in config.errors:
             logger.error(str(error))
         specs += [spec for spec in config.specs if isinstance(spec, TopicBridgeSpec)]
+    if params.shared.expand_gz_topic_names:
+        namespace, name = node.get_namespace(), node.get_name()
+        specs = [
+            dataclasses.replace(spec, gz_topic=expand_topic_name(spec.gz_topic, namespace, name))
+            for spec in specs
+        ]
     if params.camera_info:
         specs = list(with_camera_info(specs))
     try:
@@ -101,9 +116,12 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -
             "(image_bridge -h shows the syntax)"
         )
         return None
+    max_rate, problem = checked_max_rate(params.shared)
+    if problem:
+        logger.error(problem)
     bridge = Bridge(
         node,
-        options=params.shared.bridge_options(switches, gz_version=gz_version),
+        options=params.shared.bridge_options(switches, gz_version=gz_version, max_rate=max_rate),
         gz_options=params.shared.gz_node_options(),
     )
     bridge.add_all(specs)

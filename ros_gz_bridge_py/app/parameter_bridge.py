@@ -5,6 +5,11 @@ parameters), then every bridge is created; an entry that fails is reported with 
 skipped, the others bridge. Unlike the C++ bridge, the YAML file is read once at start (not on
 the first heartbeat, and not again on every heartbeat when it fails), and it applies together
 with command-line bridges.
+
+Ours beyond C++: ``${name}`` placeholders (``NAME=VALUE`` arguments and the ``placeholders``
+parameter), YAML entries that discovery completes and ``auto_bridge`` (both followed by
+``core/discovered.py``), ``--discover`` (``discover.py``), ``max_rate``, and
+``expand_gz_topic_names`` applied to the command line too.
 """
 
 from __future__ import annotations
@@ -20,11 +25,13 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
+from ros_gz_bridge_py.app import discover
 from ros_gz_bridge_py.app.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
 from ros_gz_bridge_py.app.check import Sides, run_check
 from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
     Switches,
+    checked_max_rate,
     declare_parameter_bridge_parameters,
     read_switches,
 )
@@ -38,10 +45,17 @@ from ros_gz_bridge_py.config import (
     parse_cli_args,
     parse_parameter_bridges,
     read_yaml_file,
+    templates,
 )
+from ros_gz_bridge_py.config.cli import cli_placeholders
+from ros_gz_bridge_py.config.discovered import AutoBridgeRules, auto_bridge_rules
 from ros_gz_bridge_py.config.gz_version import check_gz_version
+from ros_gz_bridge_py.config.patterns import TopicPattern
 from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.core.bridge import Bridge
+from ros_gz_bridge_py.core.discovered import DiscoveredBridges
+from ros_gz_bridge_py.core.discovery_plan import plan, sightings
+from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
@@ -51,6 +65,8 @@ from ros_gz_bridge_py.transport import create_gz_node
 NODE_NAME = "ros_gz_bridge"
 #: ``parameter_bridge --check [SECONDS]``: report on the entries instead of bridging them.
 CHECK_OPTION = "--check"
+#: ``parameter_bridge --discover [SECONDS]``: print the YAML of what discovery shows.
+DISCOVER_OPTION = "--discover"
 #: Exit status for bad arguments, as the C++ bridge (``return -1``).
 USAGE_EXIT = 255
 BRIDGE_PARAMETER_KEYS = (
@@ -64,6 +80,7 @@ BRIDGE_PARAMETER_KEYS = (
     "subscriber_queue",
     "qos_profile",
     "frame_id",
+    "max_rate",
     "service_name",
     "gz_req_type_name",
     "gz_rep_type_name",
@@ -118,8 +135,11 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         return USAGE_EXIT
     try:
         check_seconds, positional = split_check_option(positional)
-        cli = parse_cli_args(positional)
-    except UsageError as err:
+        discover_seconds, positional = split_seconds_option(
+            positional, DISCOVER_OPTION, discover.DEFAULT_SECONDS
+        )
+        cli_values = cli_placeholders(positional)
+    except ConfigError as err:
         print(USAGE)
         print(f"parameter_bridge: {err}", file=sys.stderr)
         return USAGE_EXIT
@@ -135,18 +155,29 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         node = Node(NODE_NAME)
         bridge: Bridge | None = None
         diagnostics: DiagnosticsPublisher | None = None
+        discovered: DiscoveredBridges | None = None
         try:
             params = declare_parameter_bridge_parameters(node)
+            try:
+                values = placeholder_values(params, cli_values)
+                cli = parse_cli_args(positional, values)
+            except ConfigError as err:
+                print(f"parameter_bridge: {err}", file=sys.stderr)
+                return USAGE_EXIT
             if stop.requested:
                 return 0
             if check_seconds is not None:
-                return check(node, cli, params, switches, check_seconds)
-            bridge = build_bridge(node, cli, params, switches)
+                return check(node, cli, params, switches, check_seconds, values=values)
+            if discover_seconds is not None:
+                return discover_yaml(node, cli, params, discover_seconds, values)
+            bridge, discovered = build_bridge(node, cli, params, switches, values)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
             serve(node, bridge, stop, events_executor=switches.events_executor)
         finally:
             if diagnostics is not None:
                 diagnostics.close()
+            if discovered is not None:
+                discovered.close()
             if bridge is not None:
                 bridge.close()
             node.destroy_node()
@@ -160,36 +191,78 @@ def split_check_option(args: Sequence[str]) -> tuple[float | None, list[str]]:
     Raises:
         UsageError: the seconds are not a positive number.
     """
+    return split_seconds_option(args, CHECK_OPTION, DEFAULT_CHECK_SECONDS)
+
+
+def split_seconds_option(
+    args: Sequence[str], option: str, default: float
+) -> tuple[float | None, list[str]]:
+    """(``option``'s seconds or None, the other arguments): ``option [SECONDS]`` anywhere.
+
+    Raises:
+        UsageError: the seconds are not a positive number.
+    """
     rest = list(args)
-    if CHECK_OPTION not in rest:
+    if option not in rest:
         return None, rest
-    index = rest.index(CHECK_OPTION)
+    index = rest.index(option)
     del rest[index]
-    seconds = DEFAULT_CHECK_SECONDS
-    if index < len(rest) and not rest[index].startswith("/") and "@" not in rest[index]:
+    seconds = default
+    candidate = rest[index] if index < len(rest) else ""
+    if (
+        candidate
+        and not candidate.startswith("/")
+        and "@" not in candidate
+        and "=" not in candidate
+    ):
         text = rest.pop(index)
         try:
             seconds = float(text)
         except ValueError:
             seconds = -1.0
         if not seconds > 0:
-            msg = f"--check takes a number of seconds > 0 to listen for, not {text!r}"
-            raise UsageError(msg, f"argument '{CHECK_OPTION} {text}'")
+            msg = f"{option} takes a number of seconds > 0 to listen for, not {text!r}"
+            raise UsageError(msg, f"argument '{option} {text}'")
     return seconds, rest
 
 
 def collect_sources(
-    node: Node, cli: ParseResult, params: ParameterBridgeParameters
+    node: Node, cli: ParseResult, params: ParameterBridgeParameters, values: templates.Placeholders
 ) -> list[ParseResult]:
-    """Every configuration source, its problems reported."""
-    sources = [cli]
+    """Every configuration source, its problems reported; ``expand_gz_topic_names`` applied
+    to each (the command line's too, unlike C++: ros_gz issue 702)."""
+    sources = [expand_if(cli, node, params)]
     if params.shared.config_file:
-        sources.append(expand_if(read_yaml_file(params.shared.config_file), node, params))
+        yaml_file = read_yaml_file(params.shared.config_file, values)
+        sources.append(expand_if(yaml_file, node, params))
     if params.bridge_names:
         sources.append(expand_if(parameter_bridge_specs(node, params.bridge_names), node, params))
     for source in sources:
         report(node, source)
     return sources
+
+
+def placeholder_values(
+    params: ParameterBridgeParameters, cli_values: templates.Placeholders
+) -> dict[str, tuple[str, ...]]:
+    """The ``placeholders`` parameter's values, then the arguments'.
+
+    Raises:
+        ConfigError: an item of the parameter that is not NAME=VALUE.
+    """
+    from_parameter = templates.parse_assignments(params.placeholders, "parameter placeholders")
+    return templates.merge(from_parameter, cli_values)
+
+
+def discovery_rules(
+    node: Node, params: ParameterBridgeParameters, *, enabled: bool
+) -> AutoBridgeRules:
+    """``auto_bridge`` and its patterns; a bad pattern is logged and auto-bridging stays off."""
+    try:
+        return auto_bridge_rules(enabled, params.auto_bridge_allow, params.auto_bridge_deny)
+    except ConfigError as err:
+        node.get_logger().error(f"{err}; auto_bridge is off")
+        return AutoBridgeRules()
 
 
 def check(
@@ -198,14 +271,19 @@ def check(
     params: ParameterBridgeParameters,
     switches: Switches,
     seconds: float,
+    *,
+    values: templates.Placeholders,
 ) -> int:
     """``--check``: report on every entry without bridging (:mod:`ros_gz_bridge_py.app.check`)."""
-    sources = collect_sources(node, cli, params)
+    sources = collect_sources(node, cli, params, values)
     specs = [spec for source in sources for spec in source.specs]
     errors = sum(len(source.errors) for source in sources)
+    patterns = [pattern for source in sources for pattern in source.patterns]
+    for pattern in patterns:
+        print(f"{pattern.gz_topic} ({pattern.source}): completed by discovery when the bridge runs")
     if not specs and not errors:
         print("parameter_bridge --check: no entries to check (give topics or config_file)")
-        return USAGE_EXIT
+        return USAGE_EXIT if not patterns else 0
     executor = make_executor(events=switches.events_executor)
     executor.add_node(node)
     with create_gz_node(params.shared.gz_node_options()) as gz_node:
@@ -216,37 +294,104 @@ def check(
     return 1 if errors else status
 
 
+def discover_yaml(
+    node: Node,
+    cli: ParseResult,
+    params: ParameterBridgeParameters,
+    seconds: float,
+    values: templates.Placeholders,
+) -> int:
+    """``--discover``: print the YAML of what discovered bridging would bridge (``discover.py``);
+    1 when a configuration entry could not be read."""
+    sources = collect_sources(node, cli, params, values)
+    explicit = [spec for source in sources for spec in source.specs]
+    patterns = [pattern for source in sources for pattern in source.patterns]
+    rules = discovery_rules(node, params, enabled=True)
+    node.get_logger().info(f"Listening to Gazebo discovery for {seconds:g} s ...")
+    with create_gz_node(params.shared.gz_node_options()) as gz_node:
+        discover.listen(seconds / 2)
+        gz_node.ask_subscribers()  # gz-transport 13+ list their subscriptions with types
+        discover.listen(seconds / 2)
+        found = sightings(gz_node.graph(), gz_node.partition)
+        explicit_names = frozenset(
+            gazebo_name(gz_node, spec.gz_topic)[1]
+            for spec in explicit
+            if isinstance(spec, TopicBridgeSpec)
+        )
+        wanted = plan(
+            found, patterns=patterns, rules=rules, registry=default_registry(),
+            explicit=explicit_names,
+        )  # fmt: skip
+        listening = gz_node.listening()
+    for topic, why in wanted.skipped.items():
+        node.get_logger().info(f"Not bridging Gazebo {topic}: {why}")
+    header = discover.header_lines(seconds, listening, len(found))
+    discover.write_yaml(list(wanted.specs.values()), header, sys.stdout)
+    return 1 if any(source.errors for source in sources) else 0
+
+
 def build_bridge(
-    node: Node, cli: ParseResult, params: ParameterBridgeParameters, switches: Switches
-) -> Bridge:
-    """Collect every configuration source, report its problems, and create the bridges."""
+    node: Node,
+    cli: ParseResult,
+    params: ParameterBridgeParameters,
+    switches: Switches,
+    values: templates.Placeholders,
+) -> tuple[Bridge, DiscoveredBridges | None]:
+    """Collect every configuration source, report its problems, and create the bridges; and
+    what follows discovery, when entries or ``auto_bridge`` ask for it."""
     logger = node.get_logger()
     for warning in switches.warnings:
         logger.warning(warning)
-    sources = collect_sources(node, cli, params)
+    sources = collect_sources(node, cli, params, values)
     try:
         gz_version = check_gz_version(params.shared.gz_version)
     except ConfigError as err:
         logger.error(str(err))
         gz_version = ""
+    max_rate, problem = checked_max_rate(params.shared)
+    if problem:
+        logger.error(problem)
     bridge = Bridge(
         node,
         options=params.shared.bridge_options(
-            switches, gz_version=gz_version, service_timeout=params.service_timeout
+            switches,
+            gz_version=gz_version,
+            service_timeout=params.service_timeout,
+            max_rate=max_rate,
         ),
         gz_options=params.shared.gz_node_options(),
     )
     bridge.add_all(spec for source in sources for spec in source.specs)
-    if not bridge.handles:
+    patterns: list[TopicPattern] = [p for source in sources for p in source.patterns]
+    rules = discovery_rules(node, params, enabled=params.auto_bridge)
+    discovered = None
+    if patterns or rules.enabled:
+        discovered = DiscoveredBridges(bridge, patterns=patterns, rules=rules)
+        what = ["auto_bridge"] if rules.enabled else []
+        what += [f"{len(patterns)} YAML entries completed by discovery"] if patterns else []
+        logger.info(f"Following Gazebo discovery: {' and '.join(what)}")
+    elif not bridge.handles:
         logger.warning(
             "No bridges are running: give topic arguments, or -p config_file:=<yaml>, "
-            "or bridge_names parameters (parameter_bridge -h shows the syntax)"
+            "or bridge_names parameters, or -p auto_bridge:=true "
+            "(parameter_bridge -h shows the syntax)"
         )
-    return bridge
+    return bridge, discovered
 
 
 def expand_if(result: ParseResult, node: Node, params: ParameterBridgeParameters) -> ParseResult:
-    return expand_gz_names(result, node) if params.expand_gz_topic_names else result
+    """``result`` with ``expand_gz_topic_names`` applied when it is set (patterns too)."""
+    if not params.shared.expand_gz_topic_names:
+        return result
+    expanded = expand_gz_names(result, node)
+    patterns = tuple(
+        dataclasses.replace(
+            pattern,
+            gz_topic=expand_topic_name(pattern.gz_topic, node.get_namespace(), node.get_name()),
+        )
+        for pattern in result.patterns
+    )
+    return dataclasses.replace(expanded, patterns=patterns)
 
 
 if __name__ == "__main__":

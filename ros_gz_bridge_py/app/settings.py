@@ -24,8 +24,10 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.parameter import Parameter
 
 from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV
+from ros_gz_bridge_py.config.model import as_rate
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE, BridgeOptions
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.transport import NodeOptions
 
 if TYPE_CHECKING:
@@ -131,12 +133,23 @@ class SharedParameters:
     #: Ours: the simulator's Gazebo line, when it must be said (only "garden" matters);
     #: declared with ``GZ_VERSION`` as its default.
     gz_version: str = ""
+    #: Apply the node namespace to Gazebo names (C++: YAML and ``bridges.*`` only; ours: the
+    #: command line and ``image_bridge`` too).
+    expand_gz_topic_names: bool = False
+    #: Ours: messages per second every channel passes at most unless its entry says (0: no
+    #: limit). Declared with any type (``10`` or ``10.0``); :func:`checked_max_rate` reads it.
+    max_rate: object = 0.0
 
     def gz_node_options(self) -> NodeOptions:
         return NodeOptions(implementation=self.gz_transport_implementation or None)
 
     def bridge_options(
-        self, switches: Switches, *, gz_version: str, service_timeout: float = DEFAULT_TIMEOUT
+        self,
+        switches: Switches,
+        *,
+        gz_version: str,
+        service_timeout: float = DEFAULT_TIMEOUT,
+        max_rate: float = 0.0,
     ) -> BridgeOptions:
         """The bridge's options: these parameters, ``switches``, and ``gz_version`` as checked
         by :func:`~ros_gz_bridge_py.config.gz_version.check_gz_version`."""
@@ -152,6 +165,7 @@ class SharedParameters:
             light_read=switches.light_read,
             cdr_write=switches.cdr_write,
             gz_version=gz_version,
+            max_rate=max_rate,
         )
 
 
@@ -160,7 +174,6 @@ class ParameterBridgeParameters:
     """``parameter_bridge``'s node parameters."""
 
     shared: SharedParameters
-    expand_gz_topic_names: bool = False
     #: Ours: seconds a ROS service call waits for Gazebo before answering success=false.
     service_timeout: float = DEFAULT_TIMEOUT
     #: The ``bridges.<name>.*`` groups to read (a string array parameter with no default).
@@ -168,6 +181,14 @@ class ParameterBridgeParameters:
     #: Ours: seconds between two /diagnostics status messages (0 = none). Any type may be
     #: given; ``start_diagnostics`` takes an int or a float and reports anything else.
     status_period: object = 0.0
+    #: Ours: bridge every Gazebo topic discovery shows (README, "Discovered bridging").
+    auto_bridge: bool = False
+    #: Ours: regular expressions on Gazebo names: only matching topics are auto-bridged
+    #: (empty: all), and none that ``auto_bridge_deny`` matches (string arrays).
+    auto_bridge_allow: tuple[str, ...] = ()
+    auto_bridge_deny: tuple[str, ...] = ()
+    #: Ours: ``NAME=VALUE`` items, the values of ``${NAME}`` in the YAML and arguments.
+    placeholders: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -198,22 +219,38 @@ def declare_shared_parameters(node: Any, env: Mapping[str, str] | None = None) -
     """Declare the shared parameters on ``node``; ``gz_version`` defaults to ``GZ_VERSION`` of
     ``env`` (default: the process's environment)."""
     env = os.environ if env is None else env
-    return _declare_fields(node, SharedParameters(gz_version=env.get(GZ_VERSION_ENV, "")), ())
+    defaults = SharedParameters(gz_version=env.get(GZ_VERSION_ENV, ""))
+    declared = _declare_fields(node, defaults, ("max_rate",))
+    any_type = ParameterDescriptor(dynamic_typing=True)
+    max_rate = node.declare_parameter("max_rate", defaults.max_rate, any_type).value
+    return dataclasses.replace(declared, max_rate=max_rate)
 
 
 def declare_parameter_bridge_parameters(
     node: Any, env: Mapping[str, str] | None = None
 ) -> ParameterBridgeParameters:
     """Declare ``parameter_bridge``'s parameters on ``node`` and return their values."""
+    arrays = ("bridge_names", "auto_bridge_allow", "auto_bridge_deny", "placeholders")
     declared = _declare_fields(
         node,
         ParameterBridgeParameters(declare_shared_parameters(node, env)),
-        ("shared", "bridge_names", "status_period"),
+        ("shared", "status_period", *arrays),
     )
-    names = node.declare_parameter("bridge_names", Parameter.Type.STRING_ARRAY).value
+    lists: dict[str, Any] = {
+        name: tuple(node.declare_parameter(name, Parameter.Type.STRING_ARRAY).value or ())
+        for name in arrays
+    }
     any_type = ParameterDescriptor(dynamic_typing=True)
     period = node.declare_parameter("status_period", declared.status_period, any_type).value
-    return dataclasses.replace(declared, bridge_names=tuple(names or ()), status_period=period)
+    return dataclasses.replace(declared, status_period=period, **lists)
+
+
+def checked_max_rate(shared: SharedParameters) -> tuple[float, str]:
+    """(the ``max_rate`` parameter as a rate, "") or (0, what is wrong with it, for the log)."""
+    try:
+        return as_rate("max_rate", shared.max_rate), ""
+    except ConfigError as err:
+        return 0.0, f"parameter {err.message}; no limit is applied"
 
 
 def declare_image_bridge_parameters(

@@ -24,6 +24,7 @@ from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
     SharedParameters,
     Switches,
+    checked_max_rate,
     declare_image_bridge_parameters,
     declare_parameter_bridge_parameters,
     read_switches,
@@ -211,11 +212,16 @@ def test_parameter_bridge_defaults(context: Context) -> None:
             override_frame_id="",
             gz_transport_implementation="",
             gz_version="",
+            expand_gz_topic_names=False,
+            max_rate=0.0,
         ),
-        expand_gz_topic_names=False,
         service_timeout=5.0,
         bridge_names=(),
         status_period=0.0,
+        auto_bridge=False,
+        auto_bridge_allow=(),
+        auto_bridge_deny=(),
+        placeholders=(),
     )
 
 
@@ -235,6 +241,11 @@ def test_parameter_bridge_values(context: Context) -> None:
             Parameter("service_timeout", value=0.5),
             Parameter("bridge_names", value=["a", "b"]),
             Parameter("status_period", value=2),
+            Parameter("max_rate", value=10),
+            Parameter("auto_bridge", value=True),
+            Parameter("auto_bridge_allow", value=["^/model/"]),
+            Parameter("auto_bridge_deny", value=["camera", "lidar"]),
+            Parameter("placeholders", value=["robot=r1,r2"]),
         ],
     )
     try:
@@ -242,12 +253,29 @@ def test_parameter_bridge_values(context: Context) -> None:
     finally:
         node.destroy_node()
     assert params == ParameterBridgeParameters(
-        SharedParameters("/b.yaml", True, 200, True, "base", "zenoh", "fortress"),
-        expand_gz_topic_names=True,
+        SharedParameters("/b.yaml", True, 200, True, "base", "zenoh", "fortress", True, 10),
         service_timeout=0.5,
         bridge_names=("a", "b"),
         status_period=2,
+        auto_bridge=True,
+        auto_bridge_allow=("^/model/",),
+        auto_bridge_deny=("camera", "lidar"),
+        placeholders=("robot=r1,r2",),
     )
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [(0.0, (0.0, "")), (10, (10.0, "")), ("2.5", (2.5, "")), (-1, None), ("fast", None)],
+)
+def test_max_rate_parameter_is_checked(value: object, expected: tuple[float, str] | None) -> None:
+    rate, problem = checked_max_rate(SharedParameters(max_rate=value))
+    if expected is None:
+        assert rate == 0.0
+        assert "max_rate must be a number of messages per second >= 0" in problem
+        assert "no limit is applied" in problem
+    else:
+        assert (rate, problem) == expected
 
 
 @pytest.mark.ros

@@ -1,0 +1,101 @@
+"""``parameter_bridge --discover [SECONDS]``: the YAML of what discovered bridging would bridge.
+
+It listens to Gazebo discovery for a few seconds, plans as ``auto_bridge`` would
+(``core/discovery_plan.py``: the allow and deny patterns, the name rule, the YAML entries that
+discovery completes, explicit entries left out) and prints a YAML file on standard output, one
+entry per topic, for the user to edit and commit. Logs go to standard error, so
+``parameter_bridge --discover > bridge.yaml`` writes a file ``config_file`` takes as it is.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Sequence
+from typing import TextIO
+
+from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.msgs.names import canonical_type
+
+#: Seconds ``--discover`` listens by default: every peer re-announces within a second, and
+#: discovery counts as complete after two (docs/protocol.md §2.5).
+DEFAULT_SECONDS = 5.0
+
+#: Comments on the QoS of some ROS types and names, written above their entries.
+_HINTS_BY_NAME = {
+    "clock": "# /clock: rclcpp's time source subscribes best effort, which this reliable "
+    "publisher serves; keep one bridge of /clock per simulation",
+    "tf_static": "# /tf_static is published transient-local: TF listeners that start "
+    "later still get the static transforms",
+}
+_SENSOR_TYPES = frozenset(
+    {"sensor_msgs/msg/Image", "sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/LaserScan"}
+)
+_SENSOR_HINT = (
+    "# a sensor stream: max_rate: <Hz> drops messages before conversion, qos_profile: "
+    "SENSOR_DATA matches best-effort subscribers"
+)
+
+
+def listen(seconds: float, spin_once: object = None) -> None:
+    """Wait ``seconds`` (spinning ROS with ``spin_once(timeout_sec=...)`` when given)."""
+    deadline = time.monotonic() + seconds
+    while (remaining := deadline - time.monotonic()) > 0:
+        if callable(spin_once):
+            spin_once(timeout_sec=min(0.1, remaining))
+        else:
+            time.sleep(min(0.1, remaining))
+
+
+def write_yaml(specs: Sequence[TopicBridgeSpec], header: Sequence[str], out: TextIO) -> None:
+    """The entries of ``specs`` as a bridge YAML file, preceded by ``header`` comments."""
+    for line in header:
+        print(f"# {line}", file=out)
+    if not specs:
+        print("[]", file=out)
+        return
+    for spec in specs:
+        for hint in _hints(spec):
+            print(hint, file=out)
+        print(f"- ros_topic_name: {_quoted(spec.ros_topic)}", file=out)
+        print(f"  gz_topic_name: {_quoted(spec.gz_topic)}", file=out)
+        print(f"  ros_type_name: {_quoted(spec.ros_type)}", file=out)
+        print(f"  gz_type_name: {_quoted(canonical_type(spec.gz_type))}", file=out)
+        print(f"  direction: {spec.direction.value}", file=out)
+        optional = {
+            "lazy": None if spec.lazy is None else str(spec.lazy).lower(),
+            "publisher_queue": spec.publisher_queue,
+            "subscriber_queue": spec.subscriber_queue,
+            "qos_profile": spec.qos_profile,
+            "frame_id": None if spec.frame_id is None else _quoted(spec.frame_id),
+            "max_rate": spec.max_rate,
+        }
+        for key, value in optional.items():
+            if value is not None:
+                print(f"  {key}: {value}", file=out)
+
+
+def header_lines(seconds: float, listening: str, count: int) -> list[str]:
+    """What the file is and how its names and types are written."""
+    return [
+        f"Written by parameter_bridge --discover {seconds:g}: {count} Gazebo topics seen by",
+        f"{listening}.",
+        "Gazebo types are written gz.msgs.X; they also match ignition.msgs.X (Fortress) peers.",
+        "Relative ROS names resolve in the bridge's namespace (/ unless -r __ns:=... is given).",
+        "Use: parameter_bridge --ros-args -p config_file:=<this file>",
+    ]
+
+
+def _hints(spec: TopicBridgeSpec) -> list[str]:
+    hints = []
+    name = spec.ros_topic.strip("/")
+    if name in _HINTS_BY_NAME:
+        hints.append(_HINTS_BY_NAME[name])
+    if spec.ros_type in _SENSOR_TYPES and spec.direction is Direction.GZ_TO_ROS:
+        hints.append(_SENSOR_HINT)
+    return hints
+
+
+def _quoted(text: str) -> str:
+    """A YAML double-quoted scalar (JSON strings are valid YAML)."""
+    return json.dumps(text)
