@@ -1,0 +1,216 @@
+"""Discovered bridging end to end (issue 16, points 1 and 2), with real peers and no YAML.
+
+ZeroMQ: real Fortress processes (the C++ ``ign_peer`` on ign-transport 11) publish
+``ignition.msgs.*`` types, one under a ``::`` name with a token starting with a digit; they
+appear in ROS under valid names, carry their values, and go when their process exits; a denied
+topic never appears; a Fortress subscriber, whose type the protocol does not tell, is skipped
+and said once. Zenoh: our ``ZenohGzNode`` process publishes and has a typed subscriber, so
+values go both ways. ``--discover`` prints a YAML that, fed back, bridges the same topics.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import socket
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from geometry_msgs.msg import Pose, Twist
+from nav_msgs.msg import Odometry
+from std_msgs.msg import String
+
+from tests.bridge.behaviour_harness import (
+    PARAMETER_BRIDGE,
+    WAIT,
+    RosSide,
+    bridge_command,
+    publish_until,
+    started,
+)
+from tests.gzpeer import (
+    PeerProcess,
+    require_peer,
+    start_peer,
+    start_process,
+    unique_name,
+    wait_for_line,
+    wait_until,
+)
+
+__all__ = ["started"]
+
+pytestmark = [pytest.mark.ros, pytest.mark.peer]
+
+GAZEBO_SIDE = Path(__file__).resolve().parent / "e2e_zenoh_gazebo.py"
+
+
+@pytest.fixture
+def probe() -> Iterator[RosSide]:
+    side = RosSide("discovered_probe")
+    yield side
+    side.close()
+
+
+def ros_topics(ros: RosSide) -> dict[str, list[str]]:
+    return dict(ros.run(ros.node.get_topic_names_and_types))
+
+
+def odometry_peer(topic: str) -> PeerProcess:
+    return start_peer(
+        "pub", topic, "ignition.msgs.Odometry", "10", "0", "pose { position { x: 1.5 } }",
+        "--wait", "0",
+    )  # fmt: skip
+
+
+def string_peer(topic: str, text: str, hz: str = "10") -> PeerProcess:
+    return start_peer(
+        "pub", topic, "ignition.msgs.StringMsg", hz, "0", f'data: "{text}"', "--wait", "0"
+    )
+
+
+def test_auto_bridge_follows_real_fortress_peers(
+    probe: RosSide, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    stem = unique_name("auto")  # /auto_<pid>_<hex>: nothing else in the partition has it
+    odom_gz = f"{stem}/model/box::link/odometry"
+    status_gz = f"{stem}/3d-status"
+    denied_gz = f"{stem}/camera/denied"
+    fortress_sub = f"{stem}/fortress_cmd"
+    odom_ros, status_ros = f"{stem}/model/box/link/odometry", f"{stem}/_3d_status"
+    bridge = start_process(
+        bridge_command(
+            ros_args=[
+                "-p", "auto_bridge:=true",
+                "-p", f"auto_bridge_allow:=[^{stem}/]",
+                "-p", "auto_bridge_deny:=[/camera/]",
+                "-p", "subscription_heartbeat:=200",
+            ]
+        )
+    )  # fmt: skip
+    started.append(bridge)
+    wait_for_line(bridge, r"Following Gazebo discovery: auto_bridge", timeout=30)
+    odometry = odometry_peer(odom_gz)
+    started += [odometry, string_peer(status_gz, "hi"), string_peer(denied_gz, "no")]
+    started.append(start_peer("echo", fortress_sub, "ignition.msgs.Twist", "60"))
+
+    wait_until(lambda: {odom_ros, status_ros} <= set(ros_topics(probe)), WAIT, "both in ROS")
+    assert ros_topics(probe)[odom_ros] == ["nav_msgs/msg/Odometry"]
+    assert ros_topics(probe)[status_ros] == ["std_msgs/msg/String"]
+    odoms, _ = probe.subscribe(Odometry, odom_ros)
+    statuses, _ = probe.subscribe(String, status_ros)
+    odoms.wait_for_count(1, WAIT)  # lazy: flows once ROS subscribes
+    statuses.wait_for_count(1, WAIT)
+    assert odoms.items()[0][0].pose.pose.position.x == 1.5
+    assert statuses.items()[0][0].data == "hi"
+    wait_for_line(bridge, rf"Gazebo {re.escape(odom_gz)} is bridged as ROS {odom_ros[1:]}")
+    wait_for_line(bridge, rf"Not bridging Gazebo {fortress_sub}: its Gazebo subscribers announce")
+    assert not any("denied" in name for name in ros_topics(probe))
+
+    odometry.stop()  # the process says goodbye: its topic goes from ROS too
+    wait_until(lambda: probe.count_publishers(odom_ros) == 0, WAIT, f"{odom_ros} gone from ROS")
+    wait_for_line(bridge, rf"Removing the discovered bridge of Gazebo {re.escape(odom_gz)}")
+    assert status_ros in ros_topics(probe)
+    assert not any("denied" in name for name in ros_topics(probe))
+    assert bridge.output().count(f"Not bridging Gazebo {fortress_sub}") == 1
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port: int = sock.getsockname()[1]
+        return port
+
+
+def _zenoh_env(listen: list[str], connect: list[str]) -> dict[str, str]:
+    overrides = {
+        "mode": '"peer"',
+        "scouting/multicast/enabled": "false",
+        "scouting/gossip/enabled": "false",
+        "listen/endpoints": json.dumps(listen),
+        "connect/endpoints": json.dumps(connect),
+    }
+    return dict(
+        os.environ,
+        GZ_TRANSPORT_IMPLEMENTATION="zenoh",
+        GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE=";".join(f"{k}={v}" for k, v in overrides.items()),
+    )
+
+
+def test_auto_bridge_over_zenoh_carries_values_both_ways(
+    probe: RosSide, started: list[PeerProcess]
+) -> None:
+    stem = unique_name("zauto")
+    pose_gz, cmd_gz = f"{stem}/model/a::b/pose", f"{stem}/cmd_vel"
+    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    bridge = start_process(
+        bridge_command(ros_args=["-p", "auto_bridge:=true", "-p", "subscription_heartbeat:=200"]),
+        _zenoh_env([endpoint], []),
+    )
+    started.append(bridge)
+    wait_for_line(bridge, r"Following Gazebo discovery", timeout=30)
+    spec = {
+        "publish": [[pose_gz, "gz.msgs.Pose", "position { y: 2.5 }"]],
+        "echo": [[cmd_gz, "gz.msgs.Twist"]],
+        "seconds": 40,
+    }
+    gazebo = start_process(
+        [sys.executable, str(GAZEBO_SIDE), json.dumps(spec)], _zenoh_env([], [endpoint])
+    )
+    started.append(gazebo)
+    wait_for_line(gazebo, r"^READY", timeout=30)
+    pose_ros = f"{stem}/model/a/b/pose"
+    wait_until(lambda: {pose_ros, cmd_gz} <= set(ros_topics(probe)), WAIT, "both topics in ROS")
+    poses, _ = probe.subscribe(Pose, pose_ros)
+    assert poses.wait_for_count(1, WAIT)[0][0].position.y == 2.5
+    publisher = probe.run(lambda: probe.node.create_publisher(Twist, cmd_gz, 10))
+    twist = Twist()
+    twist.linear.x = 0.75
+    publish_until(
+        lambda _: probe.run(lambda: publisher.publish(twist)),
+        lambda: any(line.startswith("MSG ") for line in gazebo.output().splitlines()),
+        "the Twist reached the Gazebo subscriber",
+    )
+    assert re.search(r"MSG gz\.msgs\.Twist linear \{ x: 0\.75 \}", gazebo.output())
+    gazebo.stop()
+    wait_until(lambda: probe.count_publishers(pose_ros) == 0, WAIT, f"{pose_ros} gone from ROS")
+
+
+def test_discover_prints_a_yaml_that_bridges_the_same_topics(
+    probe: RosSide, started: list[PeerProcess], tmp_path: Path
+) -> None:
+    require_peer()
+    stem = unique_name("disc")
+    clock_gz, odom_gz = f"{stem}/clock", f"{stem}/model/r-1/odometry"
+    started += [
+        start_peer(
+            "pub", clock_gz, "ignition.msgs.Clock", "10", "0", "sim { sec: 7 }", "--wait", "0"
+        ),
+        odometry_peer(odom_gz),
+    ]
+    discover = start_process(
+        [str(PARAMETER_BRIDGE), "--discover", "3", "--ros-args",
+         "-p", f"auto_bridge_allow:=[^{stem}/]"]
+    )  # fmt: skip
+    started.append(discover)
+    assert discover.wait(30) == 0, discover.output()
+    text = "\n".join(
+        line for line in discover.output().splitlines() if not line.startswith("[")
+    )  # the merged output: leave out the log lines (standard error)
+    assert f'gz_topic_name: "{odom_gz}"' in text
+    assert f'ros_topic_name: "{odom_gz[1:].replace("r-1", "r_1")}"' in text
+    assert 'gz_type_name: "gz.msgs.Clock"' in text
+    assert "direction: GZ_TO_ROS" in text
+    config = tmp_path / "discovered.yaml"
+    config.write_text(text + "\n")
+    bridge = start_process(bridge_command(ros_args=["-p", f"config_file:={config}"]))
+    started.append(bridge)
+    odom_ros = f"{stem}/model/r_1/odometry"
+    wait_until(lambda: {odom_ros, clock_gz} <= set(ros_topics(probe)), WAIT + 20, "the same topics")
+    odoms, _ = probe.subscribe(Odometry, odom_ros)
+    assert odoms.wait_for_count(1, WAIT)[0][0].pose.pose.position.x == 1.5
+    assert "Following Gazebo discovery" not in bridge.output()
