@@ -139,6 +139,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             positional, DISCOVER_OPTION, discover.DEFAULT_SECONDS
         )
         cli_values = cli_placeholders(positional)
+        parse_cli_args([arg for arg in positional if not templates.names_in([arg])])
     except ConfigError as err:
         print(USAGE)
         print(f"parameter_bridge: {err}", file=sys.stderr)
@@ -161,7 +162,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             try:
                 values = placeholder_values(params, cli_values)
                 cli = parse_cli_args(positional, values)
-            except ConfigError as err:
+            except ConfigError as err:  # a placeholder of an argument without a value
+                print(USAGE)
                 print(f"parameter_bridge: {err}", file=sys.stderr)
                 return USAGE_EXIT
             if stop.requested:
