@@ -31,6 +31,7 @@ from ros_gz_bridge_py.core.diagnosis import (
 )
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.transport import GzNode
+from ros_gz_bridge_py.transport.api import GraphEndpoint
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 
 #: Seconds between two evaluations of every channel.
@@ -165,10 +166,15 @@ class Explainer:
         peers = self._gz.peer_processes()
         listening = self._gz.listening()
         topics: list[str] | None = None
+        # One snapshot of the Gazebo graph for every channel (observe per channel would scan
+        # it once per channel: with 1,000 discovered topics, most of a core).
+        graph: dict[str, list[GraphEndpoint]] = {}
+        for endpoint in self._gz.graph():
+            graph.setdefault(endpoint.topic, []).append(endpoint)
         for channel in channels:
             seen = self._seen.setdefault(id(channel), _Seen(now, channel.stats.received))
             self._count(seen, channel, now)
-            situation = self._situation(channel, seen, now, peers, listening)
+            situation = self._situation(channel, seen, now, (peers, listening), graph)
             if (
                 situation.direction is Direction.ROS_TO_GZ
                 and not situation.gz_subscriber_registered
@@ -192,9 +198,17 @@ class Explainer:
             seen.count, seen.changed = count, now
 
     def _situation(
-        self, channel: Channel, seen: _Seen, now: float, peers: int, listening: str
+        self,
+        channel: Channel,
+        seen: _Seen,
+        now: float,
+        gz_side: tuple[int, str],
+        graph: dict[str, list[GraphEndpoint]],
     ) -> Situation:
+        """``gz_side``: (peer processes, where the node listens); ``graph``: the endpoints of
+        other processes by topic name (``GzNode.graph``)."""
         spec = channel.spec
+        peers, listening = gz_side
         partition, name = gazebo_name(self._gz, spec.gz_topic)
         registered = isinstance(channel, RosToGzChannel) and channel.gazebo_subscribed()
         return Situation(
@@ -204,7 +218,7 @@ class Explainer:
             gz_topic=name,
             gz_type=spec.gz_type,
             partition=partition,
-            gz_endpoints=self._gz.observe(spec.gz_topic),
+            gz_endpoints=graph.get(name, []),
             ros_endpoints=ros_endpoints(
                 channel.ctx.ros_node, channel.direction, channel.ros_topic, channel.qos, self._own
             ),
