@@ -45,6 +45,10 @@ YAML: unknown ``qos_profile``                 "Could not parse entry: invalid qo
                                               one of ..."
 YAML: ``<<: *anchor`` merge keys              merged by PyYAML's rules (shared settings for several
                                               entries)
+YAML: a missing type is "both ros_type_name   a :class:`TopicPattern` completed by discovery, as
+and gz_type_name must be set"                 is an entry with a wildcard (``patterns.py``)
+YAML, CLI: no placeholders                    ``${NAME}``, one entry per value (``templates.py``)
+YAML, params: no rate limit                   ``max_rate`` (Hz, 0: none)
 Params: direction ``NONE`` creates nothing,   the bridge is skipped with a warning
 silently
 Params: any negative queue means "default"    only -1 (or unset) means default; other negatives are
@@ -73,6 +77,7 @@ from ros_gz_bridge_py.config.model import (
 )
 from ros_gz_bridge_py.config.names import expand_topic_name
 from ros_gz_bridge_py.config.params import parse_parameter_bridges
+from ros_gz_bridge_py.config.patterns import TopicPattern
 from ros_gz_bridge_py.config.yaml_file import parse_yaml, read_yaml_file
 
 __all__ = [
@@ -83,6 +88,7 @@ __all__ = [
     "ParseResult",
     "ServiceBridgeSpec",
     "TopicBridgeSpec",
+    "TopicPattern",
     "UsageError",
     "expand_topic_name",
     "parse_cli_args",

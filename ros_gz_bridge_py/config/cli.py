@@ -57,6 +57,10 @@ or, with the Gazebo types spelled out:
 
 Bridges can also come from a YAML file: --ros-args -p config_file:=<path>
 (quote arguments that contain [ or ] in zsh).
+
+Ours: NAME=VALUE[,VALUE...] gives the values of ${NAME} in arguments and the YAML;
+--ros-args -p auto_bridge:=true bridges every Gazebo topic discovery shows;
+--discover [SECONDS] prints the YAML of them; --check [SECONDS] checks each entry.
 """
 )
 
