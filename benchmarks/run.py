@@ -16,7 +16,15 @@ import time
 import traceback
 from collections.abc import Callable
 
-from benchmarks import conversion, images, memory, small_messages, starvation, transport
+from benchmarks import (
+    conversion,
+    discovery,
+    images,
+    memory,
+    small_messages,
+    starvation,
+    transport,
+)
 from benchmarks.harness import stop_all
 from benchmarks.report import write_section
 from ros_gz_bridge_py.ros.speed import PROFILE
@@ -31,6 +39,9 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
         "images": lambda: images.main(["--seconds", str(flow)]),
         "small_messages": lambda: small_messages.main(["--seconds", str(flow)]),
         "starvation": lambda: starvation.main(["--seconds", "3" if quick else "5"]),
+        "discovery": lambda: discovery.main(
+            ["--idle", "5" if quick else "10"] + (["--counts", "10", "100"] if quick else [])
+        ),
         "memory": lambda: memory.main(
             ["--flood-seconds", "15" if quick else "60", "--slow-seconds", "8" if quick else "15"]
         ),

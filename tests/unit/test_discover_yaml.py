@@ -1,0 +1,61 @@
+"""``parameter_bridge --discover``: its argument, and the YAML it writes reads back as the same
+bridges (the end-to-end run is in tests/bridge/test_discovered_e2e.py)."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from ros_gz_bridge_py.app.discover import header_lines, write_yaml
+from ros_gz_bridge_py.app.parameter_bridge import DISCOVER_OPTION, split_seconds_option
+from ros_gz_bridge_py.config import Direction, TopicBridgeSpec, UsageError, parse_yaml
+
+SPECS = [
+    TopicBridgeSpec(
+        "clock", "/clock", "rosgraph_msgs/msg/Clock", "ignition.msgs.Clock",
+        Direction.GZ_TO_ROS, lazy=True,
+    ),
+    TopicBridgeSpec(
+        "model/r_1/cmd_vel", "/model/r-1/cmd_vel", "geometry_msgs/msg/Twist", "gz.msgs.Twist",
+        Direction.ROS_TO_GZ, lazy=True, max_rate=5.0,
+    ),
+    TopicBridgeSpec(
+        "model/box/link/camera", "/model/box::link/camera", "sensor_msgs/msg/Image",
+        "gz.msgs.Image", Direction.GZ_TO_ROS, lazy=True,
+    ),
+]  # fmt: skip
+
+
+def test_the_yaml_reads_back_as_the_same_bridges_with_hints() -> None:
+    out = io.StringIO()
+    write_yaml(SPECS, header_lines(3.0, "ZeroMQ discovery on ...", 3), out)
+    text = out.getvalue()
+    result = parse_yaml(text, "discovered.yaml")
+    assert (result.errors, result.warnings, result.patterns) == ((), (), ())
+    read = [s for s in result.specs if isinstance(s, TopicBridgeSpec)]
+    assert [
+        (s.ros_topic, s.gz_topic, s.ros_type, s.direction, s.lazy, s.max_rate) for s in read
+    ] == [(s.ros_topic, s.gz_topic, s.ros_type, s.direction, s.lazy, s.max_rate) for s in SPECS]
+    assert [s.gz_type for s in read] == ["gz.msgs.Clock", "gz.msgs.Twist", "gz.msgs.Image"]
+    assert "# /clock: rclcpp's time source subscribes best effort" in text
+    assert "# a sensor stream: max_rate: <Hz>" in text
+    assert text.startswith("# Written by parameter_bridge --discover 3: 3 Gazebo topics")
+
+
+def test_nothing_discovered_is_an_empty_list() -> None:
+    out = io.StringIO()
+    write_yaml([], ["nothing"], out)
+    assert parse_yaml(out.getvalue()).errors == ()
+
+
+def test_the_discover_option_takes_optional_seconds() -> None:
+    args = ["--discover", "/a@std_msgs/msg/String@gz.msgs.StringMsg"]
+    assert split_seconds_option(args, DISCOVER_OPTION, 5.0) == (5.0, args[1:])
+    assert split_seconds_option(["--discover", "2.5"], DISCOVER_OPTION, 5.0) == (2.5, [])
+    assert split_seconds_option(["robot=r1", "--discover"], DISCOVER_OPTION, 5.0) == (
+        5.0,
+        ["robot=r1"],
+    )
+    with pytest.raises(UsageError, match="--discover takes a number of seconds > 0"):
+        split_seconds_option(["--discover", "soon"], DISCOVER_OPTION, 5.0)
