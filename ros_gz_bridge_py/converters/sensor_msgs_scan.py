@@ -35,7 +35,7 @@ from sensor_msgs.msg import LaserScan, PointCloud2, PointField, Range
 from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header, gz_to_ros_frame
-from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError
 from ros_gz_bridge_py.msgs import message_class
 
 GzLaserScan = message_class("gz.msgs.LaserScan")
@@ -199,7 +199,7 @@ def check_cloud_sizes(type_name: str, fields_name: str, sizes: CloudSizes, data_
         )
     if problems:
         msg = f"{type_name} sizes do not match its data: {'; '.join(problems)}"
-        raise ConversionError(msg)
+        raise SizeMismatchError(msg)
 
 
 def point_cloud2_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:

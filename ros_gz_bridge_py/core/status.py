@@ -12,8 +12,9 @@ Each channel also shows its flow state (waiting for Gazebo, waiting for ROS, flo
 and, when something keeps it from carrying messages, why (``explain.py``).
 
 Levels: WARN when a cause is a misconfiguration (another type, another partition, no Gazebo
-process at all, incompatible QoS), or when conversion errors, queue drops or failed service
-calls happened in the period; STALE for a lazy channel whose input side is closed (nobody reads
+process at all, incompatible QoS), or when errors (messages the channel could not use, by
+what was wrong: ``ChannelStats.errors_by_reason``), queue drops or failed service calls
+happened in the period; STALE for a lazy channel whose input side is closed (nobody reads
 its output); OK otherwise (a side that is not there yet is explained, not warned about).
 
 :func:`serve` is how both executables run a built bridge: spinning, with the table on SIGUSR1.
@@ -80,6 +81,14 @@ class ChannelStatus:
     why: str = ""
     #: One of the causes is a misconfiguration (not just a side that is not there yet).
     fault: bool = False
+    #: ``errors`` by what was wrong ("undecodable payload": 3, ...), largest first.
+    errors_by_reason: tuple[tuple[str, int], ...] = ()
+    #: Of ``errors``, those the converter refused (the rest the transport did).
+    conversion_errors: int = 0
+
+    def error_summary(self) -> str:
+        """``"3 undecodable payload, 1 wrong type"`` ("" without errors)."""
+        return ", ".join(f"{count} {reason}" for reason, count in self.errors_by_reason)
 
     @property
     def name(self) -> str:
@@ -104,7 +113,9 @@ class ChannelStatus:
             return "lazy: no subscribers, input side closed"
         if self.level == WARN:
             text = f"{self.new_problems} errors/drops in the last period"
-            return f"{text}: {self.last_error}" if self.last_error else text
+            if self.errors_by_reason:
+                text += f" (errors since start: {self.error_summary()})"
+            return f"{text}; last: {self.last_error}" if self.last_error else text
         return "ok"
 
     def values(self) -> dict[str, str]:
@@ -118,7 +129,9 @@ class ChannelStatus:
             "state": self.state,
             "received": str(self.received),
             "published": str(self.published),
-            "conversion_errors": str(self.errors),
+            "errors": str(self.errors),
+            "conversion_errors": str(self.conversion_errors),
+            **{f"errors: {reason}": str(count) for reason, count in self.errors_by_reason},
             "dropped": str(self.dropped),
             "rate_hz": f"{self.rate:.2f}",
             "last_error": self.last_error,
@@ -181,7 +194,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
         state=channel.state.value,
         received=stats.received,
         published=stats.published,
-        errors=stats.conversion_errors,
+        errors=stats.errors,
         dropped=channel.dropped if isinstance(channel, GzToRosChannel) else 0,
         rate=0.0,
         new_problems=0,
@@ -189,6 +202,10 @@ def channel_status(channel: Channel) -> ChannelStatus:
         flow=channel.flow.value if channel.flow is not None else "",
         why="\n".join(finding.text for finding in channel.findings),
         fault=any(finding.fault for finding in channel.findings),
+        errors_by_reason=tuple(
+            sorted(dict(stats.errors_by_reason).items(), key=lambda item: (-item[1], item[0]))
+        ),
+        conversion_errors=stats.conversion_errors,
     )
 
 
@@ -207,6 +224,7 @@ def service_status(service: ServiceBridge) -> ChannelStatus:
         dropped=0,
         rate=0.0,
         new_problems=0,
+        conversion_errors=service.failures,
     )
 
 
@@ -255,6 +273,11 @@ def format_table(statuses: list[ChannelStatus]) -> str:
         lines += [
             f"why {status.direction} {status.ros_name}: {why}" for why in status.why.splitlines()
         ]
+        if status.errors_by_reason:
+            last = f"; last: {status.last_error}" if status.last_error else ""
+            lines.append(
+                f"errors {status.direction} {status.ros_name}: {status.error_summary()}{last}"
+            )
     return "\n".join(lines)
 
 
