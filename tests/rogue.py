@@ -90,28 +90,34 @@ class RoguePublisher:
     """A raw XPUB bound on loopback, advertised by a :class:`FakePeer`: it sees each
     subscription (a connection's filter), so a test can send one frame per connection."""
 
-    def __init__(self, fqn: str, msg_type: str, *, max_size: int = -1) -> None:
+    def __init__(self, fqn: str, msg_type: str, *, sndhwm: int = 100) -> None:
         self.fqn = fqn
         self.msg_type = msg_type
         self.context = zmq.Context()
         self.xpub = self.context.socket(zmq.XPUB)
         self.xpub.setsockopt(zmq.LINGER, 0)
         self.xpub.setsockopt(zmq.XPUB_VERBOSE, 1)
-        self.xpub.setsockopt(zmq.SNDHWM, 100)
+        self.xpub.setsockopt(zmq.SNDHWM, sndhwm)
         self.xpub.bind("tcp://127.0.0.1:*")
         self.address: str = self.xpub.getsockopt_string(zmq.LAST_ENDPOINT)
         self.peer = FakePeer(fqn, msg_type, [self.address])
         self.subscriptions = 0
 
     def wait_subscribed(self, timeout: float) -> bool:
-        """Wait for the next subscription message (a new or renewed connection)."""
-        if not self.xpub.poll(int(timeout * 1000)):
-            return False
-        while self.xpub.poll(0):
-            message = self.xpub.recv()
-            if message[:1] == b"\x01":
-                self.subscriptions += 1
-        return True
+        """Wait for the next subscription message (a new or renewed connection's filter);
+        unsubscriptions (a connection gone) are skipped."""
+        deadline = time.monotonic() + timeout
+        while (remaining := deadline - time.monotonic()) > 0:
+            if not self.xpub.poll(int(remaining * 1000) + 1):
+                return False
+            subscribed = False
+            while self.xpub.poll(0):
+                if self.xpub.recv()[:1] == b"\x01":
+                    self.subscriptions += 1
+                    subscribed = True
+            if subscribed:
+                return True
+        return False
 
     def send(self, payload: bytes | memoryview, msg_type: str | None = None) -> None:
         """One data message of four frames (docs/protocol.md §2.8.2), payload not copied."""

@@ -9,8 +9,11 @@ Three things libzmq does on its own that a SUB socket's owner must follow (docs/
   had succeeded, with no CONNECT_RETRIED after it (a publisher that goes away is retried). We
   count such a drop as one refused message and reconnect ourselves, sooner after a first
   refusal and up to :data:`MAX_BACKOFF` later when they repeat.
-* Handshake failures: wrong credentials (HANDSHAKE_FAILED_AUTH) are counted and said once per
-  address; the address is retried with the same back-off.
+* Connections that end before their handshake (an address that accepts and closes, wrong
+  credentials, something that is not ZeroMQ): libzmq retries those every 100 ms for ever (a
+  successful TCP connect resets its back-off). From the second such failure in a row we
+  disconnect the address and retry it ourselves with the back-off. Wrong credentials
+  (HANDSHAKE_FAILED_AUTH) are also counted and said once per address.
 * Disconnecting: ``zmq_disconnect`` while a message's first frame was already taken from the
   connection's pipe (``zmq_poll`` prefetches it) makes the next read abort the process
   (``Assertion failed: !_more (src/fq.cpp)``, libzmq issue #2163). :meth:`SubConnections.
@@ -48,6 +51,8 @@ FIRST_BACKOFF = 0.1
 MAX_BACKOFF = 5.0
 #: A refusal this long after the previous one starts the back-off anew (s).
 BACKOFF_RESET = 30.0
+#: Connections ending before their handshake, in a row, after which we take over retrying.
+FAILURES_BEFORE_BACKOFF = 2
 #: Monitor events read per turn.
 READ_BATCH = 256
 
@@ -78,6 +83,8 @@ class SubConnections:
         self._handshaken: set[str] = set()
         self._auth_failed: set[str] = set()
         self._told_auth: set[str] = set()
+        # address -> connections in a row that ended before their handshake
+        self._failures: dict[str, int] = {}
         # address -> when libzmq dropped it (waiting to see whether it retries)
         self._dropped: dict[str, float] = {}
         # address -> when to reconnect; address -> (delay, time of the last refusal)
@@ -148,6 +155,7 @@ class SubConnections:
         if kind == zmq.EVENT_HANDSHAKE_SUCCEEDED:
             self._handshaken.add(address)
             self._auth_failed.discard(address)
+            self._failures.pop(address, None)
         elif kind == zmq.EVENT_HANDSHAKE_FAILED_AUTH:
             self._auth_failed.add(address)
             self._count("auth_failures")
@@ -160,8 +168,15 @@ class SubConnections:
                     self._what,
                     address,
                 )
+        elif kind == zmq.EVENT_DISCONNECTED and address in self._handshaken:
+            self._dropped[address] = now  # a refused message, if libzmq does not retry
         elif kind == zmq.EVENT_DISCONNECTED:
-            self._dropped[address] = now
+            failures = self._failures[address] = self._failures.get(address, 0) + 1
+            if failures >= FAILURES_BEFORE_BACKOFF and address not in self._due:
+                self._drain()
+                with contextlib.suppress(zmq.ZMQError):
+                    self._sock.disconnect(address)
+                self._schedule(address, now)
         else:  # CONNECTED, CONNECT_DELAYED, CONNECT_RETRIED: libzmq is on it
             self._dropped.pop(address, None)
 
@@ -170,6 +185,11 @@ class SubConnections:
         if address in self._handshaken and address not in self._auth_failed:
             self._on_refused(address)
         self._handshaken.discard(address)
+        self._schedule(address, now)
+
+    def _schedule(self, address: str, now: float) -> None:
+        """Reconnect ``address`` after the back-off: FIRST_BACKOFF, doubled each time within
+        BACKOFF_RESET of the previous, up to MAX_BACKOFF."""
         delay, last = self._backoff.get(address, (0.0, 0.0))
         delay = FIRST_BACKOFF if now - last > BACKOFF_RESET else min(2 * delay, MAX_BACKOFF)
         self._backoff[address] = (max(delay, FIRST_BACKOFF), now)
@@ -186,7 +206,7 @@ class SubConnections:
             _LOG.debug("cannot reconnect %s to %r: %s", self._what, address, error)
 
     def _forget(self, address: str) -> None:
-        for table in (self._dropped, self._due, self._backoff):
+        for table in (self._dropped, self._due, self._backoff, self._failures):
             table.pop(address, None)
         for names in (self._handshaken, self._auth_failed, self._told_auth):
             names.discard(address)
