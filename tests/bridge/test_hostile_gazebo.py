@@ -196,10 +196,11 @@ def test_a_fake_peers_300_addresses_cost_nothing_once_it_is_silent(
     attempts); it then falls silent. Its records expire after 3 s and the bridge disconnects:
     10 s after the silence no connection attempt arrives, and the bridge's idle CPU is within
     1 percentage point of its baseline before the flood (the campaign saw 2.9% -> 9.4% for
-    good). CPU is measured over 3 s windows from /proc; the machine is shared, so the
-    baseline is the lower of two windows and the last window is retried once."""
+    good). CPU is the bridge's own (utime + stime from /proc) over 4 s windows, each holding
+    two of its 2 s explanation rounds; a window can still catch one round more than another,
+    so a last window over the bound is measured once more."""
     time.sleep(2.0)  # the bridge's start-up is over
-    baseline = min(cpu_percent(bridge.pid, 1.5), cpu_percent(bridge.pid, 1.5))
+    baseline = cpu_percent(bridge.pid, 4.0)
     rss_before = usage(bridge.pid).rss_bytes
     traps = TrapListeners(150)
     peer = FakePeer(bridge.fqn, STRING, traps.addresses + closed_ports(150))
@@ -210,9 +211,9 @@ def test_a_fake_peers_300_addresses_cost_nothing_once_it_is_silent(
         silent_at = time.monotonic()
         time.sleep(7.0)  # expiry after 3 s of silence, then the disconnects
         settled = traps.accepted
-        after = cpu_percent(bridge.pid, 3.0)
+        after = cpu_percent(bridge.pid, 4.0)
         if after > baseline + 1:
-            after = cpu_percent(bridge.pid, 3.0)
+            after = cpu_percent(bridge.pid, 4.0)
         late = traps.accepted - settled
         elapsed = time.monotonic() - silent_at
     finally:
