@@ -477,6 +477,8 @@ class ZmqGzNode(GzNode):
                 self._handle_topic_event(event)
             elif isinstance(event, PublisherAdded):
                 self._services.provider_found(event.record.topic)
+            elif isinstance(event, PublisherRemoved):
+                self._services.provider_gone(event.record.address)
         self.graph_changed()
 
     def _handle_topic_event(self, event: Event) -> None:

@@ -14,12 +14,15 @@ import time
 import uuid
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
+import zmq
 
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import MessageInfo, Rejection, TransportSettings
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
+from ros_gz_bridge_py.transport.zmq.wire import ServiceRequest, encode_request
 from tests.rogue import FakePeer, RoguePublisher, TrapListeners
 
 STRING = "gz.msgs.StringMsg"
@@ -248,3 +251,44 @@ def test_disconnecting_after_a_poll_aborts_libzmq_unless_the_socket_is_drained_f
     else:
         assert done.returncode == 0, done.stderr
         assert done.stdout.strip() == "survived 1"
+
+
+def test_service_providers_that_go_are_disconnected_and_response_addresses_are_tcp(
+    node: ZmqGzNode,
+) -> None:
+    """The requester disconnects from a provider whose records went away; a request whose
+    response address is not ``tcp://`` is refused before its handler runs."""
+    service = unique("srv")
+    calls: list[bytes] = []
+
+    def handler(request: bytes) -> tuple[bool, bytes]:
+        calls.append(request)
+        return True, request
+
+    with ZmqGzNode() as provider:
+        provider.advertise_service(service, STRING, STRING, handler)
+        assert node.request(service, b"\x0a\x01x", STRING, STRING, 10) == (True, b"\x0a\x01x")
+        assert node._services._requester_connected == {provider.replier_address}
+        raw: zmq.Socket[bytes] = zmq.Context.instance().socket(zmq.ROUTER)
+        raw.setsockopt(zmq.LINGER, 0)
+        raw.setsockopt(zmq.ROUTER_MANDATORY, 1)
+        raw.connect(provider.replier_address)
+        request = ServiceRequest(
+            provider.fqn(service), "ipc:///tmp/answer-here", "id", "node", "req", b"",
+            STRING, STRING,
+        )  # fmt: skip
+        frames = encode_request(provider._io.replier_id, request)
+        assert wait_until(lambda: _sent(raw, frames))
+        assert wait_until(lambda: provider.stats.addresses_refused == 1)
+        raw.close()
+        assert len(calls) == 1
+    assert wait_until(lambda: not node._services._requester_connected)
+
+
+def _sent(sock: zmq.Socket[bytes], frames: list[Any]) -> bool:
+    try:
+        sock.send_multipart(frames, zmq.NOBLOCK)
+    except zmq.ZMQError:  # not routable until the connection is up
+        time.sleep(0.02)
+        return False
+    return True
