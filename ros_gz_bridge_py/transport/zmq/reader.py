@@ -15,6 +15,8 @@ counted, as with ROS "keep last". ZeroMQ sockets are single-threaded: connects a
 disconnects from other threads are posted to the reader; local (intra-process) messages go
 into its queue; both wake it up.
 
+After a burst of large messages, freed memory goes back to the system (``heap.py``).
+
 A message of the topic that cannot be used (malformed frames, a type the subscription does
 not take, over the size limit: ``connections.py``) is told to ``reject``; messages of other
 topics that share the topic's name as a prefix (ZeroMQ filters by prefix) are not ours and
@@ -45,6 +47,7 @@ from ros_gz_bridge_py.transport.delivery import (
     QueueClosedError,
     payload_size,
 )
+from ros_gz_bridge_py.transport.heap import BurstTrimmer
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
@@ -102,6 +105,7 @@ class SubscriptionReader:
             size, weigh=payload_size, max_bytes=max_bytes
         )
         self._count = count
+        self._trimmer = BurstTrimmer()
         self._on_start = on_start
         self._infos: dict[tuple[Frame, Frame, Frame], Verdict] = {}
         self._posted: collections.deque[Callable[[], object]] = collections.deque()
@@ -207,6 +211,7 @@ class SubscriptionReader:
             try:
                 payload, info = self._pending.get(block=False)
             except (queue.Empty, QueueClosedError):
+                self._trimmer.idle()  # memory of a burst of large messages goes back
                 return
             self._deliver(payload, info)
             if time.monotonic() >= end:
@@ -229,6 +234,7 @@ class SubscriptionReader:
             verdict = self._verdict(frames)
             if isinstance(verdict, MessageInfo):
                 self.received += 1
+                self._trimmer.received(len(frames[2]))
                 self._keep((frames[2], verdict))
             elif verdict is not None:
                 self._reject(*verdict)
