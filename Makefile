@@ -11,7 +11,7 @@ LOOPBACK := ../shared/tools/loopback-env
 # Keep ROS, Gazebo Transport and Zenoh traffic on this host (see DEVELOPERS.md).
 WITH_LOOPBACK := if [ -f $(LOOPBACK) ]; then source $(LOOPBACK); else source tools/loopback-env; fi;
 
-.PHONY: setup test lint typecheck unit demo bench clean
+.PHONY: setup test lint typecheck unit demo bench soak clean
 
 setup: $(STAMP)
 
@@ -40,6 +40,10 @@ demo: setup
 
 bench: setup
 	$(WITH_LOOPBACK) $(PY) -m benchmarks.run
+
+# Ten minutes of mixed traffic and faults; writes SOAK.md (a short version runs in `make test`).
+soak: setup
+	$(WITH_LOOPBACK) $(PY) -m benchmarks.soak --seconds $${SOAK_SECONDS:-600}
 
 clean:
 	rm -rf .build .pytest_cache .mypy_cache .ruff_cache

@@ -18,18 +18,11 @@ from __future__ import annotations
 
 import argparse
 import difflib
-import functools
-import importlib
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from ros_gz_bridge_py.converters.registry import (
-    BUILTIN_MODULES,
-    Pair,
-    Registry,
-    build_registry,
-)
+from ros_gz_bridge_py.converters.registry import Pair, Registry, build_registry, modules_of
 from ros_gz_bridge_py.errors import BridgeError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -49,11 +42,7 @@ def builtin_registry() -> Registry:
     Raises:
         TableError: a converter module could not be imported (an interface package missing).
     """
-    modules = [
-        (name, functools.partial(importlib.import_module, f"{CONVERTERS}.{name}"))
-        for name in BUILTIN_MODULES
-    ]
-    registry = build_registry(modules)
+    registry = build_registry(modules_of(CONVERTERS))
     if registry.unavailable:
         missing = ", ".join(f"{name} ({why})" for name, why in registry.unavailable.items())
         msg = f"converter modules could not load, the table would be incomplete: {missing}"
@@ -67,7 +56,7 @@ def _pair_notes(pair: Pair, registry: Registry) -> str:
     gz_choices = registry.gz_types_for(pair.ros_type)
     if len(gz_choices) > 1 and gz_choices[0] == pair.gz_type:
         notes.append("default Gazebo type for this ROS type")
-    ros_choices = [p.ros_type for p in registry.pairs if p.gz_type == pair.gz_type]
+    ros_choices = registry.ros_types_for(pair.gz_type)
     if len(ros_choices) > 1 and ros_choices[0] == pair.ros_type:
         notes.append("default ROS type for this Gazebo type")
     if pair.gz_type.startswith("ignition.msgs."):

@@ -46,6 +46,8 @@ SERIALIZED_PUBLISH_ENV = "ROS_GZ_BRIDGE_SERIALIZED_PUBLISH"
 BULK_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
 #: A switch: off makes ROS->Gazebo channels take rclpy's message objects.
 LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
+#: A switch: off makes Gazebo->ROS channels publish rclpy's message objects through rclpy.
+CDR_WRITE_ENV = "ROS_GZ_BRIDGE_CDR_WRITE"
 
 
 @dataclass(frozen=True)
@@ -64,6 +66,8 @@ class Switches:
     bulk_nice: int = BULK_THREAD_NICE
     #: False with ``ROS_GZ_BRIDGE_LIGHT_READ=off``.
     light_read: bool = True
+    #: False with ``ROS_GZ_BRIDGE_CDR_WRITE=off``.
+    cdr_write: bool = True
     #: What was wrong with a value, one sentence each: the executables log them once their
     #: node exists (the switches are read before ``rclpy.init``).
     warnings: tuple[str, ...] = ()
@@ -107,6 +111,7 @@ def read_switches(env: Mapping[str, str] | None = None) -> Switches:
         rcl_serialized_publish=not _chosen(SERIALIZED_PUBLISH_ENV, "rclpy", env),
         bulk_nice=bulk_nice,
         light_read=not switched_off(LIGHT_READ_ENV, env),
+        cdr_write=not switched_off(CDR_WRITE_ENV, env),
         warnings=(nice_warning,) if nice_warning else (),
     )
 
@@ -145,6 +150,7 @@ class SharedParameters:
             rcl_serialized_publish=switches.rcl_serialized_publish,
             bulk_nice=switches.bulk_nice,
             light_read=switches.light_read,
+            cdr_write=switches.cdr_write,
             gz_version=gz_version,
         )
 

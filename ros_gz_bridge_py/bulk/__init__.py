@@ -8,7 +8,8 @@ megabytes about six times and holds the GIL through the DDS write. The bulk path
   (:mod:`.protowire`), converts only the small fields with the pair's own converter, lets rclpy
   serialize that small message, and splices the bulk view into the CDR (:mod:`.cdr`): one copy;
 - publishes the CDR bytes through ``rcl_publish_serialized_message`` with the GIL released
-  (:mod:`.serialized_publisher`), so other topics keep flowing during the DDS write;
+  (:mod:`ros_gz_bridge_py.ros.serialized_publisher`), so other topics keep flowing during the
+  DDS write;
 - the other way, walks the serialized ROS message to the bulk field, converts the small rest,
   and appends the bulk bytes to the small protobuf payload: one copy.
 

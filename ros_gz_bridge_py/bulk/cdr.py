@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any, Union
 
 from ros_gz_bridge_py.errors import ConversionError
-from ros_gz_bridge_py.ros import light_reader
+from ros_gz_bridge_py.ros import cdr_types
 
 #: Encapsulation identifiers of plain CDR: big endian, little endian.
 CDR_BE = b"\x00\x00"
@@ -51,7 +51,7 @@ def layout_until(msg_class: type[Any], field: str) -> Layout:
             field after it is wider than one byte (splicing bytes in would move its
             alignment), or a field before it has no token (a sequence of primitives).
     """
-    fields = light_reader.fields_of(msg_class)
+    fields = cdr_types.fields_of(msg_class)
     names = [name for name, _ in fields]
     if field not in names:
         msg = f"{msg_class.__name__} has no field {field!r}"
@@ -60,13 +60,13 @@ def layout_until(msg_class: type[Any], field: str) -> Layout:
     bulk = fields[index][1]
     element = getattr(bulk, "value_type", None)
     if (
-        type(bulk).__name__ not in light_reader.SEQUENCE_TYPES
+        type(bulk).__name__ not in cdr_types.SEQUENCE_TYPES
         or getattr(element, "typename", None) not in _BULK_ELEMENTS
     ):
         msg = f"{msg_class.__name__}.{field} is not a sequence of one-byte elements"
         raise ValueError(msg)
     for name, slot in fields[index + 1 :]:
-        if light_reader.basic_size(slot) != 1:
+        if cdr_types.basic_size(slot) != 1:
             msg = f"{msg_class.__name__}.{name} after {field} is not one byte wide"
             raise ValueError(msg)
     tokens: list[Token] = []
@@ -76,22 +76,22 @@ def layout_until(msg_class: type[Any], field: str) -> Layout:
 
 
 def _tokens(slot: Any) -> Layout:
-    size = light_reader.basic_size(slot)
+    size = cdr_types.basic_size(slot)
     if size is not None:
         return (_SIZE_TOKENS[size],)
     kind = type(slot).__name__
-    if kind in light_reader.STRING_TYPES:
+    if kind in cdr_types.STRING_TYPES:
         return ("str",)
     if kind == "NamespacedType":
-        return _struct_tokens(light_reader.nested_class(slot))
-    if kind in light_reader.SEQUENCE_TYPES and type(slot.value_type).__name__ == "NamespacedType":
-        return (Sequence(_struct_tokens(light_reader.nested_class(slot.value_type))),)
+        return _struct_tokens(cdr_types.nested_class(slot))
+    if kind in cdr_types.SEQUENCE_TYPES and type(slot.value_type).__name__ == "NamespacedType":
+        return (Sequence(_struct_tokens(cdr_types.nested_class(slot.value_type))),)
     msg = f"no CDR layout token for a field of type {kind}"
     raise ValueError(msg)
 
 
 def _struct_tokens(msg_class: type[Any]) -> Layout:
-    fields = light_reader.fields_of(msg_class)
+    fields = cdr_types.fields_of(msg_class)
     if not fields:  # an empty message still carries one uint8 on the wire
         return ("u8",)
     tokens: list[Token] = []

@@ -1,4 +1,4 @@
-"""builtin_interfaces/msg/Time <-> gz.msgs.Time (conversions.md §1.2).
+"""builtin_interfaces/msg/Time <-> gz.msgs.Time (docs/conversions.md §1.2).
 
 Times are copied field by field with C++ integer semantics and no normalisation: seconds
 narrow to int32 and nanoseconds are reinterpreted between uint32 and int32.
@@ -10,10 +10,8 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 
+from ros_gz_bridge_py.converters._fields import Fill, converters
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.msgs import message_class
-
-GzTime = message_class("gz.msgs.Time")
 
 _U32 = 1 << 32
 _I32_MAX = (1 << 31) - 1
@@ -42,16 +40,16 @@ def fill_ros_time(gz: Any, ros: Any) -> None:
     ros.nanosec = to_uint32(gz.nsec)
 
 
-def time_to_gz(ros: Any) -> Any:
-    gz = GzTime()
+def fill_gz_present_time(ros: Any, gz: Any) -> None:
+    """:func:`fill_gz_time` into a gz Time that is serialized even when it is zero."""
+    gz.SetInParent()
     fill_gz_time(ros, gz)
-    return gz
 
 
-def time_to_ros(gz: Any) -> Any:
-    ros = Time()
-    fill_ros_time(gz, ros)
-    return ros
+TIME = Fill(fill_gz_time, fill_ros_time)
+#: A ROS Time or Duration <-> a gz Time that is always present on the wire.
+PRESENT_TIME = Fill(fill_gz_present_time, fill_ros_time)
 
+time_to_gz, time_to_ros = converters(TIME, Time, "gz.msgs.Time")
 
-PAIRS = (Pair("builtin_interfaces/msg/Time", "gz.msgs.Time", time_to_gz, time_to_ros, Time),)
+PAIRS = (Pair.of(Time, "gz.msgs.Time", time_to_gz, time_to_ros),)

@@ -1,4 +1,4 @@
-"""gps_msgs/msg/GPSFix <-> gz.msgs.NavSat (conversions.md §3.6).
+"""gps_msgs/msg/GPSFix <-> gz.msgs.NavSat (docs/conversions.md §3.6).
 
 ``track`` is read and written as radians counter-clockwise from East, as the reference does,
 although the ``.msg`` documents degrees from North. Only position, speed, track and climb
@@ -13,7 +13,7 @@ from typing import Any
 from gps_msgs.msg import GPSFix, GPSStatus
 
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header, gz_to_ros_frame
+from ros_gz_bridge_py.converters.sensor_msgs_navsat import NAV_SAT_POSITION
 from ros_gz_bridge_py.msgs import message_class
 
 _GzNavSat = message_class("gz.msgs.NavSat")
@@ -21,11 +21,7 @@ _GzNavSat = message_class("gz.msgs.NavSat")
 
 def gps_fix_to_gz(ros: Any) -> Any:
     gz = _GzNavSat()
-    fill_gz_header(ros.header, gz.header)
-    gz.latitude_deg = ros.latitude
-    gz.longitude_deg = ros.longitude
-    gz.altitude = ros.altitude
-    gz.frame_id = ros.header.frame_id
+    NAV_SAT_POSITION.to_gz(ros, gz)
     gz.velocity_east = math.cos(ros.track) * ros.speed
     gz.velocity_north = math.sin(ros.track) * ros.speed
     gz.velocity_up = ros.climb
@@ -34,11 +30,7 @@ def gps_fix_to_gz(ros: Any) -> Any:
 
 def gps_fix_to_ros(gz: Any) -> Any:
     ros = GPSFix()
-    fill_ros_header(gz.header, ros.header)
-    ros.header.frame_id = gz_to_ros_frame(gz.frame_id)
-    ros.latitude = gz.latitude_deg
-    ros.longitude = gz.longitude_deg
-    ros.altitude = gz.altitude
+    NAV_SAT_POSITION.to_ros(gz, ros)
     ve, vn = gz.velocity_east, gz.velocity_north
     ros.speed = math.sqrt(ve * ve + vn * vn)
     ros.track = math.atan2(vn, ve)
@@ -48,4 +40,4 @@ def gps_fix_to_ros(gz: Any) -> Any:
     return ros
 
 
-PAIRS = (Pair("gps_msgs/msg/GPSFix", "gz.msgs.NavSat", gps_fix_to_gz, gps_fix_to_ros, GPSFix),)
+PAIRS = (Pair.of(GPSFix, "gz.msgs.NavSat", gps_fix_to_gz, gps_fix_to_ros),)

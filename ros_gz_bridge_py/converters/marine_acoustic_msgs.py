@@ -38,9 +38,9 @@ import numpy as np
 from geometry_msgs.msg import Vector3
 from marine_acoustic_msgs.msg import Dvl
 
-from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_vector3, fill_ros_vector3
+from ros_gz_bridge_py.converters.geometry_msgs import VECTOR3
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
+from ros_gz_bridge_py.converters.std_msgs import HEADER
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 
@@ -84,12 +84,12 @@ def dvl_to_gz(ros: Any) -> Any:
         msg = f"Dvl num_good_beams is {count}; the message holds at most {BEAMS} beams"
         raise ConversionError(msg)
     gz = _GzDvl()
-    fill_gz_header(ros.header, gz.header)
+    HEADER.to_gz(ros.header, gz.header)
     gz.type = _GZ_TYPE.get(ros.dvl_type, _GzDvl.DVL_TYPE_UNSPECIFIED)
     for index in range(count):
         _fill_gz_beam(ros, index, gz.beams.add())
     gz.velocity.reference = _GzEstimate.DVL_REFERENCE_SHIP
-    fill_gz_vector3(ros.velocity, gz.velocity.mean)
+    VECTOR3.to_gz(ros.velocity, gz.velocity.mean)
     gz.velocity.covariance.extend(float(value) for value in ros.velocity_covar)
     gz.target.type = _GZ_TARGET.get(ros.velocity_mode, _GzTarget.DVL_TARGET_UNSPECIFIED)
     if ros.altitude >= 0:
@@ -134,12 +134,12 @@ def _fill_ros_beams(gz_beams: Any, ros: Any) -> None:
 
 def dvl_to_ros(gz: Any) -> Any:
     ros = Dvl()
-    fill_ros_header(gz.header, ros.header)
+    HEADER.to_ros(gz.header, ros.header)
     water = gz.target.type == _GzTarget.DVL_TARGET_WATER_MASS
     ros.velocity_mode = Dvl.DVL_MODE_WATER if water else Dvl.DVL_MODE_BOTTOM
     phased = gz.type == _GzDvl.DVL_TYPE_PHASED_ARRAY
     ros.dvl_type = Dvl.DVL_TYPE_PHASED_ARRAY if phased else Dvl.DVL_TYPE_PISTON
-    fill_ros_vector3(gz.velocity.mean, ros.velocity)
+    VECTOR3.to_ros(gz.velocity.mean, ros.velocity)
     covariance = list(gz.velocity.covariance[:COVARIANCE_SIZE])
     ros.velocity_covar = covariance + [UNKNOWN] * (COVARIANCE_SIZE - len(covariance))
     ros.altitude = _altitude(gz.target)
@@ -151,6 +151,4 @@ def dvl_to_ros(gz: Any) -> Any:
     return ros
 
 
-PAIRS = (
-    Pair("marine_acoustic_msgs/msg/Dvl", "gz.msgs.DVLVelocityTracking", dvl_to_gz, dvl_to_ros, Dvl),
-)
+PAIRS = (Pair.of(Dvl, "gz.msgs.DVLVelocityTracking", dvl_to_gz, dvl_to_ros),)

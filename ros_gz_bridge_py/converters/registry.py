@@ -1,17 +1,20 @@
 """The table of ROS <-> Gazebo message pairs, built from data declared by each module.
 
-Conventions for writing converter modules: ``CONVENTIONS.md`` beside this file.
+How to add a pair or write a converter module: ``CONVENTIONS.md`` at the repository root.
 
-Each module in this package (one per ROS package) declares a module-level ``PAIRS`` tuple of
-:class:`Pair` (topics) and optionally ``SERVICES`` of :class:`ServicePair`. The registry
-imports those modules, plus any third-party module registered under the entry-point group
-``ros_gz_bridge_py.converters`` (which must expose the same ``PAIRS``/``SERVICES``), and
-indexes them by (ROS type, Gazebo type).
+A converter module declares a module-level ``PAIRS`` tuple of :class:`Pair` (topics) and
+optionally ``SERVICES`` of :class:`ServicePair`. The registry imports every module of this
+package (see :func:`modules_of`; those that declare neither are helpers and add nothing),
+then every module registered under the entry-point group ``ros_gz_bridge_py.converters``, and
+indexes their pairs by (ROS type, Gazebo type).
 
 Gazebo type names are accepted as ``gz.msgs.X`` or ``ignition.msgs.X``. An exact registration
 wins (``ignition.msgs.IMU`` has its own, Fortress wire layout); otherwise the name is
-normalised to ``gz.msgs.X``. The default ROS type for a bare Gazebo type, and the default
-Gazebo type for a ROS type, is the first pair declared for it (declaration order is deliberate).
+normalised to ``gz.msgs.X``. The default Gazebo type for a ROS type is the first pair declared
+for it (all of them are in its package's module). The default ROS type for a Gazebo type is the
+first pair declared for it too, unless one is marked ``default_for_gz_type``: where modules of
+this package pair one Gazebo type with ROS types of different packages, the default is marked,
+so that it does not depend on the order modules are read in (by name, then plugins).
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ from __future__ import annotations
 import dataclasses
 import functools
 import importlib
+import itertools
+import pkgutil
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from importlib.metadata import entry_points
@@ -32,24 +37,7 @@ if TYPE_CHECKING:
     from ros_gz_bridge_py.bulk.path import BulkPath
 
 ENTRY_POINT_GROUP = "ros_gz_bridge_py.converters"
-
-#: Modules of this package that declare pairs, in listing order.
-BUILTIN_MODULES: tuple[str, ...] = (
-    "builtin_interfaces",
-    "std_msgs",
-    "geometry_msgs",
-    "nav_msgs",
-    "rosgraph_msgs",
-    "sensor_msgs",
-    "tf2_msgs",
-    "trajectory_msgs",
-    "actuator_msgs",
-    "gps_msgs",
-    "vision_msgs",
-    "marine_acoustic_msgs",
-    "rcl_interfaces",
-    "ros_gz_interfaces",
-)
+_PACKAGE = __name__.rpartition(".")[0]
 
 
 @dataclass(frozen=True)
@@ -70,6 +58,31 @@ class Pair:
     origin: str = field(default="", compare=False)
     #: For large messages: how channels convert them without copying the bulk bytes around.
     bulk: BulkPath | None = field(default=None, compare=False)
+    #: This pair's ROS type is the default for its Gazebo type, which other modules pair too.
+    default_for_gz_type: bool = field(default=False, compare=False)
+
+    @classmethod
+    def of(
+        cls,
+        ros_class: type[Any],
+        gz_type: str,
+        to_gz: Callable[[Any], Any],
+        to_ros: Callable[[Any], Any],
+        *,
+        bulk: BulkPath | None = None,
+        default_for_gz_type: bool = False,
+    ) -> Pair:
+        """The pair for ``ros_class``, whose ROS type name (``pkg/msg/Name``) it bears."""
+        ros_type = f"{_package_of(ros_class)}/msg/{ros_class.__name__}"
+        return cls(
+            ros_type,
+            gz_type,
+            to_gz,
+            to_ros,
+            ros_class,
+            bulk=bulk,
+            default_for_gz_type=default_for_gz_type,
+        )
 
 
 @dataclass(frozen=True)
@@ -165,11 +178,13 @@ class Registry:
         return [p.gz_type for p in self.pairs if p.ros_type == ros_type]
 
     def ros_types_for(self, gz_type: str) -> list[str]:
-        exact = [p.ros_type for p in self.pairs if p.gz_type == gz_type]
-        if exact:
-            return exact
-        canonical = canonical_type(gz_type)
-        return [p.ros_type for p in self.pairs if p.gz_type == canonical]
+        """The ROS types paired with ``gz_type``, its default first."""
+        pairs = [p for p in self.pairs if p.gz_type == gz_type]
+        if not pairs:
+            canonical = canonical_type(gz_type)
+            pairs = [p for p in self.pairs if p.gz_type == canonical]
+        pairs.sort(key=lambda pair: not pair.default_for_gz_type)
+        return [p.ros_type for p in pairs]
 
     def _explain_missing(self, ros_type: str, gz_type: str) -> str:
         text = f"no converter for ROS type [{ros_type}] and Gazebo type [{gz_type}]"
@@ -190,6 +205,11 @@ class Registry:
         return f"{text}; run `bridge_types --print-pairs` to list the supported pairs"
 
 
+def _package_of(ros_class: type[Any]) -> str:
+    """``std_msgs`` for ``std_msgs.msg.Bool`` (whose module is ``std_msgs.msg._bool``)."""
+    return ros_class.__module__.split(".", 1)[0]
+
+
 def _with_origin(item: Any, origin: str) -> Any:
     if not isinstance(item, Pair | ServicePair):
         msg = f"{origin}: expected Pair or ServicePair, got {type(item).__name__}"
@@ -197,9 +217,23 @@ def _with_origin(item: Any, origin: str) -> Any:
     return item if item.origin else dataclasses.replace(item, origin=origin)
 
 
-def _iter_modules() -> Iterator[tuple[str, Callable[[], ModuleType]]]:
-    for name in BUILTIN_MODULES:
-        yield name, functools.partial(importlib.import_module, f"{__package__}.{name}")
+def modules_of(package: str) -> list[tuple[str, Callable[[], ModuleType]]]:
+    """The public modules of ``package``, by name, each with the call that imports it.
+
+    Which of them are converter modules is known once imported: those that declare ``PAIRS``
+    or ``SERVICES``; the others (helpers, this registry) add nothing.
+    """
+    names = sorted(
+        info.name
+        for info in pkgutil.iter_modules(importlib.import_module(package).__path__)
+        if not info.name.startswith("_")
+    )
+    return [
+        (name, functools.partial(importlib.import_module, f"{package}.{name}")) for name in names
+    ]
+
+
+def _plugin_modules() -> Iterator[tuple[str, Callable[[], ModuleType]]]:
     for ep in entry_points(group=ENTRY_POINT_GROUP):
         yield ep.name, ep.load
 
@@ -207,13 +241,15 @@ def _iter_modules() -> Iterator[tuple[str, Callable[[], ModuleType]]]:
 def build_registry(
     modules: Iterable[tuple[str, Callable[[], ModuleType]]] | None = None,
 ) -> Registry:
-    """Import every converter module and index its pairs.
+    """Import ``modules`` (by default this package's, then the plugins) and index their pairs.
 
     A module that fails to import (its ROS interface package is not installed) is recorded in
     :attr:`Registry.unavailable` instead of failing the whole registry.
     """
+    if modules is None:
+        modules = itertools.chain(modules_of(_PACKAGE), _plugin_modules())
     registry = Registry()
-    for name, load in modules if modules is not None else _iter_modules():
+    for name, load in modules:
         try:
             module = load()
         except ImportError as err:

@@ -1,4 +1,4 @@
-"""ros_gz_interfaces: the message pairs (conversions.md §3.13) and the four bridged services.
+"""ros_gz_interfaces: the message pairs (docs/conversions.md §3.13) and the four bridged services.
 
 The message conversions are in ``ros_gz_interfaces_messages``, AirSpeed and LogicalCameraImage
 in ``ros_gz_interfaces_sensors``. The services (§3.14, plus the
@@ -44,8 +44,9 @@ from ros_gz_interfaces.srv import ControlWorld, DeleteEntity, SetEntityPose, Spa
 
 from ros_gz_bridge_py.converters import ros_gz_interfaces_messages as m
 from ros_gz_bridge_py.converters import ros_gz_interfaces_sensors as sensors
-from ros_gz_bridge_py.converters.builtin_interfaces import fill_gz_time
-from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_pose
+from ros_gz_bridge_py.converters._fields import fields
+from ros_gz_bridge_py.converters.builtin_interfaces import PRESENT_TIME
+from ros_gz_bridge_py.converters.geometry_msgs import POSE
 from ros_gz_bridge_py.converters.registry import Pair, ServicePair
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
@@ -58,42 +59,40 @@ _GzPose = message_class("gz.msgs.Pose")
 _UINT32_MAX = (1 << 32) - 1
 
 
-def _pair(ros_class: type[Any], gz_type: str, to_gz: Any, to_ros: Any) -> Pair:
-    return Pair(f"ros_gz_interfaces/msg/{ros_class.__name__}", gz_type, to_gz, to_ros, ros_class)
-
-
 PAIRS = (
-    _pair(AirSpeed, "gz.msgs.AirSpeed", sensors.air_speed_to_gz, sensors.air_speed_to_ros),
-    _pair(Altimeter, "gz.msgs.Altimeter", m.altimeter_to_gz, m.altimeter_to_ros),
-    _pair(Contact, "gz.msgs.Contact", m.contact_to_gz, m.contact_to_ros),
-    _pair(Contacts, "gz.msgs.Contacts", m.contacts_to_gz, m.contacts_to_ros),
-    _pair(Dataframe, "gz.msgs.Dataframe", m.dataframe_to_gz, m.dataframe_to_ros),
-    _pair(Entity, "gz.msgs.Entity", m.entity_to_gz, m.entity_to_ros),
-    _pair(EntityWrench, "gz.msgs.EntityWrench", m.entity_wrench_to_gz, m.entity_wrench_to_ros),
-    _pair(Float32Array, "gz.msgs.Float_V", m.float32_array_to_gz, m.float32_array_to_ros),
-    _pair(GuiCamera, "gz.msgs.GUICamera", m.gui_camera_to_gz, m.gui_camera_to_ros),
-    _pair(JointWrench, "gz.msgs.JointWrench", m.joint_wrench_to_gz, m.joint_wrench_to_ros),
-    _pair(Light, "gz.msgs.Light", m.light_to_gz, m.light_to_ros),
-    _pair(
+    Pair.of(AirSpeed, "gz.msgs.AirSpeed", sensors.air_speed_to_gz, sensors.air_speed_to_ros),
+    Pair.of(Altimeter, "gz.msgs.Altimeter", m.altimeter_to_gz, m.altimeter_to_ros),
+    Pair.of(Contact, "gz.msgs.Contact", m.contact_to_gz, m.contact_to_ros),
+    Pair.of(Contacts, "gz.msgs.Contacts", m.contacts_to_gz, m.contacts_to_ros),
+    Pair.of(Dataframe, "gz.msgs.Dataframe", m.dataframe_to_gz, m.dataframe_to_ros),
+    Pair.of(Entity, "gz.msgs.Entity", m.entity_to_gz, m.entity_to_ros),
+    Pair.of(EntityWrench, "gz.msgs.EntityWrench", m.entity_wrench_to_gz, m.entity_wrench_to_ros),
+    Pair.of(Float32Array, "gz.msgs.Float_V", m.float32_array_to_gz, m.float32_array_to_ros),
+    Pair.of(GuiCamera, "gz.msgs.GUICamera", m.gui_camera_to_gz, m.gui_camera_to_ros),
+    Pair.of(JointWrench, "gz.msgs.JointWrench", m.joint_wrench_to_gz, m.joint_wrench_to_ros),
+    Pair.of(Light, "gz.msgs.Light", m.light_to_gz, m.light_to_ros),
+    Pair.of(
         LogicalCameraImage,
         "gz.msgs.LogicalCameraImage",
         sensors.logical_camera_image_to_gz,
         sensors.logical_camera_image_to_ros,
     ),
-    _pair(
+    Pair.of(
         LogPlaybackStatistics,
         "gz.msgs.LogPlaybackStatistics",
         m.log_playback_statistics_to_gz,
         m.log_playback_statistics_to_ros,
     ),
-    _pair(MaterialColor, "gz.msgs.MaterialColor", m.material_color_to_gz, m.material_color_to_ros),
-    _pair(ParamVec, "gz.msgs.Param", m.param_vec_to_gz_param, m.param_vec_from_gz_param),
-    _pair(ParamVec, "gz.msgs.Param_V", m.param_vec_to_gz_param_v, m.param_vec_from_gz_param_v),
-    _pair(SensorNoise, "gz.msgs.SensorNoise", m.sensor_noise_to_gz, m.sensor_noise_to_ros),
-    _pair(StringVec, "gz.msgs.StringMsg_V", m.string_vec_to_gz, m.string_vec_to_ros),
-    _pair(TrackVisual, "gz.msgs.TrackVisual", m.track_visual_to_gz, m.track_visual_to_ros),
-    _pair(VideoRecord, "gz.msgs.VideoRecord", m.video_record_to_gz, m.video_record_to_ros),
-    _pair(
+    Pair.of(
+        MaterialColor, "gz.msgs.MaterialColor", m.material_color_to_gz, m.material_color_to_ros
+    ),
+    Pair.of(ParamVec, "gz.msgs.Param", m.param_vec_to_gz_param, m.param_vec_from_gz_param),
+    Pair.of(ParamVec, "gz.msgs.Param_V", m.param_vec_to_gz_param_v, m.param_vec_from_gz_param_v),
+    Pair.of(SensorNoise, "gz.msgs.SensorNoise", m.sensor_noise_to_gz, m.sensor_noise_to_ros),
+    Pair.of(StringVec, "gz.msgs.StringMsg_V", m.string_vec_to_gz, m.string_vec_to_ros),
+    Pair.of(TrackVisual, "gz.msgs.TrackVisual", m.track_visual_to_gz, m.track_visual_to_ros),
+    Pair.of(VideoRecord, "gz.msgs.VideoRecord", m.video_record_to_gz, m.video_record_to_ros),
+    Pair.of(
         WorldStatistics,
         "gz.msgs.WorldStatistics",
         m.world_statistics_to_gz,
@@ -105,26 +104,27 @@ PAIRS = (
 # --- Service requests -----------------------------------------------------------------------
 
 
+#: WorldControl; ``reset`` and ``run_to_sim_time`` are always present, no header.
+_WORLD_CONTROL = fields(
+    "pause",
+    "step",
+    "multi_step",
+    ("reset", fields("all", "time_only", "model_only")),
+    "seed",
+    ("run_to_sim_time", PRESENT_TIME),
+)
+
+
 def control_world_request_to_gz(request: Any) -> Any:
-    """WorldControl; ``reset`` and ``run_to_sim_time`` are always present, no header."""
-    ros = request.world_control
     gz = _GzWorldControl()
-    gz.pause = ros.pause
-    gz.step = ros.step
-    gz.multi_step = ros.multi_step
     gz.reset.SetInParent()
-    gz.reset.all = ros.reset.all
-    gz.reset.time_only = ros.reset.time_only
-    gz.reset.model_only = ros.reset.model_only
-    gz.seed = ros.seed
-    gz.run_to_sim_time.SetInParent()
-    fill_gz_time(ros.run_to_sim_time, gz.run_to_sim_time)
+    _WORLD_CONTROL.to_gz(request.world_control, gz)
     return gz
 
 
 def delete_entity_request_to_gz(request: Any) -> Any:
     gz = _GzEntity()
-    m.fill_gz_entity(request.entity, gz)
+    m.ENTITY.to_gz(request.entity, gz)
     return gz
 
 
@@ -147,7 +147,7 @@ def spawn_entity_request_to_gz(request: Any) -> Any:
             "all three are empty"
         )
         raise ConversionError(msg)
-    fill_gz_pose(ros.pose, gz.pose)
+    POSE.to_gz(ros.pose, gz.pose)
     return gz
 
 
@@ -160,7 +160,7 @@ def set_entity_pose_request_to_gz(request: Any) -> Any:
     gz = _GzPose()
     gz.id = entity.id
     gz.name = entity.name
-    fill_gz_pose(request.pose, gz)
+    POSE.to_gz(request.pose, gz)
     return gz
 
 

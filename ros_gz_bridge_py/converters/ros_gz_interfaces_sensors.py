@@ -7,70 +7,30 @@ states the mapping: header, diff_pressure, temperature).
 ``gz.msgs.AirSpeed`` exists from Harmonic (gz-msgs 10) on; ``LogicalCameraImage`` also in
 Fortress, under ``ignition.msgs.LogicalCameraImage`` with the same fields.
 
-Differences from ros_gz_bridge: none known. As for every pose (conversions.md §1.4), a gz
+Differences from ros_gz_bridge: none known. As for every pose (docs/conversions.md §1.4), a gz
 orientation that is absent reads as the quaternion (0, 0, 0, 0), not the identity.
 """
 
 from __future__ import annotations
 
-from typing import Any
-
 from ros_gz_interfaces.msg import AirSpeed, LogicalCameraImage, LogicalCameraImageModel
 
-from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_pose, fill_ros_pose
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
-from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.converters._fields import converters, each, fields
+from ros_gz_bridge_py.converters.geometry_msgs import POSE
+from ros_gz_bridge_py.converters.std_msgs import HEADER
 
-_GzAirSpeed = message_class("gz.msgs.AirSpeed")
-_GzLogicalCameraImage = message_class("gz.msgs.LogicalCameraImage")
+air_speed_to_gz, air_speed_to_ros = converters(
+    fields(("header", HEADER), "diff_pressure", "temperature"), AirSpeed, "gz.msgs.AirSpeed"
+)
 
-
-# --- AirSpeed -------------------------------------------------------------------------------
-
-
-def air_speed_to_gz(ros: Any) -> Any:
-    gz = _GzAirSpeed()
-    fill_gz_header(ros.header, gz.header)
-    gz.diff_pressure = ros.diff_pressure
-    gz.temperature = ros.temperature
-    return gz
-
-
-def air_speed_to_ros(gz: Any) -> Any:
-    ros = AirSpeed()
-    fill_ros_header(gz.header, ros.header)
-    ros.diff_pressure = gz.diff_pressure
-    ros.temperature = gz.temperature
-    return ros
-
-
-# --- LogicalCameraImage ---------------------------------------------------------------------
-
-
-def logical_camera_image_to_gz(ros: Any) -> Any:
-    """Header, the camera pose and one gz ``model`` per ROS model, in order.
-
-    Every pose has its position and orientation present; gz pose header, name and id stay unset.
-    """
-    gz = _GzLogicalCameraImage()
-    fill_gz_header(ros.header, gz.header)
-    fill_gz_pose(ros.pose, gz.pose)
-    for model in ros.model:
-        gz_model = gz.model.add()
-        gz_model.name = model.name
-        fill_gz_pose(model.pose, gz_model.pose)
-    return gz
-
-
-def _ros_model(gz_model: Any) -> Any:
-    model = LogicalCameraImageModel(name=gz_model.name)
-    fill_ros_pose(gz_model.pose, model.pose)
-    return model
-
-
-def logical_camera_image_to_ros(gz: Any) -> Any:
-    ros = LogicalCameraImage()
-    fill_ros_header(gz.header, ros.header)
-    fill_ros_pose(gz.pose, ros.pose)
-    ros.model = [_ros_model(gz_model) for gz_model in gz.model]
-    return ros
+#: Header, the camera pose and one gz ``model`` per ROS model, in order. Every pose has its
+#: position and orientation present; gz pose header, name and id stay unset.
+logical_camera_image_to_gz, logical_camera_image_to_ros = converters(
+    fields(
+        ("header", HEADER),
+        ("pose", POSE),
+        ("model", each(fields("name", ("pose", POSE)), LogicalCameraImageModel)),
+    ),
+    LogicalCameraImage,
+    "gz.msgs.LogicalCameraImage",
+)

@@ -1,4 +1,4 @@
-"""rosgraph_msgs/msg/Clock <-> gz.msgs.Clock (conversions.md §3.8). Only ``sim`` is used.
+"""rosgraph_msgs/msg/Clock <-> gz.msgs.Clock (docs/conversions.md §3.8). Only ``sim`` is used.
 
 G→R normalises like ``rclcpp::Time``: nanoseconds of 10^9 or more carry into seconds.
 
@@ -13,7 +13,11 @@ from typing import Any
 
 from rosgraph_msgs.msg import Clock
 
-from ros_gz_bridge_py.converters.builtin_interfaces import fill_gz_time, to_int32, to_uint32
+from ros_gz_bridge_py.converters.builtin_interfaces import (
+    fill_gz_present_time,
+    to_int32,
+    to_uint32,
+)
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
@@ -25,8 +29,7 @@ _NS_PER_S = 10**9
 
 def clock_to_gz(ros: Any) -> Any:
     gz = GzClock()
-    gz.sim.SetInParent()
-    fill_gz_time(ros.clock, gz.sim)
+    fill_gz_present_time(ros.clock, gz.sim)
     return gz
 
 
@@ -42,4 +45,4 @@ def clock_to_ros(gz: Any) -> Any:
     return ros
 
 
-PAIRS = (Pair("rosgraph_msgs/msg/Clock", "gz.msgs.Clock", clock_to_gz, clock_to_ros, Clock),)
+PAIRS = (Pair.of(Clock, "gz.msgs.Clock", clock_to_gz, clock_to_ros),)

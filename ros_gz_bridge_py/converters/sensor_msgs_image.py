@@ -1,4 +1,4 @@
-"""sensor_msgs Image and CameraInfo converters (conversions.md §3.5); paired in sensor_msgs.py.
+"""sensor_msgs Image and CameraInfo converters (docs/conversions.md §3.5); paired in sensor_msgs.py.
 
 Image data is copied once, as ``bytes``; on the bulk path (``IMAGE_BULK``) the channel converts
 only the other fields with the ``*_meta_*`` halves and copies the data once into the output.
@@ -29,7 +29,8 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath, Rows, Take, taken
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
+from ros_gz_bridge_py.converters._fields import fields
+from ros_gz_bridge_py.converters.std_msgs import HEADER
 from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError
 from ros_gz_bridge_py.msgs import message_class
 
@@ -57,6 +58,9 @@ PIXEL_FORMATS: dict[int, tuple[str, int]] = {
 DISTORTION_MODELS: dict[str, int] = {"plumb_bob": 0, "rational_polynomial": 1, "equidistant": 2}
 _DISTORTION_NAMES = {value: name for name, value in DISTORTION_MODELS.items()}
 
+
+#: What Image and CameraInfo both carry alike, on both sides.
+_IMAGE_SIZE = fields(("header", HEADER), "height", "width")
 
 #: The largest value of a uint32 field (``step`` on both sides).
 UINT32_MAX = 2**32 - 1
@@ -94,9 +98,7 @@ def image_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, Take]:
         )
         raise SizeMismatchError(msg)
     gz = GzImage()
-    fill_gz_header(ros.header, gz.header)
-    gz.width = width
-    gz.height = height
+    _IMAGE_SIZE.to_gz(ros, gz)
     gz.pixel_format_type = pixel_format
     gz.step = row
     return gz, (height * row if step == row or height <= 1 else Rows(height, row, step))
@@ -139,9 +141,7 @@ def image_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
         )
         raise SizeMismatchError(msg)
     ros = Image()
-    fill_ros_header(gz.header, ros.header)
-    ros.height = height
-    ros.width = width
+    _IMAGE_SIZE.to_ros(gz, ros)
     ros.encoding = encoding
     ros.is_bigendian = 0
     ros.step = step
@@ -167,9 +167,7 @@ IMAGE_BULK = BulkPath(
 def camera_info_to_gz(ros: Any) -> Any:
     """An unknown distortion model leaves gz ``model`` at 0 (PLUMB_BOB), as in C++."""
     gz = GzCameraInfo()
-    fill_gz_header(ros.header, gz.header)
-    gz.width = ros.width
-    gz.height = ros.height
+    _IMAGE_SIZE.to_gz(ros, gz)
     gz.distortion.SetInParent()
     gz.distortion.model = DISTORTION_MODELS.get(ros.distortion_model, 0)
     gz.distortion.k.extend(ros.d)
@@ -190,9 +188,7 @@ def _fixed(values: Any, size: int) -> list[float]:
 def camera_info_to_ros(gz: Any) -> Any:
     """An unknown gz distortion model leaves ``distortion_model`` empty, as in C++."""
     ros = CameraInfo()
-    fill_ros_header(gz.header, ros.header)
-    ros.height = gz.height
-    ros.width = gz.width
+    _IMAGE_SIZE.to_ros(gz, ros)
     if gz.HasField("distortion"):
         ros.distortion_model = _DISTORTION_NAMES.get(gz.distortion.model, "")
         ros.d = list(gz.distortion.k)

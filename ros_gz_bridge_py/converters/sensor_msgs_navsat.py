@@ -1,6 +1,6 @@
 """sensor_msgs/msg/NavSatFix <-> gz.msgs.NavSatWithCovariance (Jetty, gz-msgs 12).
 
-ros_gz_bridge has no such pair; this one extends its NavSat conversion (conversions.md §3.5,
+ros_gz_bridge has no such pair; this one extends its NavSat conversion (docs/conversions.md §3.5,
 ``sensor_msgs.py``) with the position covariance that NavSatFix can carry:
 
 - Position, header and frame_id as for ``gz.msgs.NavSat``: G→R takes ``header.frame_id`` from
@@ -24,8 +24,9 @@ from typing import Any
 
 from sensor_msgs.msg import NavSatFix, NavSatStatus
 
+from ros_gz_bridge_py.converters._fields import Value, fields, same
 from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_covariance
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header, gz_to_ros_frame
+from ros_gz_bridge_py.converters.std_msgs import HEADER, gz_to_ros_frame
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 
@@ -34,6 +35,25 @@ _GzNavSatWithCovariance = message_class("gz.msgs.NavSatWithCovariance")
 COVARIANCE_SIZE = 9
 #: COVARIANCE_TYPE_UNKNOWN .. COVARIANCE_TYPE_KNOWN, numbered alike on both sides.
 _COVARIANCE_TYPES = range(4)
+
+#: What every gz NavSat pair (NavSatFix, GPSFix; NavSat, NavSatWithCovariance) carries alike:
+#: header and position; R→G sends the ROS frame_id in both places, G→R takes it from gz
+#: ``frame_id`` (``::`` -> ``/``), whatever the header says.
+NAV_SAT_POSITION = fields(
+    ("header", HEADER),
+    ("header.frame_id", "frame_id", Value(same, gz_to_ros_frame)),
+    ("latitude", "latitude_deg"),
+    ("longitude", "longitude_deg"),
+    "altitude",
+)
+
+
+def new_nav_sat_fix() -> Any:
+    """A NavSatFix with what no gz NavSat says: STATUS_FIX, and an unknown covariance."""
+    return NavSatFix(
+        status=NavSatStatus(status=NavSatStatus.STATUS_FIX),
+        position_covariance_type=NavSatFix.COVARIANCE_TYPE_UNKNOWN,
+    )
 
 
 def _checked_type(value: int, where: str) -> int:
@@ -45,13 +65,9 @@ def _checked_type(value: int, where: str) -> int:
 
 def nav_sat_fix_to_gz_nav_sat_with_covariance(ros: Any) -> Any:
     gz = _GzNavSatWithCovariance()
-    fill_gz_header(ros.header, gz.header)
-    gz.latitude_deg = ros.latitude
-    gz.longitude_deg = ros.longitude
-    gz.altitude = ros.altitude
+    NAV_SAT_POSITION.to_gz(ros, gz)
     fill_gz_covariance(ros.position_covariance, gz.position_covariance)
     gz.position_covariance_type = _checked_type(ros.position_covariance_type, "NavSatFix")
-    gz.frame_id = ros.header.frame_id
     return gz
 
 
@@ -64,16 +80,9 @@ def nav_sat_fix_from_gz_nav_sat_with_covariance(gz: Any) -> Any:
             f"NavSatFix takes {COVARIANCE_SIZE} (or none)"
         )
         raise ConversionError(msg)
-    ros = NavSatFix()
-    fill_ros_header(gz.header, ros.header)
-    ros.header.frame_id = gz_to_ros_frame(gz.frame_id)
-    ros.latitude = gz.latitude_deg
-    ros.longitude = gz.longitude_deg
-    ros.altitude = gz.altitude
+    ros = new_nav_sat_fix()
+    NAV_SAT_POSITION.to_ros(gz, ros)
     if covariance:
         ros.position_covariance = covariance
         ros.position_covariance_type = kind
-    else:
-        ros.position_covariance_type = NavSatFix.COVARIANCE_TYPE_UNKNOWN
-    ros.status.status = NavSatStatus.STATUS_FIX
     return ros

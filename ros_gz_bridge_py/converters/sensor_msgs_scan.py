@@ -1,4 +1,4 @@
-"""sensor_msgs LaserScan, Range and PointCloud2 converters (conversions.md §3.5).
+"""sensor_msgs LaserScan, Range and PointCloud2 converters (docs/conversions.md §3.5).
 
 Paired in sensor_msgs.py. ``sensor_msgs/msg/Range`` <-> ``gz.msgs.LaserScan`` follows
 ros_gz PR #736 in spirit (a narrow Gazebo lidar used as a range finder); its upstream source
@@ -34,7 +34,8 @@ from sensor_msgs.msg import LaserScan, PointCloud2, PointField, Range
 
 from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header, gz_to_ros_frame
+from ros_gz_bridge_py.converters._fields import Value, fields, same
+from ros_gz_bridge_py.converters.std_msgs import HEADER, gz_to_ros_frame
 from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError
 from ros_gz_bridge_py.msgs import message_class
 
@@ -81,37 +82,34 @@ def _first(values: Any, count: int) -> Any:
     return head
 
 
+#: Header; R→G the frame_id also goes to gz ``frame``, G→R it always comes from there.
+_SCAN_HEADER = fields(
+    ("header", HEADER), ("header.frame_id", "frame", Value(same, gz_to_ros_frame))
+)
+_LASER_SCAN = fields(
+    _SCAN_HEADER,
+    "angle_min",
+    "angle_max",
+    ("angle_increment", "angle_step"),
+    "range_min",
+    "range_max",
+)
+
+
 def laser_scan_to_gz(ros: Any) -> Any:
     count = scan_count(ros.angle_min, ros.angle_max, ros.angle_increment)
     gz = GzLaserScan()
-    fill_gz_header(ros.header, gz.header)
-    gz.frame = ros.header.frame_id
-    gz.angle_min = ros.angle_min
-    gz.angle_max = ros.angle_max
-    gz.angle_step = ros.angle_increment
-    gz.range_min = ros.range_min
-    gz.range_max = ros.range_max
+    _LASER_SCAN.to_gz(ros, gz)
     gz.count = count
     gz.ranges.extend(_first(ros.ranges, count))
     gz.intensities.extend(_first(ros.intensities, count))
     return gz
 
 
-def _fill_ros_scan_header(gz: Any, ros: Any) -> None:
-    """Header from gz ``header``, then frame_id always overwritten from gz ``frame``."""
-    fill_ros_header(gz.header, ros.header)
-    ros.header.frame_id = gz_to_ros_frame(gz.frame)
-
-
 def laser_scan_to_ros(gz: Any) -> Any:
     """Only the middle row of a multi-row scan reaches ROS: row ``vertical_count // 2``."""
     ros = LaserScan()
-    _fill_ros_scan_header(gz, ros)
-    ros.angle_min = gz.angle_min
-    ros.angle_max = gz.angle_max
-    ros.angle_increment = gz.angle_step
-    ros.range_min = gz.range_min
-    ros.range_max = gz.range_max
+    _LASER_SCAN.to_ros(gz, ros)
     count = gz.count
     start = (gz.vertical_count // 2) * count
     ros.ranges = array("f", _first(gz.ranges[start : start + count], count))
@@ -121,8 +119,7 @@ def laser_scan_to_ros(gz: Any) -> Any:
 
 def range_to_gz(ros: Any) -> Any:
     gz = GzLaserScan()
-    fill_gz_header(ros.header, gz.header)
-    gz.frame = ros.header.frame_id
+    _SCAN_HEADER.to_gz(ros, gz)
     half = float(ros.field_of_view) / 2.0
     gz.angle_min = -half
     gz.angle_max = half
@@ -139,7 +136,7 @@ def range_to_ros(gz: Any) -> Any:
         msg = "gz.msgs.LaserScan has no ranges: cannot make a sensor_msgs/msg/Range"
         raise ConversionError(msg)
     ros = Range()
-    _fill_ros_scan_header(gz, ros)
+    _SCAN_HEADER.to_ros(gz, ros)
     ros.field_of_view = gz.angle_max - gz.angle_min
     ros.min_range = gz.range_min
     ros.max_range = gz.range_max
@@ -202,6 +199,23 @@ def check_cloud_sizes(type_name: str, fields_name: str, sizes: CloudSizes, data_
         raise SizeMismatchError(msg)
 
 
+def _checked_fields(
+    type_name: str, fields_name: str, cloud: Any, int8: int, data_size: int
+) -> list[tuple[str, int, int, int]]:
+    """(name, offset, count, datatype) of each point field of ``cloud`` (in its field
+    ``fields_name``), once :func:`check_cloud_sizes` has found that the sizes describe the data."""
+    described = [(f.name, f.offset, f.count, f.datatype) for f in getattr(cloud, fields_name)]
+    sizes = CloudSizes(cloud.height, cloud.width, cloud.point_step, cloud.row_step, described, int8)
+    check_cloud_sizes(type_name, fields_name, sizes, data_size)
+    return described
+
+
+#: Every field of a point cloud but ``fields`` and ``data``; the names are the same both sides.
+_CLOUD = fields(
+    ("header", HEADER), "height", "width", "is_bigendian", "point_step", "row_step", "is_dense"
+)
+
+
 def point_cloud2_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
     """Every field but ``data`` (all of which is taken). An unknown ROS datatype becomes gz
     INT8, silently, as in C++.
@@ -209,18 +223,12 @@ def point_cloud2_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, int]:
     Raises:
         ConversionError: the sizes do not describe the data (:func:`check_cloud_sizes`).
     """
-    fields = [(f.name, f.offset, f.count, f.datatype) for f in ros.fields]
-    sizes = CloudSizes(ros.height, ros.width, ros.point_step, ros.row_step, fields, _ROS_INT8)
-    check_cloud_sizes("sensor_msgs/msg/PointCloud2", "fields", sizes, data_size)
+    point_fields = _checked_fields(
+        "sensor_msgs/msg/PointCloud2", "fields", ros, _ROS_INT8, data_size
+    )
     gz = GzPointCloudPacked()
-    fill_gz_header(ros.header, gz.header)
-    gz.height = ros.height
-    gz.width = ros.width
-    gz.is_bigendian = ros.is_bigendian
-    gz.point_step = ros.point_step
-    gz.row_step = ros.row_step
-    gz.is_dense = ros.is_dense
-    for name, offset, count, datatype in fields:
+    _CLOUD.to_gz(ros, gz)
+    for name, offset, count, datatype in point_fields:
         gz.field.add(
             name=name,
             offset=offset,
@@ -244,20 +252,12 @@ def point_cloud2_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
     Raises:
         ConversionError: the sizes do not describe the data (:func:`check_cloud_sizes`).
     """
-    fields = [(f.name, f.offset, f.count, f.datatype) for f in gz.field]
-    sizes = CloudSizes(gz.height, gz.width, gz.point_step, gz.row_step, fields, _GZ_INT8)
-    check_cloud_sizes("gz.msgs.PointCloudPacked", "field", sizes, data_size)
+    point_fields = _checked_fields("gz.msgs.PointCloudPacked", "field", gz, _GZ_INT8, data_size)
     ros = PointCloud2()
-    fill_ros_header(gz.header, ros.header)
-    ros.height = gz.height
-    ros.width = gz.width
-    ros.is_bigendian = gz.is_bigendian
-    ros.point_step = gz.point_step
-    ros.row_step = gz.row_step
-    ros.is_dense = gz.is_dense
+    _CLOUD.to_ros(gz, ros)
     ros.fields = [
         PointField(name=name, offset=offset, count=count, datatype=_ros_datatype(datatype))
-        for name, offset, count, datatype in fields
+        for name, offset, count, datatype in point_fields
     ]
     return ros, data_size
 

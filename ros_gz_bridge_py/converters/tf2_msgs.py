@@ -1,4 +1,4 @@
-"""tf2_msgs/msg/TFMessage <-> gz.msgs.Pose_V (conversions.md §3.7).
+"""tf2_msgs/msg/TFMessage <-> gz.msgs.Pose_V (docs/conversions.md §3.7).
 
 Each transform is one gz Pose carrying its own header (``frame_id`` and ``child_frame_id``).
 R→G also writes the first transform's header (stamp and ``frame_id``) as the Pose_V header;
@@ -12,38 +12,20 @@ from typing import Any
 from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
 
-from ros_gz_bridge_py.converters.geometry_msgs import (
-    fill_gz_transform_stamped,
-    fill_ros_transform_stamped,
-)
+from ros_gz_bridge_py.converters._fields import converters, each, fields
+from ros_gz_bridge_py.converters.geometry_msgs import TRANSFORM_STAMPED
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header
-from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.converters.std_msgs import HEADER
 
-GzPoseV = message_class("gz.msgs.Pose_V")
+_TRANSFORMS = fields(("transforms", "pose", each(TRANSFORM_STAMPED, TransformStamped)))
+_transforms_to_gz, tf_message_to_ros = converters(_TRANSFORMS, TFMessage, "gz.msgs.Pose_V")
 
 
 def tf_message_to_gz(ros: Any) -> Any:
-    gz = GzPoseV()
-    transforms = ros.transforms
-    if transforms:
-        fill_gz_header(transforms[0].header, gz.header)
-    for transform in transforms:
-        fill_gz_transform_stamped(transform, gz.pose.add())
+    gz = _transforms_to_gz(ros)
+    if ros.transforms:
+        HEADER.to_gz(ros.transforms[0].header, gz.header)
     return gz
 
 
-def tf_message_to_ros(gz: Any) -> Any:
-    transforms = []
-    for pose in gz.pose:
-        transform = TransformStamped()
-        fill_ros_transform_stamped(pose, transform)
-        transforms.append(transform)
-    return TFMessage(transforms=transforms)
-
-
-PAIRS = (
-    Pair(
-        "tf2_msgs/msg/TFMessage", "gz.msgs.Pose_V", tf_message_to_gz, tf_message_to_ros, TFMessage
-    ),
-)
+PAIRS = (Pair.of(TFMessage, "gz.msgs.Pose_V", tf_message_to_gz, tf_message_to_ros),)

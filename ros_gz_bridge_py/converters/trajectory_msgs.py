@@ -1,4 +1,4 @@
-"""trajectory_msgs/msg/JointTrajectory <-> gz.msgs.JointTrajectory (conversions.md §3.9).
+"""trajectory_msgs/msg/JointTrajectory <-> gz.msgs.JointTrajectory (docs/conversions.md §3.9).
 
 The point lists are copied whole (no per-element Python loop). ``time_from_start`` is copied
 verbatim in R→G and normalised like ``rclcpp::Duration`` in G→R, saturating at the int32 ends.
@@ -6,17 +6,14 @@ verbatim in R→G and normalised like ``rclcpp::Duration`` in G→R, saturating 
 
 from __future__ import annotations
 
-from array import array
 from typing import Any
 
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from ros_gz_bridge_py.converters.builtin_interfaces import to_int32, to_uint32
+from ros_gz_bridge_py.converters._fields import STRINGS, Fill, converters, each, fields, numbers
+from ros_gz_bridge_py.converters.builtin_interfaces import fill_gz_present_time, to_int32, to_uint32
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.converters.std_msgs import fill_gz_header, fill_ros_header
-from ros_gz_bridge_py.msgs import message_class
-
-_GzJointTrajectory = message_class("gz.msgs.JointTrajectory")
+from ros_gz_bridge_py.converters.std_msgs import HEADER
 
 _NS_PER_S = 10**9
 _INT32_MAX = (1 << 31) - 1
@@ -43,50 +40,31 @@ def normalize_duration(sec: int, nsec: int) -> tuple[int, int]:
     return quotient - 1, _NS_PER_S + remainder
 
 
-def joint_trajectory_to_gz(ros: Any) -> Any:
-    gz = _GzJointTrajectory()
-    fill_gz_header(ros.header, gz.header)
-    gz.joint_names.extend(ros.joint_names)
-    for ros_point in ros.points:
-        gz_point = gz.points.add()
-        gz_point.positions.extend(ros_point.positions)
-        gz_point.velocities.extend(ros_point.velocities)
-        gz_point.accelerations.extend(ros_point.accelerations)
-        gz_point.effort.extend(ros_point.effort)
-        duration = gz_point.time_from_start
-        duration.SetInParent()
-        duration.sec = ros_point.time_from_start.sec
-        duration.nsec = to_int32(ros_point.time_from_start.nanosec)
-    return gz
+def _fill_ros_duration(gz: Any, ros: Any) -> None:
+    ros.sec, ros.nanosec = normalize_duration(gz.sec, gz.nsec)
 
 
-def joint_trajectory_to_ros(gz: Any) -> Any:
-    ros = JointTrajectory()
-    fill_ros_header(gz.header, ros.header)
-    ros.joint_names = list(gz.joint_names)
-    points = []
-    for gz_point in gz.points:
-        ros_point = JointTrajectoryPoint()
-        ros_point.positions = array("d", gz_point.positions)
-        ros_point.velocities = array("d", gz_point.velocities)
-        ros_point.accelerations = array("d", gz_point.accelerations)
-        ros_point.effort = array("d", gz_point.effort)
-        sec, nanosec = normalize_duration(
-            gz_point.time_from_start.sec, gz_point.time_from_start.nsec
-        )
-        ros_point.time_from_start.sec = sec
-        ros_point.time_from_start.nanosec = nanosec
-        points.append(ros_point)
-    ros.points = points
-    return ros
-
+#: ``time_from_start``: verbatim R→G, normalised G→R.
+_DURATION = Fill(fill_gz_present_time, _fill_ros_duration)
+_POINT = fields(
+    ("positions", numbers("d")),
+    ("velocities", numbers("d")),
+    ("accelerations", numbers("d")),
+    ("effort", numbers("d")),
+    ("time_from_start", _DURATION),
+)
+joint_trajectory_to_gz, joint_trajectory_to_ros = converters(
+    fields(
+        ("header", HEADER),
+        ("joint_names", STRINGS),
+        ("points", each(_POINT, JointTrajectoryPoint)),
+    ),
+    JointTrajectory,
+    "gz.msgs.JointTrajectory",
+)
 
 PAIRS = (
-    Pair(
-        "trajectory_msgs/msg/JointTrajectory",
-        "gz.msgs.JointTrajectory",
-        joint_trajectory_to_gz,
-        joint_trajectory_to_ros,
-        JointTrajectory,
+    Pair.of(
+        JointTrajectory, "gz.msgs.JointTrajectory", joint_trajectory_to_gz, joint_trajectory_to_ros
     ),
 )

@@ -229,7 +229,7 @@ class Channel(abc.ABC):
         with self._error_lock:
             by_reason = self.stats.errors_by_reason
             by_reason[reason.value] = count = by_reason.get(reason.value, 0) + 1
-            self.stats.last_error = f"{reason.value}: {detail}"
+            self.stats.last_error = detail  # what was wrong: errors_by_reason
             now = time.monotonic()
             if now - self._last_error_log.get(reason, -ERROR_LOG_PERIOD) < ERROR_LOG_PERIOD:
                 return

@@ -2,7 +2,8 @@
 
 Each message is decoded, converted and published on the channel's own delivery thread (see
 :mod:`~ros_gz_bridge_py.core.channel`), in the layout of the spelling it arrived with; images
-and point clouds take the bulk path unless ``BridgeOptions.bulk_path`` is off.
+and point clouds take the bulk path unless ``BridgeOptions.bulk_path`` is off; other messages
+are serialized by the compiled CDR writer unless ``BridgeOptions.cdr_write`` is off.
 """
 
 from __future__ import annotations
@@ -17,13 +18,13 @@ from typing import Any
 from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.bulk.path import gz_to_ros_cdr
-from ros_gz_bridge_py.bulk.serialized_publisher import SerializedPublisher
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext
 from ros_gz_bridge_py.errors import UndecodableError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros.qos import PUBLISHER_OVERRIDES, gz_to_ros_publisher_qos
+from ros_gz_bridge_py.ros.serialized_publisher import SerializedPublisher, object_publisher
 from ros_gz_bridge_py.transport import MessageInfo, Subscription
 
 
@@ -95,13 +96,15 @@ class GzToRosChannel(Channel):
             self._qos,
             qos_overriding_options=PUBLISHER_OVERRIDES,
         )
-        publisher = (
-            self._publisher
-            if self.bulk is None
-            else SerializedPublisher(
-                self._publisher, through_rcl=self.ctx.options.rcl_serialized_publish
+        through_rcl = self.ctx.options.rcl_serialized_publish
+        if self.bulk is not None:
+            publisher = SerializedPublisher(self._publisher, through_rcl=through_rcl)
+        elif self.ctx.options.cdr_write:
+            publisher = object_publisher(
+                self._publisher, self.pair.ros_class, through_rcl=through_rcl
             )
-        )
+        else:
+            publisher = self._publisher
         self._publish = self.ctx.own_publications(self.ros_topic).wrap(publisher)
 
     def _close_output(self) -> None:

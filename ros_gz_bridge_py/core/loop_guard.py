@@ -22,6 +22,8 @@ from typing import Any
 
 #: How many recent publications per ROS topic are remembered (covers bursts and slow executors).
 HISTORY = 1024
+#: The end of the window of a publish call that has not returned yet.
+_STILL_PUBLISHING = 2**63
 
 
 class OwnPublications:
@@ -36,21 +38,33 @@ class OwnPublications:
     def wrap(self, publisher: Any) -> Callable[[Any], None]:
         """A publish function for ``publisher`` that records each publication's window.
 
-        Must be the only way ``publisher`` publishes, so the sequence numbers stay in step.
+        Must be the only way ``publisher`` publishes, from one thread at a time, so the
+        sequence numbers stay in step. The window opens before the call: the sample can reach
+        our own subscription (on another thread) before ``publish`` returns, all the more
+        when the write is made with the GIL released.
         """
         key = id(publisher)
         publish = publisher.publish
 
         def publish_and_record(msg: Any) -> None:
             start = time.time_ns()
-            publish(msg)
-            end = time.time_ns()
             with self._lock:
                 sequence = self._sequences.get(key, 0) + 1
                 self._sequences[key] = sequence
-                self._windows[(key, sequence)] = (start, end)
+                self._windows[(key, sequence)] = (start, _STILL_PUBLISHING)
                 if len(self._windows) > HISTORY:
                     self._windows.popitem(last=False)
+            try:
+                publish(msg)
+            except BaseException:
+                with self._lock:  # nothing was written: the number was not used
+                    self._sequences[key] = sequence - 1
+                    self._windows.pop((key, sequence), None)
+                raise
+            end = time.time_ns()
+            with self._lock:
+                if (key, sequence) in self._windows:
+                    self._windows[(key, sequence)] = (start, end)
 
         return publish_and_record
 

@@ -35,6 +35,9 @@ class BridgeOptions:
     bulk_nice: int = BULK_THREAD_NICE
     #: ROS->Gazebo channels read serialized messages with ros_cdr (False: rclpy's objects).
     light_read: bool = True
+    #: Gazebo->ROS channels of small messages serialize with ``cdr_writer`` and publish the
+    #: bytes with the GIL released (False: rclpy's publish of the message object).
+    cdr_write: bool = True
     #: The simulator's Gazebo line when the user names it (``gz_version``, ``GZ_VERSION``);
     #: only ``garden`` changes anything: its ``gz.msgs.*`` have Fortress layouts and names.
     gz_version: str = ""

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from typing import Any
 
 from rclpy.qos import QoSProfile
+from rclpy.qos_overriding_options import QoSOverridingOptions
 from rclpy.serialization import deserialize_message
 
 from ros_gz_bridge_py.bulk.path import ros_cdr_to_gz
@@ -19,7 +20,11 @@ from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import Channel, ChannelContext, ChannelState
 from ros_gz_bridge_py.ros import light_reader
-from ros_gz_bridge_py.ros.qos import SUBSCRIPTION_OVERRIDES, endpoint_qos
+from ros_gz_bridge_py.ros.qos import (
+    SUBSCRIPTION_OVERRIDES,
+    apply_subscription_overrides,
+    endpoint_qos,
+)
 from ros_gz_bridge_py.transport import Publisher
 
 
@@ -77,8 +82,11 @@ class RosToGzChannel(Channel):
 
     def _open_input(self) -> None:
         callback: Callable[..., None]
+        overrides: QoSOverridingOptions | None = SUBSCRIPTION_OVERRIDES
         if self.loop_guard:
-            node, callback = self.ctx.side_node(), self._on_ros_message_guarded
+            # The overrides are the bridge node's parameters, not the side node's.
+            apply_subscription_overrides(self.ctx.ros_node, self.spec.ros_topic, self._qos)
+            node, callback, overrides = self.ctx.side_node(), self._on_ros_message_guarded, None
         else:
             node, callback = self.ctx.ros_node, self._on_ros_message
         self._subscription = node.create_subscription(
@@ -86,7 +94,7 @@ class RosToGzChannel(Channel):
             self.spec.ros_topic,
             callback,
             self._qos,
-            qos_overriding_options=SUBSCRIPTION_OVERRIDES,
+            qos_overriding_options=overrides,
             raw=self.bulk is not None or self._light,
         )
         self._subscription_node = node

@@ -1,27 +1,37 @@
 """Service bridges: a ROS service whose requests are forwarded to a Gazebo service.
 
-Service bridges live on the bridge's side node (``side_node.py``), spun by a multi-threaded
-executor in its own thread: each call converts the request, waits (blocking that executor thread
-only) for the Gazebo reply or the timeout, and returns exactly one response —
-the converted reply, or ``success=False`` when Gazebo reports failure, does not answer in time,
-or the request cannot be converted. The C++ bridge can answer twice, and never answers when
-Gazebo is absent. Keeping calls off the main executor means a slow or absent Gazebo service never
-delays topic traffic (the EventsExecutor also cannot run coroutine service callbacks).
+Service bridges live on the bridge's side node (``ros/side_node.py``), spun by a multi-threaded
+executor in its own thread. Each call is a coroutine: it converts the request, sends it to
+Gazebo asynchronously, and awaits the reply or the timeout without holding a thread, so any
+number of calls can wait at once; it returns exactly one response: the converted reply, or
+``success=False`` when Gazebo reports failure, does not answer in time, the request cannot be
+converted, or :data:`MAX_WAITING` calls already wait (answered at once, never dropped). The
+server keeps :data:`REQUEST_DEPTH` requests, so a burst of clients is not overwritten before it
+is taken. The C++ bridge can answer twice, never answers when Gazebo is absent, and holds a
+thread per waiting call. Keeping calls off the main executor means a slow or absent Gazebo
+service never delays topic traffic (the EventsExecutor also cannot run coroutine callbacks).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
 from ros_gz_bridge_py.config import ServiceBridgeSpec
 from ros_gz_bridge_py.converters.registry import ServicePair
-from ros_gz_bridge_py.errors import ConfigError, ConversionError, TransportError
+from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.side_node import SideNode
 from ros_gz_bridge_py.transport import GzNode
 
 DEFAULT_TIMEOUT = 5.0
+#: Requests the ROS service server keeps before they are taken (rclpy's default is 10, and a
+#: burst of clients beyond it was overwritten without an answer).
+REQUEST_DEPTH = 1000
+#: Calls that may wait for Gazebo at once; one more is answered ``success=false`` at once.
+MAX_WAITING = 1000
 
 
 def resolve_gz_types(spec: ServiceBridgeSpec, pair: ServicePair) -> tuple[str, str]:
@@ -68,13 +78,23 @@ class ServiceBridge:
         self.timeout = timeout
         self.gz_req_type, self.gz_rep_type = resolve_gz_types(spec, pair)
         self._reply_class = message_class(self.gz_rep_type)
+        self._host = host
         self._ros_node = host.node
         self._gz_node = gz_node
         self._logger = host.node.get_logger()
         self.calls = 0
         self.failures = 0
+        self.waiting = 0
         self._service = host.node.create_service(
-            pair.ros_class, spec.service, self._on_request, callback_group=host.reentrant
+            pair.ros_class,
+            spec.service,
+            self._on_request,
+            qos_profile=QoSProfile(
+                depth=REQUEST_DEPTH,
+                reliability=ReliabilityPolicy.RELIABLE,
+                durability=DurabilityPolicy.VOLATILE,
+            ),
+            callback_group=host.reentrant,
         )
         self.service_name: str = self._service.srv_name
 
@@ -84,20 +104,36 @@ class ServiceBridge:
             f"{self.gz_req_type}/{self.gz_rep_type})]"
         )
 
-    def _on_request(self, request: Any, _response: Any) -> Any:
+    async def _on_request(self, request: Any, _response: Any) -> Any:
+        """One call, answered once: never raises (an exception would leave it unanswered)."""
         self.calls += 1
+        if self.waiting >= MAX_WAITING:
+            return self._fail(f"{self.waiting} calls already wait for Gazebo; try again later")
         try:
             payload = self.pair.request_to_gz(request).SerializeToString()
-        except ConversionError as err:
+        except Exception as err:
             return self._fail(f"request not converted: {err}")
+        self.waiting += 1
         try:
-            success, reply = self._gz_node.request(
-                self.spec.service, payload, self.gz_req_type, self.gz_rep_type, self.timeout
-            )
-        except TimeoutError:
-            return self._fail(f"no reply from Gazebo within {self.timeout:g} s")
-        except TransportError as err:
+            return await self._forward(payload)
+        except Exception as err:
             return self._fail(f"request failed: {err}")
+        finally:
+            self.waiting -= 1
+
+    async def _forward(self, payload: bytes) -> Any:
+        future = self._host.future()
+
+        def on_reply(ok: bool | None, reply: bytes) -> None:
+            if not future.done():
+                future.set_result((ok, reply))
+
+        self._gz_node.request_async(
+            self.spec.service, payload, self.gz_req_type, self.gz_rep_type, self.timeout, on_reply
+        )
+        success, reply = await future
+        if success is None:
+            return self._fail(f"no reply from Gazebo within {self.timeout:g} s")
         if not success:
             return self._fail("Gazebo reported failure")
         try:

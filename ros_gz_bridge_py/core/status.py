@@ -113,9 +113,10 @@ class ChannelStatus:
             return "lazy: no subscribers, input side closed"
         if self.level == WARN:
             text = f"{self.new_problems} errors/drops in the last period"
+            text = f"{text}: {self.last_error}" if self.last_error else text
             if self.errors_by_reason:
                 text += f" (errors since start: {self.error_summary()})"
-            return f"{text}; last: {self.last_error}" if self.last_error else text
+            return text
         return "ok"
 
     def values(self) -> dict[str, str]:

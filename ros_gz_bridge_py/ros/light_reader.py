@@ -17,40 +17,29 @@ is left to rclpy (:func:`reader_for` returns None, :func:`read` returns None).
 
 from __future__ import annotations
 
-import importlib
 import struct
 from collections.abc import Callable
 from types import SimpleNamespace
 from typing import Any
 
 from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.ros.cdr_types import (
+    BASIC,
+    BODY,
+    BYTE_TYPES,
+    CDR_LE_HEADER,
+    SEQUENCE_TYPES,
+    STRING_TYPES,
+    basic_of,
+    fields_of,
+    nested_class,
+)
 
 #: Reads one value at a position of the buffer; returns it and the position after it.
 Reader = Callable[[bytes, int], tuple[Any, int]]
 
-_CDR_LE = b"\x00\x01"
-_BODY = 4
-#: rosidl basic type -> (size, struct code).
-_BASIC: dict[str, tuple[int, str]] = {
-    "boolean": (1, "?"),
-    "octet": (1, "c"),
-    "char": (1, "B"),
-    "uint8": (1, "B"),
-    "int8": (1, "b"),
-    "int16": (2, "h"),
-    "uint16": (2, "H"),
-    "int32": (4, "i"),
-    "uint32": (4, "I"),
-    "float": (4, "f"),
-    "int64": (8, "q"),
-    "uint64": (8, "Q"),
-    "double": (8, "d"),
-}
-_BYTES = {"octet", "uint8"}
+_CDR_LE = CDR_LE_HEADER[:2]
 _U32 = struct.Struct("<I")
-#: rosidl type classes (by name) of strings and of sequences.
-STRING_TYPES = frozenset({"UnboundedString", "BoundedString"})
-SEQUENCE_TYPES = frozenset({"UnboundedSequence", "BoundedSequence"})
 
 
 class _UnreadableTypeError(Exception):
@@ -67,7 +56,7 @@ def read(cdr: bytes, msg_class: type[Any]) -> Any | None:
     if reader is None or cdr[:2] != _CDR_LE:
         return None
     try:
-        return reader(cdr, _BODY)[0]
+        return reader(cdr, BODY)[0]
     except (struct.error, UnicodeDecodeError, IndexError) as err:
         name = msg_class.__name__
         msg = f"serialized {name} of {len(cdr)} bytes is malformed: {err}"
@@ -86,25 +75,6 @@ def reader_for(msg_class: type[Any]) -> Reader | None:
         except _UnreadableTypeError:
             _READERS[msg_class] = None
     return _READERS[msg_class]
-
-
-def fields_of(msg_class: type[Any]) -> list[tuple[str, Any]]:
-    """(name, rosidl type) of each field of ``msg_class``, in wire order."""
-    names = msg_class.get_fields_and_field_types()
-    return list(zip(names, msg_class.SLOT_TYPES, strict=True))
-
-
-def basic_size(slot: Any) -> int | None:
-    """The wire size of a basic type (bool .. double) we read; None for any other type."""
-    basic = _basic_of(slot)
-    return _BASIC[basic][0] if basic in _BASIC else None
-
-
-def nested_class(slot: Any) -> type[Any]:
-    """The rclpy class of a nested message type."""
-    module = importlib.import_module(".".join(slot.namespaces))
-    cls: type[Any] = getattr(module, slot.name)
-    return cls
 
 
 def _struct_reader(msg_class: type[Any]) -> Reader:
@@ -137,9 +107,9 @@ def _merge_basic_runs(fields: list[tuple[str, Any]]) -> list[Step]:
     run: list[tuple[str, str]] = []
     run_size = 0
     for name, slot in fields:
-        basic = _basic_of(slot)
-        if basic is not None and basic in _BASIC and basic != "octet":
-            size, code = _BASIC[basic]
+        basic = basic_of(slot)
+        if basic is not None and basic in BASIC and basic != "octet":
+            size, code = BASIC[basic]
             if run and size != run_size:
                 steps.append(_basic_run_step(run, run_size))
                 run = []
@@ -161,7 +131,7 @@ def _basic_run_step(run: list[tuple[str, str]], size: int) -> Step:
     length = size * len(run)
 
     def step(buf: bytes, pos: int, values: dict[str, Any]) -> int:
-        pos += -(pos - _BODY) % size
+        pos += -(pos - BODY) % size
         values.update(zip(names, unpack(buf, pos), strict=True))
         return pos + length
 
@@ -174,11 +144,6 @@ def _field_step(name: str, reader: Reader) -> Step:
         return pos
 
     return step
-
-
-def _basic_of(slot: Any) -> str | None:
-    typename = getattr(slot, "typename", None)
-    return typename if type(slot).__name__ == "BasicType" else None
 
 
 def _value_reader(slot: Any) -> Reader:
@@ -197,20 +162,20 @@ def _value_reader(slot: Any) -> Reader:
 
 
 def _basic_reader(typename: str) -> Reader:
-    if typename not in _BASIC:
+    if typename not in BASIC:
         raise _UnreadableTypeError(typename)
-    size, code = _BASIC[typename]
+    size, code = BASIC[typename]
     unpack = struct.Struct("<" + code).unpack_from
 
     def read_basic(buf: bytes, pos: int) -> tuple[Any, int]:
-        pos += -(pos - _BODY) % size
+        pos += -(pos - BODY) % size
         return unpack(buf, pos)[0], pos + size
 
     return read_basic
 
 
 def _read_string(buf: bytes, pos: int) -> tuple[str, int]:
-    pos += -(pos - _BODY) % 4
+    pos += -(pos - BODY) % 4
     (length,) = _U32.unpack_from(buf, pos)
     pos += 4
     end = pos + length
@@ -225,7 +190,7 @@ def _nested_reader(slot: Any) -> Reader:
 
 
 def _array_reader(value_type: Any, count: int) -> Reader:
-    basic = _basic_of(value_type)
+    basic = basic_of(value_type)
     if basic is not None:
         return _basic_block_reader(basic, lambda _buf, pos: (count, pos))
     element = _value_reader(value_type)
@@ -233,28 +198,28 @@ def _array_reader(value_type: Any, count: int) -> Reader:
 
 
 def _sequence_reader(value_type: Any) -> Reader:
-    basic = _basic_of(value_type)
+    basic = basic_of(value_type)
     if basic is not None:
         return _basic_block_reader(basic, _read_count)
     return _element_list_reader(_value_reader(value_type), _read_count)
 
 
 def _read_count(buf: bytes, pos: int) -> tuple[int, int]:
-    pos += -(pos - _BODY) % 4
+    pos += -(pos - BODY) % 4
     return _U32.unpack_from(buf, pos)[0], pos + 4
 
 
 def _basic_block_reader(typename: str, count_of: Callable[[bytes, int], tuple[int, int]]) -> Reader:
-    if typename not in _BASIC:
+    if typename not in BASIC:
         raise _UnreadableTypeError(typename)
-    size, code = _BASIC[typename]
-    as_bytes = typename in _BYTES
+    size, code = BASIC[typename]
+    as_bytes = typename in BYTE_TYPES
 
     def read_block(buf: bytes, pos: int) -> tuple[Any, int]:
         count, pos = count_of(buf, pos)
         if count == 0:
             return (b"" if as_bytes else ()), pos
-        pos += -(pos - _BODY) % size
+        pos += -(pos - BODY) % size
         end = pos + size * count
         if end > len(buf):
             msg = f"{count} x {typename} at offset {pos}"

@@ -24,7 +24,12 @@ from rclpy.qos import (
     qos_profile_services_default,
     qos_profile_system_default,
 )
-from rclpy.qos_overriding_options import QoSOverridingOptions, QoSPolicyKind
+from rclpy.qos_overriding_options import (  # the function create_subscription calls
+    QoSOverridingOptions,
+    QoSPolicyKind,
+    _declare_qos_parameters,
+)
+from rclpy.subscription import Subscription
 
 from ros_gz_bridge_py.errors import ConfigError
 
@@ -77,6 +82,20 @@ PUBLISHER_OVERRIDES = QoSOverridingOptions(
     )
 )
 SUBSCRIPTION_OVERRIDES = QoSOverridingOptions.with_default_policies()
+
+
+def apply_subscription_overrides(node: Any, topic: str, qos: QoSProfile) -> None:
+    """Apply to ``qos`` (in place) the ``qos_overrides`` of a subscription of ``topic`` on
+    ``node``, declaring its parameters there, as ``create_subscription`` does.
+
+    For a subscription the bridge creates on its side node: the user wrote the overrides for
+    the bridge node (``-p`` for its name, a params file, ``parameter_overrides``), so they are
+    read and shown there. rclpy's own function is used, so the names, the policies and the
+    errors are rclpy's.
+    """
+    _declare_qos_parameters(
+        Subscription, node, node.resolve_topic_name(topic), qos, SUBSCRIPTION_OVERRIDES
+    )
 
 
 def _fields(profile: QoSProfile) -> dict[str, Any]:

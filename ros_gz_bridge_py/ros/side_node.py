@@ -5,8 +5,8 @@ callbacks nor subscription callbacks that take rclpy's message info. The side no
 same context and namespace, is spun by a small multi-threaded executor on its own thread, and
 hosts:
 
-* service bridges, whose calls block on a Gazebo reply (up to the service timeout) without
-  delaying any topic, in a reentrant group so calls run concurrently;
+* service bridges, whose callbacks are coroutines awaiting the Gazebo reply (up to the service
+  timeout) without holding a thread or delaying any topic, in a reentrant group;
 * ROS -> Gazebo subscriptions that need message info to recognise the bridge's own publications
   (bidirectional topics, see ``loop_guard.py``), in the node's default mutually exclusive group
   so each topic keeps its order.
@@ -21,6 +21,7 @@ from typing import Any
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node as RosNode
+from rclpy.task import Future
 
 SUFFIX = "_side"
 
@@ -47,6 +48,17 @@ class SideNode:
         self._thread = threading.Thread(target=self._spin, name="ros-gz-side", daemon=True)
         self._thread.start()
 
+    def future(self) -> Future:
+        """A future that resumes a coroutine callback of this node awaiting it when it is done,
+        whichever thread completes it.
+
+        rclpy resumes a waiting coroutine only when its executor wakes; scheduling a done
+        callback is what wakes it, so every future made here has one.
+        """
+        future = Future(executor=self._executor)
+        future.add_done_callback(_resume)
+        return future
+
     def _spin(self) -> None:
         with contextlib.suppress(ExternalShutdownException):
             self._executor.spin()
@@ -55,3 +67,7 @@ class SideNode:
         self._executor.shutdown(timeout_sec=1.0)
         self._thread.join(timeout=2.0)
         self.node.destroy_node()
+
+
+def _resume(_future: Future) -> None:
+    """A done callback whose only job is to be scheduled (see :meth:`SideNode.future`)."""

@@ -1,8 +1,8 @@
-"""A Zenoh router for the client-mode tests: ``python e2e_zenoh_router.py PORT SECONDS``.
+"""A Zenoh router for the client-mode tests: ``python e2e_zenoh_router.py PORT SECONDS [HOST]``.
 
 There is no ``zenohd`` here; a Python session in router mode routes the same way. It listens
-on ``tcp/127.0.0.1:PORT`` only, without scouting, prints ``READY`` and runs until SIGTERM or
-``SECONDS`` pass.
+on ``tcp/HOST:PORT`` only (HOST 127.0.0.1 unless given), without scouting, prints ``READY``
+and runs until SIGTERM or ``SECONDS`` pass.
 """
 
 from __future__ import annotations
@@ -18,8 +18,9 @@ from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
 
 def main() -> int:
     port, seconds = int(sys.argv[1]), float(sys.argv[2])
+    host = sys.argv[3] if len(sys.argv) > 3 else "127.0.0.1"
     with StopSignal() as stop:
-        config = endpoints_config("router", listen=[f"tcp/127.0.0.1:{port}"])
+        config = endpoints_config("router", listen=[f"tcp/{host}:{port}"])
         with zenoh.open(config):
             sys.stdout.write("READY\n")
             sys.stdout.flush()

@@ -15,6 +15,7 @@ from typing import Any
 
 import pytest
 import rclpy
+from rclpy.qos import QoSProfile
 from ros_gz_interfaces.msg import Entity
 from ros_gz_interfaces.srv import ControlWorld, DeleteEntity, SetEntityPose, SpawnEntity
 
@@ -37,6 +38,8 @@ SERVICE_TIMEOUT = 1.0
 #: (ROS service type, Gazebo request type) of the CLI service bridges, by key.
 CLI_SERVICES = {
     "control": ("ControlWorld", WORLD_CONTROL),
+    "storm": ("ControlWorld", WORLD_CONTROL),
+    "storm_absent": ("ControlWorld", WORLD_CONTROL),
     "control_fail": ("ControlWorld", WORLD_CONTROL),
     "control_absent": ("ControlWorld", WORLD_CONTROL),
     "delete": ("DeleteEntity", "ignition.msgs.Entity"),
@@ -228,3 +231,62 @@ def test_spawn_entity_request_as_gazebo_sees_it(
     assert 'sdf_filename: "model://box"' in seen
     assert "allow_renaming: true" in seen
     assert "y: 3" in seen
+
+
+#: Clients calling at once in the storm tests (issue 14: 36 of 50 went unanswered before).
+STORM = 50
+#: Every client's reader sees every client's responses on the shared reply topic; with rclpy's
+#: default depth of 10, a client whose own response was pushed out by others' would look
+#: unanswered, so each keeps them all.
+CLIENT_QOS = QoSProfile(depth=STORM * 2)
+
+
+def call_at_once(context: Any, service: str) -> dict[int, list[tuple[float, bool]]]:
+    """``STORM`` clients call ``service`` at the same moment; each client's responses, with the
+    seconds from the calls to their arrival. The node is not spun: responses are taken here."""
+    node = rclpy.create_node(f"svc_storm_{int(time.time() * 1000) % 100000}", context=context)
+    try:
+        clients = [
+            node.create_client(ControlWorld, service, qos_profile=CLIENT_QOS) for _ in range(STORM)
+        ]
+        for client in clients:
+            assert client.wait_for_service(timeout_sec=WAIT)
+        start = time.monotonic()
+        for client in clients:
+            client.call_async(control_request())
+        answers: dict[int, list[tuple[float, bool]]] = {}
+        listen_until = start + SERVICE_TIMEOUT + 3.0
+        while time.monotonic() < listen_until:
+            for index, client in enumerate(clients):
+                with client.handle:
+                    header, response = client.handle.take_response(ControlWorld.Response)
+                if header is not None:
+                    answers.setdefault(index, []).append(
+                        (time.monotonic() - start, response.success)
+                    )
+            time.sleep(0.01)
+        return answers
+    finally:
+        node.destroy_node()
+
+
+def test_a_storm_without_gazebo_gets_every_answer_once_within_the_timeout(
+    services: dict[str, str], ros_side: RosSide
+) -> None:
+    answers = call_at_once(ros_side.context, services["storm_absent"])
+    assert sorted(answers) == list(range(STORM)), f"unanswered: {STORM - len(answers)}"
+    assert all(len(got) == 1 for got in answers.values()), answers
+    assert {ok for ((_, ok),) in answers.values()} == {False}
+    latest = max(elapsed for ((elapsed, _),) in answers.values())
+    assert latest <= SERVICE_TIMEOUT + 1.0, f"the last answer came after {latest:.2f} s"
+
+
+def test_a_storm_with_gazebo_is_served_in_full(
+    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    peer = start_replier(started, services["storm"], WORLD_CONTROL)
+    call_until_served(ros_side, peer, ControlWorld, services["storm"], control_request())
+    answers = call_at_once(ros_side.context, services["storm"])
+    assert sorted(answers) == list(range(STORM)), f"unanswered: {STORM - len(answers)}"
+    assert all(len(got) == 1 for got in answers.values()), answers
+    assert {ok for ((_, ok),) in answers.values()} == {True}

@@ -15,6 +15,7 @@ from rclpy.parameter import Parameter
 from ros_gz_bridge_py.app.settings import (
     BULK_NICE_ENV,
     BULK_PATH_ENV,
+    CDR_WRITE_ENV,
     EXECUTOR_ENV,
     FASTDDS_PROFILE_ENV,
     LIGHT_READ_ENV,
@@ -36,6 +37,7 @@ OFF_SWITCHES = {
     FASTDDS_PROFILE_ENV: "fastdds_profile",
     BULK_PATH_ENV: "bulk_path",
     LIGHT_READ_ENV: "light_read",
+    CDR_WRITE_ENV: "cdr_write",
 }
 #: Each choice switch, the value that chooses, and the field it sets False.
 CHOICES = {
@@ -59,6 +61,7 @@ def test_nothing_set_is_the_fast_defaults() -> None:
         rcl_serialized_publish=True,
         bulk_nice=BULK_THREAD_NICE,
         light_read=True,
+        cdr_write=True,
         warnings=(),
     )
 
@@ -123,6 +126,7 @@ def test_every_switch_at_once() -> None:
         SERIALIZED_PUBLISH_ENV: "rclpy",
         BULK_NICE_ENV: "0",
         LIGHT_READ_ENV: "false",
+        CDR_WRITE_ENV: "off",
     }
     assert read_switches(env) == Switches(
         events_executor=False,
@@ -131,6 +135,7 @@ def test_every_switch_at_once() -> None:
         rcl_serialized_publish=False,
         bulk_nice=0,
         light_read=False,
+        cdr_write=False,
     )
 
 
@@ -142,7 +147,7 @@ def test_bridge_options_from_parameters_and_switches() -> None:
         override_frame_id="cam",
         gz_version="GARDEN",
     )
-    switches = Switches(bulk_path=False, rcl_serialized_publish=False, bulk_nice=2)
+    switches = Switches(bulk_path=False, rcl_serialized_publish=False, bulk_nice=2, cdr_write=False)
     options = shared.bridge_options(switches, gz_version="garden", service_timeout=1.5)
     assert options == BridgeOptions(
         lazy=True,
@@ -154,6 +159,7 @@ def test_bridge_options_from_parameters_and_switches() -> None:
         rcl_serialized_publish=False,
         bulk_nice=2,
         light_read=True,
+        cdr_write=False,
         gz_version="garden",
     )
 

@@ -15,36 +15,10 @@ from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 THIS = Path(__file__).resolve()
 
-#: Files whose citations others are rewriting right now (issue 13, point 6): they may still
-#: name the notes or cite a section without a page. Whoever reworks one of them replaces its
-#: citations (the new texts are in the docs branch's report) and deletes its line here; a line
-#: whose file has nothing left to excuse fails the test, so the list only shrinks.
-ALLOWED = {
-    "ros_gz_bridge_py/converters/actuator_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/builtin_interfaces.py": "being reworked",
-    "ros_gz_bridge_py/converters/geometry_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/gps_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/nav_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/rcl_interfaces.py": "being reworked",
-    "ros_gz_bridge_py/converters/ros_gz_interfaces.py": "being reworked",
-    "ros_gz_bridge_py/converters/ros_gz_interfaces_messages.py": "being reworked",
-    "ros_gz_bridge_py/converters/ros_gz_interfaces_sensors.py": "being reworked",
-    "ros_gz_bridge_py/converters/rosgraph_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/sensor_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/sensor_msgs_image.py": "being reworked",
-    "ros_gz_bridge_py/converters/sensor_msgs_navsat.py": "being reworked",
-    "ros_gz_bridge_py/converters/sensor_msgs_scan.py": "being reworked",
-    "ros_gz_bridge_py/converters/std_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/tf2_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/trajectory_msgs.py": "being reworked",
-    "ros_gz_bridge_py/converters/vision_msgs.py": "being reworked",
-}
 
 #: How the notes outside the repository were named. A page of ours is always written with its
 #: folder (``docs/conversions.md``), so a bare ``conversions.md`` is a note.
@@ -154,19 +128,6 @@ def test_problems_are_found() -> None:
     assert _problems("x.py", "docs/nowhere.md") == ["cites docs/nowhere.md, which does not exist"]
 
 
-@pytest.mark.parametrize("name", sorted(ALLOWED))
-def test_allowed_files_still_need_it(name: str) -> None:
-    """An allow-listed file that has nothing left to excuse must leave the list."""
-    text = dict(_files()).get(name)
-    if text is None or not _problems(name, text):
-        pytest.fail(f"{name} cites only our docs now: delete its line from ALLOWED")
-
-
 def test_every_citation_is_good() -> None:
-    report = [
-        f"{name}: {problem}"
-        for name, text in _files()
-        if name not in ALLOWED
-        for problem in _problems(name, text)
-    ]
+    report = [f"{name}: {problem}" for name, text in _files() for problem in _problems(name, text)]
     assert not report, "\n".join(report)

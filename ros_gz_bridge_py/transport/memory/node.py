@@ -9,7 +9,8 @@ spelling its subscribers need; service calls reach a provider of either spelling
 types, after it is known, and time out otherwise.
 
 ``native`` makes a node stand for a gz process of one Gazebo line: it announces and takes
-only that line's spelling (``Spelling.IGNITION`` for Fortress), as real gz-transport does.
+only that line's spelling (``Spelling.IGNITION`` for Fortress), as real gz-transport does; its
+generic subscribers register with every announcement and drop the other line's names.
 
 Threads: a message to a subscription without a queue is delivered on the publishing thread;
 service handlers and ``request_async`` callbacks run on the node's worker thread.
@@ -168,6 +169,8 @@ class MemoryGzNode(GzNode):
     def _receive(self, fqn: str, sender: str, msg_type: str, payload: bytes) -> None:
         """A message from another node's publisher (§2.8.1 step 8); subscriptions of the topic
         that do not take its type, or all when it is over the size limit, are told."""
+        if self.native is not None and respell(msg_type, self.native) != msg_type:
+            return  # a name this line's gz-msgs does not know: dropped, as gz does (§9.1)
         every = self.subscriptions(fqn)
         for sub in every:
             if not sub.accepts(msg_type):
@@ -199,9 +202,18 @@ class MemoryGzNode(GzNode):
         self._take(announcement, self.subscriptions(announcement.fqn))
 
     def _take(self, announcement: Announcement, subs: Sequence[Subscription]) -> None:
-        taking = [s for s in subs if s.take(announcement.address, announcement.msg_type)]
+        taking = [s for s in subs if self._takes(s, announcement)]
         if taking:
             announcement.node._register(announcement.fqn, self, announcement.msg_type)
+
+    def _takes(self, sub: Subscription, announcement: Announcement) -> bool:
+        """Whether ``sub`` registers with ``announcement``. A generic subscriber of a gz
+        process (``native``) registers with every announcement of the topic, both spellings
+        of one publisher included (§9.1); the publisher then sends it one message, in the
+        spelling of its line (§9.2)."""
+        if self.native is not None and sub.generic:
+            return True
+        return sub.take(announcement.address, announcement.msg_type)
 
     def _register(self, fqn: str, subscriber: MemoryGzNode, msg_type: str) -> None:
         """NEW_CONNECTION: ``subscriber`` takes our publisher of ``fqn`` as ``msg_type``."""

@@ -286,3 +286,29 @@ def test_only_tcp_addresses_are_taken_from_advertisements() -> None:
         ad = datagram(DiscoveryType.ADVERTISE, pub=record(address=address))
         events = engine.datagram_received(ad, "127.0.0.1", 0.0)[1]
         assert events[-1] == PublisherAdded(record(address=address))  # (after the moved one)
+
+
+def test_a_publisher_that_readvertises_rarely_stays_known() -> None:
+    """gz-transport after 15 re-ADVERTISEs only on a change, for a new peer, or every tenth
+    heartbeat: heartbeats alone must keep its records (docs/protocol.md §2.5)."""
+    engine = DiscoveryEngine(ME, 0.0)
+    engine.datagram_received(datagram(DiscoveryType.ADVERTISE, pub=record()), "127.0.0.1", 0.0)
+    for second in range(1, 25):
+        engine.datagram_received(datagram(DiscoveryType.HEARTBEAT), "127.0.0.1", float(second))
+        assert engine.tick(second + 0.5)[1] == []
+    assert engine.remote_publishers(TOPIC) == [record()]
+
+
+def test_fields_added_by_newer_lines_are_ignored() -> None:
+    """Additive fields (a node id in SUBSCRIBE, a snapshot in SUBSCRIBERS_REP, anything a
+    later gz-transport adds) are skipped as protobuf skips unknown fields."""
+    engine = DiscoveryEngine(ME, 0.0)
+    extra = bytes([0xA2, 0x06, 0x04]) + b"node"  # field 100, length-delimited: unknown to us
+    subscribe = datagram(DiscoveryType.SUBSCRIBE, topic=TOPIC)
+    body = subscribe[2:] + extra
+    widened = len(body).to_bytes(2, "little") + body
+    engine.advertise(record(ME))
+    out, events = engine.datagram_received(widened, "127.0.0.1", 0.0)
+    assert events == []
+    assert [m.type for m in sent(out)] == [DiscoveryType.ADVERTISE]
+    assert engine.counts["malformed"] == 0

@@ -1,0 +1,124 @@
+"""``OwnPublications``: a sample is the bridge's own when its sequence number is one the
+bridge's publisher used and its source timestamp falls inside that publish call.
+
+A stand-in publisher stamps each sample inside ``publish`` as a DDS writer does. The same
+rule at work with rclpy, where another node of the same process must still get through
+(ros_gz issue #788), is ``test_channels.py``'s bidirectional test.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import pytest
+
+from ros_gz_bridge_py.core.loop_guard import HISTORY, OwnPublications
+
+
+class StampingPublisher:
+    """Numbers its samples 1, 2, ... and stamps each during ``publish`` (wall clock, ns)."""
+
+    def __init__(self) -> None:
+        self.samples: list[dict[str, int]] = []
+
+    def publish(self, _msg: Any) -> None:
+        self.samples.append(
+            {
+                "publication_sequence_number": len(self.samples) + 1,
+                "source_timestamp": time.time_ns(),
+            }
+        )
+
+
+def test_every_own_sample_is_recognised() -> None:
+    own = OwnPublications()
+    publisher = StampingPublisher()
+    publish = own.wrap(publisher)
+    for index in range(5):
+        publish(index)
+    assert [own.is_own(sample) for sample in publisher.samples] == [True] * 5
+
+
+def test_another_writer_is_not_own_even_with_a_sequence_number_in_use() -> None:
+    own = OwnPublications()
+    ours = StampingPublisher()
+    publish = own.wrap(ours)
+    publish("a")
+    publish("b")
+    first, second = ours.samples
+    after_every_call = time.time_ns() + 1_000_000
+    assert own.is_own(first)
+    # Another writer's sample 1, written after our publish calls.
+    assert not own.is_own({**first, "source_timestamp": after_every_call})
+    # Our number 2, but written before our call that used it began.
+    assert not own.is_own({**second, "source_timestamp": first["source_timestamp"] - 1})
+    # A number we never used.
+    assert not own.is_own({**second, "publication_sequence_number": 3})
+
+
+def test_a_sample_without_writer_information_is_not_own() -> None:
+    own = OwnPublications()
+    publisher = StampingPublisher()
+    own.wrap(publisher)(None)
+    assert not own.is_own({})
+    assert not own.is_own({"publication_sequence_number": 1, "source_timestamp": 0})
+    assert not own.is_own({"publication_sequence_number": 0, "source_timestamp": time.time_ns()})
+
+
+def test_two_publishers_of_one_topic_each_keep_their_numbers() -> None:
+    own = OwnPublications()
+    first, second = StampingPublisher(), StampingPublisher()
+    publish_first, publish_second = own.wrap(first), own.wrap(second)
+    for index in range(3):
+        publish_first(index)
+        publish_second(index)
+    assert all(own.is_own(sample) for sample in first.samples + second.samples)
+
+
+def test_only_the_recent_history_is_remembered() -> None:
+    own = OwnPublications()
+    publisher = StampingPublisher()
+    publish = own.wrap(publisher)
+    for index in range(HISTORY + 2):
+        publish(index)
+    remembered = [own.is_own(sample) for sample in publisher.samples]
+    assert remembered == [False, False] + [True] * HISTORY
+
+
+def test_a_sample_seen_before_publish_returns_is_own() -> None:
+    """With the write made with the GIL released, our subscription may take the sample while
+    ``publish`` has not returned yet."""
+    own = OwnPublications()
+    seen: list[bool] = []
+
+    class SeenDuringPublish(StampingPublisher):
+        def publish(self, msg: Any) -> None:
+            super().publish(msg)
+            seen.append(own.is_own(self.samples[-1]))
+
+    publish = own.wrap(SeenDuringPublish())
+    publish("a")
+    publish("b")
+    assert seen == [True, True]
+
+
+def test_a_publish_that_raises_uses_no_sequence_number() -> None:
+    own = OwnPublications()
+    publisher = StampingPublisher()
+    refusing = True
+
+    class SometimesRefusing:
+        def publish(self, msg: Any) -> None:
+            if refusing:
+                raise ValueError(msg)
+            publisher.publish(msg)
+
+    publish = own.wrap(SometimesRefusing())
+    with pytest.raises(ValueError, match="x"):
+        publish("x")
+    refusing = False
+    publish("y")
+    (sample,) = publisher.samples
+    assert own.is_own(sample)
+    assert not own.is_own({**sample, "publication_sequence_number": 2})

@@ -1,0 +1,196 @@
+"""Service forwarding in one process: ROS clients calling memory Gazebo providers.
+
+The bridge serves each ROS service on its side node (spun by the side node's own executor)
+and forwards each request to the Gazebo provider; the providers here are memory nodes whose
+handlers record what they got, so converted requests are checked where Gazebo sees them.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+from ros_gz_interfaces.srv import ControlWorld, SetEntityPose
+
+from ros_gz_bridge_py.config import ServiceBridgeSpec
+from ros_gz_bridge_py.core.status import StatusTracker
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.msgs.names import Spelling, respell
+from tests.core.harness import WAIT, Rig, RosWorld, options, unique, wait_until
+
+pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
+
+SERVICE_TIMEOUT = 0.3
+CONTROL_WORLD = "ros_gz_interfaces/srv/ControlWorld"
+GzWorldControl = message_class("gz.msgs.WorldControl")
+GzBoolean = message_class("gz.msgs.Boolean")
+GzPose = message_class("gz.msgs.Pose")
+
+
+@pytest.fixture
+def rig(make_rig: Callable[..., Rig]) -> Rig:
+    """A bridge whose service calls give up after :data:`SERVICE_TIMEOUT` seconds."""
+    return make_rig(options(service_timeout=SERVICE_TIMEOUT))
+
+
+class Provider:
+    """A Gazebo service handler that decodes and keeps every request, and replies ``reply``
+    (``None``: Gazebo reports failure; an exception: the handler raises)."""
+
+    def __init__(self, request_class: Any, reply: Any) -> None:
+        self.request_class = request_class
+        self.reply = reply
+        self.requests: list[Any] = []
+
+    def __call__(self, payload: bytes) -> tuple[bool, bytes]:
+        self.requests.append(self.request_class.FromString(payload))
+        if isinstance(self.reply, Exception):
+            raise self.reply
+        if self.reply is None:
+            return False, b""
+        return True, self.reply.SerializeToString()
+
+
+def call(world: RosWorld, srv_type: Any, service: str, request: Any) -> Any:
+    """One call through a client of the test node; fails the test without a response."""
+    client = world.run(lambda: world.node.create_client(srv_type, service))
+    try:
+        wait_until(client.service_is_ready, f"the service {service}")
+        future = world.run(lambda: client.call_async(request))
+        wait_until(future.done, f"a response from {service}", timeout=WAIT + SERVICE_TIMEOUT)
+        return future.result()
+    finally:
+        world.destroy(client)
+
+
+def control_request() -> Any:
+    request = ControlWorld.Request()
+    request.world_control.pause = True
+    request.world_control.multi_step = 7
+    request.world_control.reset.model_only = True
+    return request
+
+
+@pytest.mark.parametrize("native", [Spelling.GZ, Spelling.IGNITION])
+def test_a_call_reaches_gazebo_and_the_reply_comes_back(
+    rig: Rig, world: RosWorld, native: Spelling
+) -> None:
+    """The default (gz.msgs) types reach a provider of either Gazebo line."""
+    service = unique("control")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    provider = Provider(GzWorldControl, GzBoolean(data=True))
+    rig.gazebo(native=native).advertise_service(
+        service,
+        respell("gz.msgs.WorldControl", native),
+        respell("gz.msgs.Boolean", native),
+        provider,
+    )
+    response = call(world, ControlWorld, service, control_request())
+    assert response.success is True
+    (seen,) = provider.requests
+    assert (seen.pause, seen.multi_step, seen.reset.model_only) == (True, 7, True)
+    assert not seen.reset.all
+
+
+def test_the_reply_value_is_converted(rig: Rig, world: RosWorld) -> None:
+    service = unique("set_pose")
+    rig.add(ServiceBridgeSpec(service, "ros_gz_interfaces/srv/SetEntityPose"))
+    provider = Provider(GzPose, GzBoolean(data=False))  # answered: "did not move it"
+    rig.gazebo().advertise_service(service, "gz.msgs.Pose", "gz.msgs.Boolean", provider)
+    request = SetEntityPose.Request()
+    request.entity.name = "moved_box"
+    request.pose.position.x, request.pose.position.z = 1.5, -2.25
+    request.pose.orientation.w = 1.0
+    assert call(world, SetEntityPose, service, request).success is False
+    (seen,) = provider.requests
+    assert seen.name == "moved_box"
+    assert (seen.position.x, seen.position.y, seen.position.z) == (1.5, 0.0, -2.25)
+    assert seen.orientation.w == 1.0
+    assert rig.bridge.services[0].failures == 0  # Gazebo answered; its answer was "false"
+
+
+@pytest.mark.parametrize(
+    "reply", [None, RuntimeError("the handler failed")], ids=["reports-failure", "raises"]
+)
+def test_a_failing_provider_gives_success_false(rig: Rig, world: RosWorld, reply: Any) -> None:
+    service = unique("failing")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    provider = Provider(GzWorldControl, reply)
+    rig.gazebo().advertise_service(service, "gz.msgs.WorldControl", "gz.msgs.Boolean", provider)
+    assert call(world, ControlWorld, service, control_request()).success is False
+    assert len(provider.requests) == 1
+    bridge = rig.bridge.services[0]
+    assert (bridge.calls, bridge.failures) == (1, 1)
+
+
+def test_no_provider_gives_success_false_after_the_timeout(rig: Rig, world: RosWorld) -> None:
+    service = unique("absent")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    assert call(world, ControlWorld, service, control_request()).success is False
+    bridge = rig.bridge.services[0]
+    assert (bridge.calls, bridge.failures) == (1, 1)
+
+
+def test_a_request_that_cannot_be_converted_never_reaches_gazebo(rig: Rig, world: RosWorld) -> None:
+    service = unique("bad_id")
+    rig.add(ServiceBridgeSpec(service, "ros_gz_interfaces/srv/SetEntityPose"))
+    provider = Provider(GzPose, GzBoolean(data=True))
+    rig.gazebo().advertise_service(service, "gz.msgs.Pose", "gz.msgs.Boolean", provider)
+    request = SetEntityPose.Request()
+    request.entity.id = 2**32  # the gz Pose id is a uint32
+    assert call(world, SetEntityPose, service, request).success is False
+    assert provider.requests == []
+
+
+def take_response(client: Any) -> tuple[int, Any]:
+    """The next response the client has, as (sequence number of its request, response)."""
+    deadline = time.monotonic() + WAIT + SERVICE_TIMEOUT
+    while time.monotonic() < deadline:
+        with client.handle:
+            header, response = client.handle.take_response(ControlWorld.Response)
+        if header is not None:
+            return header.request_id.sequence_number, response
+        time.sleep(0.005)
+    pytest.fail("no response")
+
+
+def test_each_call_is_answered_exactly_once(rig: Rig, world: RosWorld) -> None:
+    """Responses of one service come in order, so a second answer to a call would be taken
+    before the answer to the next one. The C++ bridge answers a call whose Gazebo reply
+    comes after the timeout twice; here the late reply is dropped."""
+    service = unique("once")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    caller = world.create_node(f"core_caller_{service.rsplit('_', 1)[-1]}")  # not spun
+    late = threading.Event()
+
+    class HeldOnce(Provider):
+        """Holds its first request until the test has the timeout's answer."""
+
+        def __call__(self, payload: bytes) -> tuple[bool, bytes]:
+            if not self.requests:
+                late.wait(WAIT)
+            return super().__call__(payload)
+
+    try:
+        client = caller.create_client(ControlWorld, service)
+        assert client.wait_for_service(timeout_sec=WAIT)
+        absent = client.handle.send_request(control_request())
+        assert take_response(client) == (absent, ControlWorld.Response(success=False))
+
+        provider = HeldOnce(GzWorldControl, GzBoolean(data=True))
+        rig.gazebo().advertise_service(service, "gz.msgs.WorldControl", "gz.msgs.Boolean", provider)
+        held = client.handle.send_request(control_request())
+        assert take_response(client) == (held, ControlWorld.Response(success=False))
+        late.set()  # Gazebo's reply to the held call comes now, after the timeout
+        served = client.handle.send_request(control_request())
+        assert take_response(client) == (served, ControlWorld.Response(success=True))
+        assert len(provider.requests) == 2
+    finally:
+        late.set()
+        caller.destroy_node()
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert (status.direction, status.ros_name) == ("service", service)
+    assert (status.received, status.published, status.errors) == (3, 1, 2)
