@@ -35,6 +35,15 @@ class ConversionError(BridgeError, ValueError):
     """One message could not be converted; the channel counts it and goes on."""
 
 
+class UndecodableError(ConversionError):
+    """A payload that is not a valid serialized message of its type."""
+
+
+class SizeMismatchError(ConversionError):
+    """Sizes in a message that do not describe its data (an image's step and data, a point
+    cloud's fields, steps and data)."""
+
+
 class TransportError(BridgeError):
     """Gazebo Transport could not be initialised or an operation on it failed."""
 

@@ -12,7 +12,7 @@ from rclpy.serialization import deserialize_message, serialize_message
 
 from ros_gz_bridge_py.bulk.cdr import Layout, locate_bulk
 from ros_gz_bridge_py.bulk.protowire import bytes_field_prefix, split_bytes_field
-from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.errors import ConversionError, UndecodableError
 
 _EMPTY_SEQUENCE = b"\0\0\0\0"
 
@@ -86,7 +86,7 @@ def gz_to_ros_cdr(
         small = gz_class.FromString(rest)
     except DecodeError as err:
         msg = f"{gz_class.DESCRIPTOR.full_name} payload is not a valid message: {err}"
-        raise ConversionError(msg) from err
+        raise UndecodableError(msg) from err
     ros, take = path.gz_meta_to_ros(small, len(bulk))
     if finish is not None:
         finish(ros)

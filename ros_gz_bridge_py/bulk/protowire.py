@@ -8,7 +8,7 @@ to a serialized message sets that field.
 
 from __future__ import annotations
 
-from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.errors import UndecodableError
 
 _VARINT, _I64, _LEN, _I32 = 0, 1, 2, 5
 _MAX_VARINT_BYTES = 10
@@ -20,14 +20,14 @@ def read_varint(buf: memoryview, pos: int) -> tuple[int, int]:
     for shift in range(0, 7 * _MAX_VARINT_BYTES, 7):
         if pos >= len(buf):
             msg = "protobuf payload ends inside a varint"
-            raise ConversionError(msg)
+            raise UndecodableError(msg)
         byte = buf[pos]
         pos += 1
         value |= (byte & 0x7F) << shift
         if byte < 0x80:
             return value, pos
     msg = "protobuf payload has a varint longer than 10 bytes"
-    raise ConversionError(msg)
+    raise UndecodableError(msg)
 
 
 def encode_varint(value: int) -> bytes:
@@ -79,9 +79,9 @@ def split_bytes_field(payload: memoryview, field_number: int) -> tuple[bytes, me
             pos += length
         else:
             msg = f"protobuf payload has unsupported wire type {wire_type} at byte {record}"
-            raise ConversionError(msg)
+            raise UndecodableError(msg)
     if pos != end:
         msg = f"protobuf payload of {end} bytes is truncated (a record runs past its end)"
-        raise ConversionError(msg)
+        raise UndecodableError(msg)
     rest.append(payload[start:end])
     return b"".join(rest), bulk

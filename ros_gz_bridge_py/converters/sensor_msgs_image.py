@@ -31,7 +31,7 @@ from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath, Rows, Take, taken
 from ros_gz_bridge_py.converters._fields import fields
 from ros_gz_bridge_py.converters.std_msgs import HEADER
-from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError
 from ros_gz_bridge_py.msgs import message_class
 
 GzImage = message_class("gz.msgs.Image")
@@ -90,13 +90,13 @@ def image_meta_to_gz(ros: Any, data_size: int) -> tuple[Any, Take]:
             f"sensor_msgs/msg/Image step is {step}, less than width*bytes_per_pixel = "
             f"{width}*{bytes_per_pixel} = {row} for {shape}"
         )
-        raise ConversionError(msg)
+        raise SizeMismatchError(msg)
     if data_size < height * step:
         msg = (
             f"sensor_msgs/msg/Image data has {data_size} bytes, fewer than height*step = "
             f"{height}*{step} = {height * step} for {shape}"
         )
-        raise ConversionError(msg)
+        raise SizeMismatchError(msg)
     gz = GzImage()
     _IMAGE_SIZE.to_gz(ros, gz)
     gz.pixel_format_type = pixel_format
@@ -132,14 +132,14 @@ def image_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
             f"gz.msgs.Image width*bytes_per_pixel = {width}*{bytes_per_pixel} = {step} for "
             f"{shape} does not fit the uint32 step of sensor_msgs/msg/Image"
         )
-        raise ConversionError(msg)
+        raise SizeMismatchError(msg)
     if data_size < height * step:
         msg = (
             f"gz.msgs.Image data has {data_size} bytes, fewer than height*step = "
             f"{height}*{step} = {height * step} for {shape} (step = width*bytes_per_pixel; "
             "the gz step is ignored)"
         )
-        raise ConversionError(msg)
+        raise SizeMismatchError(msg)
     ros = Image()
     _IMAGE_SIZE.to_ros(gz, ros)
     ros.encoding = encoding

@@ -36,7 +36,7 @@ from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters._fields import Value, fields, same
 from ros_gz_bridge_py.converters.std_msgs import HEADER, gz_to_ros_frame
-from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError
 from ros_gz_bridge_py.msgs import message_class
 
 GzLaserScan = message_class("gz.msgs.LaserScan")
@@ -196,7 +196,7 @@ def check_cloud_sizes(type_name: str, fields_name: str, sizes: CloudSizes, data_
         )
     if problems:
         msg = f"{type_name} sizes do not match its data: {'; '.join(problems)}"
-        raise ConversionError(msg)
+        raise SizeMismatchError(msg)
 
 
 def _checked_fields(

@@ -44,13 +44,35 @@ from ros_gz_bridge_py.core.diagnosis import Finding, Flow
 from ros_gz_bridge_py.core.loop_guard import OwnPublications
 from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.rate_limit import rate_limiter
-from ros_gz_bridge_py.transport import GzNode
+from ros_gz_bridge_py.errors import SizeMismatchError, UndecodableError
+from ros_gz_bridge_py.transport import GzNode, Rejection
 
 #: Minimum seconds between two log lines about conversion errors of one channel.
 ERROR_LOG_PERIOD = 5.0
 #: Fewest messages a Gazebo->ROS delivery queue holds: ZeroMQ's default high-water mark, so
 #: 200 ms at 5 kHz (measured: with 100, a 5 kHz Odometry channel dropped 5-9% on 2 busy cores).
 MIN_DELIVERY_QUEUE = 1000
+
+
+#: What a warning about each kind of error adds: where to look.
+_HINTS = {
+    Rejection.UNDECODABLE: "; the publisher does not send valid messages of its type",
+    Rejection.MALFORMED: "; a process that does not speak Gazebo Transport sends on the topic",
+    Rejection.WRONG_TYPE: "; set the bridge's Gazebo type to that one, or stop that publisher",
+    Rejection.OVERSIZE: (
+        "; if the publisher is legitimate, raise GZ_TRANSPORT_MAX_MESSAGE_SIZE (bytes) in the "
+        "bridge's environment"
+    ),
+}
+
+
+def conversion_reason(err: Exception) -> Rejection:
+    """What was wrong with a message the converter refused."""
+    if isinstance(err, UndecodableError):
+        return Rejection.UNDECODABLE
+    if isinstance(err, SizeMismatchError):
+        return Rejection.INCONSISTENT_SIZES
+    return Rejection.CONVERSION
 
 
 class ChannelState(enum.Enum):
@@ -62,22 +84,37 @@ class ChannelState(enum.Enum):
 
 @dataclass
 class ChannelStats:
-    """Counters of one channel; plain ints updated from one thread each, read from any."""
+    """Counters of one channel; plain ints updated from one thread each, read from any.
+
+    Every message the channel could not use counts once in ``errors_by_reason`` under what
+    was wrong (:class:`~ros_gz_bridge_py.transport.Rejection`); those the converter refused
+    also in ``conversion_errors``, those the transport refused (malformed frames, another
+    type, over the size limit) in ``rejected``.
+    """
 
     received: int = 0
     published: int = 0
     conversion_errors: int = 0
+    rejected: int = 0
     own_skipped: int = 0
     #: Dropped by ``max_rate`` before conversion.
     rate_limited: int = 0
     last_error: str = ""
+    errors_by_reason: dict[str, int] = field(default_factory=dict)
     started_at: float = field(default_factory=time.monotonic)
+
+    @property
+    def errors(self) -> int:
+        """Every message the channel could not use."""
+        return self.conversion_errors + self.rejected
 
     def as_dict(self) -> dict[str, int | float | str]:
         return {
             "received": self.received,
             "published": self.published,
+            "errors": self.errors,
             "conversion_errors": self.conversion_errors,
+            "rejected": self.rejected,
             "own_skipped": self.own_skipped,
             "rate_limited": self.rate_limited,
             "last_error": self.last_error,
@@ -139,7 +176,9 @@ class Channel(abc.ABC):
         self.findings: list[Finding] = []
         self.ros_topic = ctx.resolve(spec.ros_topic)
         self._logger = ctx.ros_node.get_logger()
-        self._last_error_log = 0.0
+        # Error counting: from the transport's thread and the delivery thread.
+        self._error_lock = threading.Lock()
+        self._last_error_log: dict[Rejection, float] = {}
         self.bulk: BulkPath | None = self.pair.bulk if ctx.options.bulk_path else None
         self._limiter = rate_limiter(spec.max_rate, ctx.options.max_rate)
 
@@ -187,15 +226,33 @@ class Channel(abc.ABC):
         self.state = ChannelState.CLOSED
 
     def _conversion_failed(self, err: Exception) -> None:
-        self.stats.conversion_errors += 1
-        self.stats.last_error = str(err)
-        now = time.monotonic()
-        if now - self._last_error_log >= ERROR_LOG_PERIOD:
-            self._last_error_log = now
-            self._logger.error(
-                f"{self.describe()}: message skipped: {err} "
-                f"({self.stats.conversion_errors} conversion errors so far)"
-            )
+        """The converter (or the decoder) refused a message: counted under what was wrong."""
+        with self._error_lock:
+            self.stats.conversion_errors += 1
+        self._count_error(conversion_reason(err), str(err))
+
+    def _rejected(self, reason: Rejection, detail: str) -> None:
+        """The transport could not use a message of the channel's Gazebo topic (its
+        ``on_reject``; called on the transport's thread)."""
+        with self._error_lock:
+            self.stats.rejected += 1
+        self._count_error(reason, detail)
+
+    def _count_error(self, reason: Rejection, detail: str) -> None:
+        """Count under ``reason``; a warning per reason at most every ERROR_LOG_PERIOD s."""
+        with self._error_lock:
+            by_reason = self.stats.errors_by_reason
+            by_reason[reason.value] = count = by_reason.get(reason.value, 0) + 1
+            self.stats.last_error = detail  # what was wrong: errors_by_reason
+            now = time.monotonic()
+            if now - self._last_error_log.get(reason, -ERROR_LOG_PERIOD) < ERROR_LOG_PERIOD:
+                return
+            self._last_error_log[reason] = now
+        hint = _HINTS.get(reason, "")
+        self._logger.warning(
+            f"{self.describe()}: message skipped ({reason.value}): {detail} "
+            f"({count} so far, {self.stats.errors} errors in all){hint}"
+        )
 
     @abc.abstractmethod
     def describe(self) -> str: ...

@@ -21,7 +21,7 @@ from ros_gz_bridge_py.bulk.path import gz_to_ros_cdr
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext
-from ros_gz_bridge_py.errors import ConversionError
+from ros_gz_bridge_py.errors import UndecodableError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros.qos import PUBLISHER_OVERRIDES, gz_to_ros_publisher_qos
 from ros_gz_bridge_py.ros.serialized_publisher import SerializedPublisher, object_publisher
@@ -126,6 +126,7 @@ class GzToRosChannel(Channel):
             on_delivery_start=(lambda: yield_cpu_to_light_topics(self.ctx.options.bulk_nice))
             if bulk
             else None,
+            on_reject=self._rejected,
         )
 
     def _close_input(self) -> None:
@@ -147,7 +148,7 @@ class GzToRosChannel(Channel):
             gz_msg = gz_class.FromString(payload)
         except Exception as err:
             self._conversion_failed(
-                ConversionError(
+                UndecodableError(
                     f"undecodable {info.msg_type} payload of {len(payload)} bytes: {err}"
                 )
             )

@@ -12,11 +12,11 @@ Each channel also shows its flow state (waiting for Gazebo, waiting for ROS, flo
 and, when something keeps it from carrying messages, why (``explain.py``).
 
 Levels: WARN when a cause is a misconfiguration (another type, another partition, no Gazebo
-process at all, incompatible QoS), or when conversion errors, queue drops or failed service
-calls happened in the period (messages ``max_rate`` drops are counted apart, as
-``rate_limited``, and are no problem); STALE for a lazy channel whose input side is closed
-(nobody reads its output); OK otherwise (a side that is not there yet is explained, not warned
-about).
+process at all, incompatible QoS), or when errors (messages the channel could not use, by
+what was wrong: ``ChannelStats.errors_by_reason``), queue drops or failed service calls
+happened in the period (messages ``max_rate`` drops are counted apart, as ``rate_limited``,
+and are no problem); STALE for a lazy channel whose input side is closed (nobody reads its
+output); OK otherwise (a side that is not there yet is explained, not warned about).
 
 :func:`serve` is how both executables run a built bridge: spinning, with the table on SIGUSR1.
 """
@@ -84,6 +84,14 @@ class ChannelStatus:
     fault: bool = False
     #: Messages ``max_rate`` dropped (by design: not a problem).
     rate_limited: int = 0
+    #: ``errors`` by what was wrong ("undecodable payload": 3, ...), largest first.
+    errors_by_reason: tuple[tuple[str, int], ...] = ()
+    #: Of ``errors``, those the converter refused (the rest the transport did).
+    conversion_errors: int = 0
+
+    def error_summary(self) -> str:
+        """``"3 undecodable payload, 1 wrong type"`` ("" without errors)."""
+        return ", ".join(f"{count} {reason}" for reason, count in self.errors_by_reason)
 
     @property
     def name(self) -> str:
@@ -108,7 +116,10 @@ class ChannelStatus:
             return "lazy: no subscribers, input side closed"
         if self.level == WARN:
             text = f"{self.new_problems} errors/drops in the last period"
-            return f"{text}: {self.last_error}" if self.last_error else text
+            text = f"{text}: {self.last_error}" if self.last_error else text
+            if self.errors_by_reason:
+                text += f" (errors since start: {self.error_summary()})"
+            return text
         return "ok"
 
     def values(self) -> dict[str, str]:
@@ -122,7 +133,9 @@ class ChannelStatus:
             "state": self.state,
             "received": str(self.received),
             "published": str(self.published),
-            "conversion_errors": str(self.errors),
+            "errors": str(self.errors),
+            "conversion_errors": str(self.conversion_errors),
+            **{f"errors: {reason}": str(count) for reason, count in self.errors_by_reason},
             "dropped": str(self.dropped),
             "rate_limited": str(self.rate_limited),
             "rate_hz": f"{self.rate:.2f}",
@@ -186,7 +199,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
         state=channel.state.value,
         received=stats.received,
         published=stats.published,
-        errors=stats.conversion_errors,
+        errors=stats.errors,
         dropped=channel.dropped if isinstance(channel, GzToRosChannel) else 0,
         rate=0.0,
         new_problems=0,
@@ -195,6 +208,10 @@ def channel_status(channel: Channel) -> ChannelStatus:
         why="\n".join(finding.text for finding in channel.findings),
         fault=any(finding.fault for finding in channel.findings),
         rate_limited=stats.rate_limited,
+        errors_by_reason=tuple(
+            sorted(dict(stats.errors_by_reason).items(), key=lambda item: (-item[1], item[0]))
+        ),
+        conversion_errors=stats.conversion_errors,
     )
 
 
@@ -213,6 +230,7 @@ def service_status(service: ServiceBridge) -> ChannelStatus:
         dropped=0,
         rate=0.0,
         new_problems=0,
+        conversion_errors=service.failures,
     )
 
 
@@ -262,6 +280,11 @@ def format_table(statuses: list[ChannelStatus]) -> str:
         lines += [
             f"why {status.direction} {status.ros_name}: {why}" for why in status.why.splitlines()
         ]
+        if status.errors_by_reason:
+            last = f"; last: {status.last_error}" if status.last_error else ""
+            lines.append(
+                f"errors {status.direction} {status.ros_name}: {status.error_summary()}{last}"
+            )
     return "\n".join(lines)
 
 

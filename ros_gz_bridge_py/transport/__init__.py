@@ -18,6 +18,7 @@ from ros_gz_bridge_py.transport.api import (
     GraphEndpoint,
     MessageInfo,
     NodeOptions,
+    Rejection,
     TopicInfo,
     TransportStats,
 )
@@ -33,6 +34,7 @@ __all__ = [
     "MessageInfo",
     "NodeOptions",
     "Publisher",
+    "Rejection",
     "ServiceOffer",
     "Subscription",
     "TopicInfo",

@@ -13,6 +13,23 @@ from typing import Any
 from ros_gz_bridge_py.msgs.names import Spelling
 
 
+class Rejection(enum.StrEnum):
+    """Why a message that reached a subscription could not be used (the channel counts each)."""
+
+    #: The payload is not a valid message of its type.
+    UNDECODABLE = "undecodable payload"
+    #: The frames are not a Gazebo Transport data message (count, or names that are not text).
+    MALFORMED = "malformed frame"
+    #: A message of a type the subscription does not take.
+    WRONG_TYPE = "wrong type"
+    #: Larger than the maximum message size (``GZ_TRANSPORT_MAX_MESSAGE_SIZE``).
+    OVERSIZE = "over the size limit"
+    #: Sizes in the message that do not describe its data (images, point clouds).
+    INCONSISTENT_SIZES = "inconsistent sizes"
+    #: Any other content the converter refuses.
+    CONVERSION = "conversion error"
+
+
 class Scope(enum.IntEnum):
     """How far an advertisement travels (Discovery.Publisher.Scope, docs/protocol.md §2.6)."""
 
@@ -105,6 +122,16 @@ class TransportStats:
     datagrams_wrong_version: int = 0
     frames_malformed: int = 0
     payloads_undecodable: int = 0
+    #: Messages of a type no subscription of their topic takes.
+    messages_wrong_type: int = 0
+    #: Messages refused for their size (ZeroMQ: connections dropped by libzmq for one).
+    messages_oversize: int = 0
+    #: Publisher addresses from the network that are not ``tcp://host:port``.
+    addresses_refused: int = 0
+    #: Connections to publishers closed because every record at their address went away.
+    publishers_disconnected: int = 0
+    #: Handshakes that failed on credentials (GZ_TRANSPORT_USERNAME/PASSWORD), both ways.
+    auth_failures: int = 0
     unknown_types: int = 0
     peers_expired: int = 0
     messages_received: int = 0
@@ -122,6 +149,8 @@ class TransportStats:
 
 #: Subscription callback: ``callback(payload or message, info)``.
 Callback = Callable[[Any, MessageInfo], None]
+#: Told about each message a subscription could not use: ``on_reject(reason, detail)``.
+RejectCallback = Callable[[Rejection, str], None]
 #: Service handler: ``handler(request bytes) -> (success, response bytes)``.
 ServiceHandler = Callable[[bytes], tuple[bool, bytes]]
 #: Async service callback: ``(True/False, reply)`` on a reply, ``(None, b"")`` on timeout.

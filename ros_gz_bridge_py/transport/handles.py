@@ -5,16 +5,26 @@ their own entities (ZeroMQ records and frames, Zenoh declarations).
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Protocol
 
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, canonical_type
-from ros_gz_bridge_py.transport.api import MessageInfo
+from ros_gz_bridge_py.transport.api import MessageInfo, RejectCallback, Rejection
 from ros_gz_bridge_py.transport.delivery import Deliver, Payload
 from ros_gz_bridge_py.transport.wire_types import WireTypeCache
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.node import GzNode
+
+_LOG = logging.getLogger("ros_gz_bridge_py.transport")
+#: The node counter of each rejection the transport makes.
+_REJECTION_COUNTERS = {
+    Rejection.UNDECODABLE: "payloads_undecodable",
+    Rejection.MALFORMED: "frames_malformed",
+    Rejection.WRONG_TYPE: "messages_wrong_type",
+    Rejection.OVERSIZE: "messages_oversize",
+}
 
 
 class Publisher:
@@ -79,7 +89,8 @@ class Subscription:
     """One subscription: which types it takes, and how its messages reach ``deliver``.
 
     Without a queue (``delivery`` None) messages are delivered on the thread that offers
-    them; with one, on the delivery's own thread.
+    them; with one, on the delivery's own thread. A message of its topic that the transport
+    cannot use is counted on the node and told to ``on_reject`` (:meth:`reject`).
     """
 
     def __init__(
@@ -91,6 +102,7 @@ class Subscription:
         deliver: Deliver,
         *,
         ignore_local: bool,
+        on_reject: RejectCallback | None = None,
     ) -> None:
         self.topic = topic
         self.fqn = fqn
@@ -98,6 +110,7 @@ class Subscription:
         self.names = node.names_of(msg_type)
         self.generic = msg_type == GENERIC_TYPE
         self.ignore_local = ignore_local
+        self.on_reject = on_reject
         self.delivery: Delivery | None = None
         self._node = node
         self._deliver = deliver
@@ -133,6 +146,23 @@ class Subscription:
             return False
         taken = self._taken.get((publisher, canonical_type(msg_type)))
         return taken is None or taken == msg_type
+
+    def forget(self, publisher: str) -> None:
+        """Forget the spellings taken from ``publisher`` (its address was disconnected)."""
+        for key in [key for key in self._taken if key[0] == publisher]:
+            del self._taken[key]
+
+    def reject(self, reason: Rejection, detail: str) -> None:
+        """A message of this topic could not be used: count it and tell ``on_reject`` (from
+        the thread that found it; never raises)."""
+        self._node.count(_REJECTION_COUNTERS.get(reason, "frames_malformed"))
+        if self.on_reject is None or self.closed:
+            return
+        try:
+            self.on_reject(reason, detail)
+        except Exception:
+            self._node.count("callback_errors")
+            _LOG.exception("on_reject of the subscription of %s raised", self.topic)
 
     def offer(self, payload: Payload, info: MessageInfo) -> None:
         """Deliver now (no queue), or queue for the delivery thread."""

@@ -28,6 +28,7 @@ from ros_gz_bridge_py.transport.api import (
     Callback,
     GraphEndpoint,
     MessageInfo,
+    RejectCallback,
     ReplyCallback,
     ServiceHandler,
     TopicInfo,
@@ -189,6 +190,7 @@ class GzNode(abc.ABC):
         queue_size: int | None = None,
         copy: bool = True,
         on_delivery_start: Callable[[], None] | None = None,
+        on_reject: RejectCallback | None = None,
     ) -> Subscription:
         """Receive raw payloads of ``msg_type`` (either spelling; GENERIC_TYPE = any).
 
@@ -196,7 +198,9 @@ class GzNode(abc.ABC):
         N gives the subscription its own delivery thread behind a drop-oldest queue of N
         messages, which first runs ``on_delivery_start`` (e.g. to set its own priority).
         ``copy=False`` hands over the backend's buffer (``bytes`` or a read-only
-        ``memoryview``) instead of copying it into ``bytes``.
+        ``memoryview``) instead of copying it into ``bytes``. ``on_reject(reason, detail)`` is
+        told of each message of the topic the transport could not use (a malformed frame,
+        another type, over ``settings.max_message_size``), on the receiving thread.
 
         Raises:
             ValueError: a queue of no messages, or ``on_delivery_start`` without a queue.
@@ -208,7 +212,7 @@ class GzNode(abc.ABC):
             raise ValueError(msg)
         deliver = raw_deliverer(self.count, callback, copy=copy)
         return self._add_subscription(
-            topic, msg_type, deliver, ignore_local, queue_size, on_delivery_start
+            topic, msg_type, deliver, ignore_local, queue_size, on_delivery_start, on_reject
         )
 
     def subscribe_typed(
@@ -228,9 +232,9 @@ class GzNode(abc.ABC):
         """
         deliver = typed_deliverer(self.count, msg_class, callback)
         wanted = msg_type or msg_class.DESCRIPTOR.full_name
-        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size, None)
+        return self._add_subscription(topic, wanted, deliver, ignore_local, queue_size, None, None)
 
-    def _add_subscription(  # noqa: PLR0917 - private, called with every argument by name above
+    def _add_subscription(  # noqa: PLR0917 - private, called only by the two methods above
         self,
         topic: str,
         msg_type: str,
@@ -238,9 +242,11 @@ class GzNode(abc.ABC):
         ignore_local: bool,
         queue_size: int | None,
         on_start: Callable[[], None] | None,
+        on_reject: RejectCallback | None,
     ) -> Subscription:
         self._check_open()
         sub = self._new_subscription(topic, self.fqn(topic), msg_type, deliver, ignore_local)
+        sub.on_reject = on_reject
         if queue_size is not None:
             sub.delivery = self._open_delivery(sub, queue_size, on_start)
         with self._subscriptions_lock:

@@ -13,7 +13,7 @@ import pwd
 import socket
 import uuid
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ros_gz_bridge_py.msgs.names import Spelling
 
@@ -23,6 +23,10 @@ DEFAULT_MULTICAST_IP = "239.255.0.7"
 DEFAULT_MSG_PORT = 10317
 DEFAULT_SRV_PORT = 10318
 DEFAULT_HWM = 1000
+#: Largest message accepted from the network (ours, not gz's, docs/protocol.md §1.4): a 4K
+#: image of 8 bytes per pixel (66 MB) or a 1080p depth cloud of 32 bytes per point (66 MB)
+#: fits twice over; a 200 MB frame does not.
+DEFAULT_MAX_MESSAGE_SIZE = 128 * 1024 * 1024
 MAX_PORT = 65535
 #: gethostname() buffer size in gz-transport's NetUtils hostname().
 _HOSTNAME_LIMIT = 200
@@ -77,6 +81,27 @@ def _positive(env: Mapping[str, str], name: str, default: int) -> int:
     return value
 
 
+def _max_message_size(env: Mapping[str, str]) -> int:
+    """GZ_TRANSPORT_MAX_MESSAGE_SIZE in bytes; 0 or a bad value: the default (with a warning
+    for a bad value): there is always a limit."""
+    size = _positive(env, "TRANSPORT_MAX_MESSAGE_SIZE", DEFAULT_MAX_MESSAGE_SIZE)
+    return size or DEFAULT_MAX_MESSAGE_SIZE
+
+
+def _credentials(env: Mapping[str, str]) -> tuple[str, str] | None:
+    """(user, password) when both are set and not empty, as gz-transport requires."""
+    user = lookup(env, "TRANSPORT_USERNAME")
+    password = lookup(env, "TRANSPORT_PASSWORD")
+    if user and password:
+        return user, password
+    if user or password:
+        _LOG.warning(
+            "GZ_TRANSPORT_USERNAME and GZ_TRANSPORT_PASSWORD must both be set (and not empty) "
+            "for authentication; only one is, so it is off"
+        )
+    return None
+
+
 @dataclass(frozen=True)
 class TransportSettings:
     """Everything the environment decides about a Gazebo Transport node."""
@@ -90,6 +115,11 @@ class TransportSettings:
     relays: tuple[str, ...] = ()
     rcvhwm: int = DEFAULT_HWM
     sndhwm: int = DEFAULT_HWM
+    #: GZ_TRANSPORT_MAX_MESSAGE_SIZE: larger messages are refused before they are buffered.
+    max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE
+    #: GZ_TRANSPORT_USERNAME and GZ_TRANSPORT_PASSWORD, when both are set and not empty:
+    #: ZeroMQ PLAIN authentication (docs/protocol.md §2.8.6); None otherwise.
+    credentials: tuple[str, str] | None = field(default=None, repr=False)
     #: GZ_TRANSPORT_IMPLEMENTATION, lower-cased: "zeromq" (default) or "zenoh".
     implementation: str = "zeromq"
     #: What ZeroMQ peers of gz-transport 11/12 (Fortress, Garden: no record in their
@@ -115,5 +145,7 @@ class TransportSettings:
             relays=relays,
             rcvhwm=_positive(env, "TRANSPORT_RCVHWM", DEFAULT_HWM),
             sndhwm=_positive(env, "TRANSPORT_SNDHWM", DEFAULT_HWM),
+            max_message_size=_max_message_size(env),
+            credentials=_credentials(env),
             implementation=(env.get("GZ_TRANSPORT_IMPLEMENTATION") or "zeromq").lower(),
         )

@@ -34,6 +34,7 @@ from ros_gz_bridge_py.transport.api import (
     SUBSCRIBER,
     GraphEndpoint,
     MessageInfo,
+    Rejection,
     ReplyCallback,
     ServiceCall,
     ServiceHandler,
@@ -166,10 +167,20 @@ class MemoryGzNode(GzNode):
             node._receive(publisher.fqn, self.address, wire_type, data)
 
     def _receive(self, fqn: str, sender: str, msg_type: str, payload: bytes) -> None:
-        """A message from another node's publisher (§2.8.1 step 8)."""
+        """A message from another node's publisher (§2.8.1 step 8); subscriptions of the topic
+        that do not take its type, or all when it is over the size limit, are told."""
         if self.native is not None and respell(msg_type, self.native) != msg_type:
             return  # a name this line's gz-msgs does not know: dropped, as gz does (§9.1)
-        subs = [s for s in self.subscriptions(fqn) if s.accepts_from(sender, msg_type)]
+        every = self.subscriptions(fqn)
+        for sub in every:
+            if not sub.accepts(msg_type):
+                sub.reject(Rejection.WRONG_TYPE, f"the publisher at {sender} sends {msg_type}")
+        subs = [s for s in every if s.accepts_from(sender, msg_type)]
+        limit = self.settings.max_message_size
+        if len(payload) > limit:
+            for sub in subs:
+                sub.reject(Rejection.OVERSIZE, f"a message of {len(payload)} bytes, over {limit}")
+            return
         if not subs:
             return
         self.count("messages_received")

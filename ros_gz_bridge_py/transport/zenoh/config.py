@@ -98,6 +98,21 @@ def session_config(
     return config
 
 
+#: Zenoh's receive limit (bytes) of a message reassembled from fragments, and its default.
+RX_LIMIT_KEY = "transport/link/rx/max_message_size"
+ZENOH_RX_LIMIT_DEFAULT = 1 << 30
+
+
+def limit_message_size(config: zenoh.Config, limit: int) -> zenoh.Config:
+    """Give Zenoh our maximum message size (GZ_TRANSPORT_MAX_MESSAGE_SIZE) as its receive
+    limit, unless the configuration chose one: Zenoh then drops a larger message before
+    reassembling it (without telling; messages that still arrive larger are counted by the
+    node). gz sets nothing (docs/protocol.md §4.2); the limit applies to what we receive."""
+    if json.loads(config.get_json(RX_LIMIT_KEY)) == ZENOH_RX_LIMIT_DEFAULT:
+        config.insert_json5(RX_LIMIT_KEY, str(limit))
+    return config
+
+
 def endpoints_config(
     mode: str, listen: Iterable[str] = (), connect: Iterable[str] = ()
 ) -> zenoh.Config:

@@ -9,8 +9,10 @@ from typing import TYPE_CHECKING, Any
 
 import zenoh
 
+from ros_gz_bridge_py.transport.api import MessageInfo, Rejection
 from ros_gz_bridge_py.transport.delivery import Deliver
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
+from ros_gz_bridge_py.transport.names import decompose
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
@@ -67,3 +69,33 @@ class ZenohServiceOffer(ServiceOffer):
         super().__init__(node, service, fqn, types, handler)
         #: The queryable and SS token, in declaration order.
         self.entities: list[Any] = []
+
+
+def take_sample(
+    sub: Subscription, sample: zenoh.Sample, partition: str, limit: int
+) -> tuple[bytes, MessageInfo] | None:
+    """A remote sample's payload and info as gz checks it (docs/protocol.md §4.5), or None
+    once ``sub`` was told why not: no or an unreadable type attachment, another type, or a
+    payload over ``limit`` bytes (Zenoh itself drops larger fragmented messages unseen,
+    ``config.limit_message_size``)."""
+    attachment = sample.attachment
+    if attachment is None:
+        sub.reject(Rejection.MALFORMED, "a sample without the type attachment")
+        return None
+    try:
+        msg_type = attachment.to_bytes().decode()
+    except UnicodeDecodeError:
+        sub.reject(Rejection.MALFORMED, "a sample whose type attachment is not UTF-8")
+        return None
+    if not sub.accepts(msg_type):
+        sub.reject(Rejection.WRONG_TYPE, f"a sample of type {msg_type}")
+        return None
+    size = len(sample.payload)
+    if size > limit:
+        sub.reject(
+            Rejection.OVERSIZE,
+            f"a sample of {size} bytes, over {limit} (GZ_TRANSPORT_MAX_MESSAGE_SIZE)",
+        )
+        return None
+    name = (decompose(sub.fqn) or ("", sub.topic))[1]
+    return sample.payload.to_bytes(), MessageInfo(name, msg_type, partition, "", False)

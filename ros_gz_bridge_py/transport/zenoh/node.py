@@ -21,7 +21,8 @@ calls whose deadline passed; a ``request_async`` callback runs once, on it or on
 Zenoh thread. Bad network input never raises out of a Zenoh callback: liveliness samples count
 as ``datagrams_received`` (``datagrams_malformed`` when gz would reject the token), a sample
 without a readable attachment as ``frames_malformed``, one of a type not taken as
-``unknown_types``.
+``messages_wrong_type``, one over the size limit as ``messages_oversize`` (each also told to
+the subscription's ``on_reject``).
 """
 
 from __future__ import annotations
@@ -42,7 +43,6 @@ from ros_gz_bridge_py.msgs.names import Spelling, canonical_type, same_message
 from ros_gz_bridge_py.transport.api import (
     ONE_WAY_TYPES,
     GraphEndpoint,
-    MessageInfo,
     ReplyCallback,
     ServiceCall,
     ServiceHandler,
@@ -53,11 +53,17 @@ from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscrip
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.node import GzNode
 from ros_gz_bridge_py.transport.settings import TransportSettings
-from ros_gz_bridge_py.transport.zenoh.config import Overrides, describe_session, session_config
+from ros_gz_bridge_py.transport.zenoh.config import (
+    Overrides,
+    describe_session,
+    limit_message_size,
+    session_config,
+)
 from ros_gz_bridge_py.transport.zenoh.endpoints import (
     ZenohPublisher,
     ZenohServiceOffer,
     ZenohSubscription,
+    take_sample,
     undeclare,
 )
 from ros_gz_bridge_py.transport.zenoh.graph import ZenohGraph
@@ -129,7 +135,9 @@ class ZenohGzNode(GzNode):
         self._calls: list[_Call] = []
         self._local_calls: collections.deque[_Call] = collections.deque()
         self._stop = False
-        chosen = session_config(config, config_overrides)
+        chosen = limit_message_size(
+            session_config(config, config_overrides), self.settings.max_message_size
+        )
         self._where = describe_session(chosen)
         try:
             self._session = zenoh.open(chosen)
@@ -233,25 +241,12 @@ class ZenohGzNode(GzNode):
         undeclare(*reversed(cast(ZenohSubscription, sub).entities))
 
     def _on_sample(self, sub: Subscription, sample: zenoh.Sample) -> None:
-        """A remote sample on ``sub``'s key: check the attachment as gz does (§4.5)."""
+        """A remote sample on ``sub``'s key: checked as gz does (§4.5), then offered."""
         try:
-            attachment = sample.attachment
-            if attachment is None:
-                self.count("frames_malformed")
-                _LOG.debug("sample without attachment on %s dropped", sub.fqn)
-                return
-            msg_type = attachment.to_bytes().decode()
-            if not sub.accepts(msg_type):
-                self.count("unknown_types")
-                _LOG.debug("sample of type %r on %s dropped", msg_type, sub.fqn)
-                return
-            self.count("messages_received")
-            name = (decompose(sub.fqn) or ("", sub.topic))[1]
-            info = MessageInfo(name, msg_type, self.partition, "", intra_process=False)
-            sub.offer(sample.payload.to_bytes(), info)
-        except UnicodeDecodeError:
-            self.count("frames_malformed")
-            _LOG.debug("sample with a non-UTF-8 attachment on %s dropped", sub.fqn)
+            taken = take_sample(sub, sample, self.partition, self.settings.max_message_size)
+            if taken is not None:
+                self.count("messages_received")
+                sub.offer(*taken)
         except Exception:  # never out of a Zenoh callback
             self.count("io_errors")
             _LOG.exception("unexpected error handling a sample on %s", sub.fqn)

@@ -26,6 +26,7 @@ from ros_gz_bridge_py.transport.zmq.wire import (
     UnknownMessageTypeError,
     decode_discovery,
     encode_discovery,
+    is_tcp_endpoint,
 )
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
@@ -348,6 +349,10 @@ class DiscoveryEngine:
             raise RemoteProtocolError(msg)
         if kind in (DiscoveryType.ADVERTISE, DiscoveryType.UNADVERTISE):
             if not self._in_scope(pub, source_ip):
+                return [], []
+            if kind == DiscoveryType.ADVERTISE and not is_tcp_endpoint(pub.address):
+                self.counts["addresses_refused"] += 1
+                _LOG.debug("discovery: refused address %r from %s", pub.address, source_ip)
                 return [], []
             if kind == DiscoveryType.ADVERTISE:
                 if pub.msg is not None:

@@ -48,10 +48,12 @@ from ros_gz_bridge_py.transport.zmq.discovery import (
     Event,
     Outgoing,
     PublisherAdded,
+    PublisherRemoved,
     SubscriberAdded,
     SubscriberRemoved,
 )
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
+from ros_gz_bridge_py.transport.zmq.intake import DataIntake
 from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader, receive_message
 from ros_gz_bridge_py.transport.zmq.routes import DataRouter
 from ros_gz_bridge_py.transport.zmq.services import PendingCall, RouterSockets, ServiceRouter
@@ -77,6 +79,7 @@ _ENGINE_COUNTS = {
     "datagrams_wrong_version": "wrong_version",
     "peers_expired": "peers_expired",
     "unknown_types": "unknown_type",
+    "addresses_refused": "addresses_refused",
 }
 #: Messages read from one socket per loop turn, so no socket starves the others.
 READ_BATCH = 64
@@ -105,17 +108,16 @@ class ZmqGzNode(GzNode):
         self._io_thread: threading.Thread | None = None
         self._stopping = False
         self._spellings_version = -1
-        self._readers: list[SubscriptionReader] = []
-        # I/O thread only. Like gz, the SUB socket never disconnects from an address: ZMQ
-        # reconnects if the publisher comes back there, and disconnecting a pipe with data in
-        # flight trips a libzmq assertion (fq.cpp, seen with ign-transport11's `-p`).
-        self._sub_connected: set[str] = set()
         self._open_resources()
 
     # --- sockets and the I/O thread -------------------------------------------------------
 
     def _open_resources(self) -> None:
-        self._io = open_sockets(self.settings, self.host)
+        self._io = open_sockets(self.settings, self.host, self.count)
+        # Connections to publishers, and the queued subscriptions' readers (intake.py).
+        self._intake = DataIntake(
+            self, self._io, lambda: self._read_frames(self._io.sub, self._router.on_data)
+        )
         self.host = self._io.host
         self.pub_address = self._io.address(self._io.pub)
         self.replier_address = self._io.address(self._io.replier)
@@ -181,9 +183,9 @@ class ZmqGzNode(GzNode):
 
     def _add_stats(self, counts: dict[str, int]) -> dict[str, int]:
         """The I/O thread's and the readers' received counts, and the discovery counters."""
-        counts["messages_received"] = self._router.received + sum(r.received for r in self._readers)
+        counts["messages_received"] = self._router.received + self._intake.received
         for ours, theirs in _ENGINE_COUNTS.items():
-            counts[ours] = self._msg.counts[theirs] + self._srv.counts[theirs]
+            counts[ours] = counts.get(ours, 0) + self._msg.counts[theirs] + self._srv.counts[theirs]
         return counts
 
     # --- topics -----------------------------------------------------------------------------
@@ -242,13 +244,7 @@ class ZmqGzNode(GzNode):
         self, sub: Subscription, size: int, on_start: Callable[[], None] | None
     ) -> SubscriptionReader:
         """A queued subscription reads its topic's SUB socket on its own thread (reader.py)."""
-        reader = SubscriptionReader(
-            self._io.context, fqn=sub.fqn, partition=self.partition, accepts=sub.accepts_from,
-            deliver=sub.run, size=size, rcvhwm=self.settings.rcvhwm, count=self.count,
-            on_start=on_start,
-        )  # fmt: skip
-        self._readers.append(reader)
-        return reader
+        return self._intake.open_reader(sub, size, on_start)
 
     def _open_subscription(self, sub: Subscription) -> None:
         self._call(lambda: self._start_subscription(cast(ZmqSubscription, sub)))
@@ -271,8 +267,7 @@ class ZmqGzNode(GzNode):
 
     def _close_subscription(self, sub: Subscription, *, last: bool) -> None:
         if sub.delivery is not None:
-            with contextlib.suppress(ValueError):
-                self._readers.remove(cast(SubscriptionReader, sub.delivery))
+            self._intake.close_reader(cast(SubscriptionReader, sub.delivery))
         with contextlib.suppress(TransportError):
             self._call(lambda: self._end_subscription(cast(ZmqSubscription, sub), last=last))
 
@@ -294,17 +289,8 @@ class ZmqGzNode(GzNode):
     def _connect_publisher(self, record: PublisherRecord, subs: Sequence[Subscription]) -> None:
         """§2.8.1 steps 4-5: connect once per address, NEW_CONNECTION if a subscription takes
         the record (docs/protocol.md §9). Queued subscriptions connect their own sockets."""
-        for sub in subs:
-            if sub.delivery is not None:
-                cast(SubscriptionReader, sub.delivery).connect(record.address)
-        if any(s.delivery is None for s in subs) and record.address not in self._sub_connected:
-            try:
-                self._io.sub.connect(record.address)
-            except zmq.ZMQError as error:
-                self.count("frames_malformed")
-                _LOG.debug("cannot connect to publisher %r: %s", record.address, error)
-                return
-            self._sub_connected.add(record.address)
+        if not self._intake.connect(record, subs):
+            return
         taking = [sub for sub in subs if sub.take(record.address, record.msg_type)]
         if taking:
             self._datagrams(self._io.msg_udp, self._msg.connect(record, self.node_uuid))
@@ -414,6 +400,9 @@ class ZmqGzNode(GzNode):
             poller.register(udp.fileno(), zmq.POLLIN)
         for sock in (self._io.sub, self._io.replier, self._io.responses):
             poller.register(sock, zmq.POLLIN)
+        poller.register(self._intake.shared.monitor, zmq.POLLIN)
+        if self._io.zap is not None:
+            poller.register(self._io.zap.socket, zmq.POLLIN)
         while not self._stopping:
             try:
                 ready = dict(poller.poll(int(self._poll_timeout() * 1000)))
@@ -427,6 +416,7 @@ class ZmqGzNode(GzNode):
         if self._services.retrying or self._commands:
             return RETRY_POLL if self._services.retrying else 0.0
         deadline = min(self._msg.next_deadline(), self._srv.next_deadline(), now + MAX_POLL)
+        deadline = min(deadline, self._intake.shared.next_deadline() or deadline)
         return max(0.0, self._services.next_deadline(deadline) - now)
 
     def _io_turn(self, ready: dict[Any, int]) -> None:
@@ -446,7 +436,10 @@ class ZmqGzNode(GzNode):
         for sock, handler in handlers:
             if sock in ready:
                 self._read_frames(sock, handler)
+        if self._io.zap is not None and self._io.zap.socket in ready:
+            self._io.zap.handle()
         now = time.monotonic()
+        self._intake.shared.turn(now)
         for udp, engine in ((self._io.msg_udp, self._msg), (self._io.srv_udp, self._srv)):
             out, events = engine.tick(now)
             self._datagrams(udp, out)
@@ -486,6 +479,8 @@ class ZmqGzNode(GzNode):
                 self._handle_topic_event(event)
             elif isinstance(event, PublisherAdded):
                 self._services.provider_found(event.record.topic)
+            elif isinstance(event, PublisherRemoved):
+                self._services.provider_gone(event.record.address)
         self.graph_changed()
 
     def _handle_topic_event(self, event: Event) -> None:
@@ -493,6 +488,8 @@ class ZmqGzNode(GzNode):
             subs = self.subscriptions(event.record.topic)
             if subs:
                 self._connect_publisher(event.record, subs)
+        elif isinstance(event, PublisherRemoved):
+            self._intake.publisher_gone(event.record, list(self._msg.all_publishers()))
         elif isinstance(event, SubscriberAdded | SubscriberRemoved):
             self._update_subscribers(event.topic)
 

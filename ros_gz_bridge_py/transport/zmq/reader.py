@@ -11,9 +11,16 @@ topic's back-pressure never holds another topic's messages.
 The newest ``size`` messages (and at most ``max_bytes`` of them) wait in the transport's one
 :class:`~ros_gz_bridge_py.transport.delivery.DropOldestQueue`; the socket is drained between
 deliveries, so when the callback is slower than the publisher the oldest are dropped and
-counted, as with ROS "keep last". ZeroMQ sockets are single-threaded: connects from other
-threads are posted to the reader; local (intra-process) messages go into its queue; both wake
-it up.
+counted, as with ROS "keep last". ZeroMQ sockets are single-threaded: connects and
+disconnects from other threads are posted to the reader; local (intra-process) messages go
+into its queue; both wake it up.
+
+After a burst of large messages, freed memory goes back to the system (``heap.py``).
+
+A message of the topic that cannot be used (malformed frames, a type the subscription does
+not take, over the size limit: ``connections.py``) is told to ``reject``; messages of other
+topics that share the topic's name as a prefix (ZeroMQ filters by prefix) are not ours and
+are skipped without a word.
 """
 
 from __future__ import annotations
@@ -31,7 +38,7 @@ from typing import Any
 import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
-from ros_gz_bridge_py.transport.api import MessageInfo
+from ros_gz_bridge_py.transport.api import MessageInfo, Rejection
 from ros_gz_bridge_py.transport.delivery import (
     MAX_QUEUED_BYTES,
     Delivery,
@@ -40,7 +47,11 @@ from ros_gz_bridge_py.transport.delivery import (
     QueueClosedError,
     payload_size,
 )
+from ros_gz_bridge_py.transport.heap import BurstTrimmer
 from ros_gz_bridge_py.transport.names import decompose
+from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.zmq.connections import SubConnections
+from ros_gz_bridge_py.transport.zmq.sockets import subscriber_socket
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
@@ -56,6 +67,9 @@ DELIVERY_SLICE = 0.001
 IDLE_POLL = 0.25
 #: Messages read from the socket per drain, so a flood cannot hold the thread in reading.
 READ_BATCH = 256
+#: What a message's (topic, sender, type) frames make of it: what the callback is told, a
+#: rejection (reason, detail), or None (another topic's).
+Verdict = MessageInfo | tuple[Rejection, str] | None
 
 
 class SubscriptionReader:
@@ -68,9 +82,11 @@ class SubscriptionReader:
         fqn: str,
         partition: str,
         accepts: Callable[[str, str], bool],
+        takes: Callable[[str], bool],
         deliver: Callable[[Frame, MessageInfo], None],
+        reject: Callable[[Rejection, str], None],
         size: int,
-        rcvhwm: int,
+        settings: TransportSettings,
         count: Callable[..., None],
         on_start: Callable[[], None] | None = None,
         max_bytes: int = MAX_QUEUED_BYTES,
@@ -79,25 +95,29 @@ class SubscriptionReader:
         self.received = 0
         self._partition = partition
         self._name = (decompose(fqn) or ("", fqn))[1]
+        self._topic_frame = fqn.encode()
         self._accepts = accepts
+        self._takes = takes
         self._deliver = deliver
+        self._reject = reject
+        self._limit = settings.max_message_size
         self._pending: DropOldestQueue[Delivery] = DropOldestQueue(
             size, weigh=payload_size, max_bytes=max_bytes
         )
         self._count = count
+        self._trimmer = BurstTrimmer()
         self._on_start = on_start
-        self._infos: dict[tuple[Frame, Frame, Frame], MessageInfo | None] = {}
-        self._connected: set[str] = set()
-        self._posted: collections.deque[Callable[[], None]] = collections.deque()
+        self._infos: dict[tuple[Frame, Frame, Frame], Verdict] = {}
+        self._posted: collections.deque[Callable[[], object]] = collections.deque()
         self._closed = False
         self._wake_r, self._wake_w = socket.socketpair()
         self._wake_r.setblocking(False)
         self._wake_w.setblocking(False)
-        self._sock = context.socket(zmq.SUB)
-        self._sock.setsockopt(zmq.LINGER, 0)
-        if rcvhwm:
-            self._sock.setsockopt(zmq.RCVHWM, rcvhwm)
+        self._sock = subscriber_socket(context, settings)
         self._sock.setsockopt(zmq.SUBSCRIBE, fqn.encode())
+        self._connections = SubConnections(
+            self._sock, drain=self._drain, on_refused=self._refused, count=count, what=fqn
+        )
         self._thread = threading.Thread(target=self._run, name=f"gz-sub {self._name}", daemon=True)
         self._thread.start()
 
@@ -105,7 +125,11 @@ class SubscriptionReader:
 
     def connect(self, address: str) -> None:
         """Connect to a publisher of the topic (once per address)."""
-        self._post(lambda: self._connect(address))
+        self._post(lambda: self._connections.connect(address))
+
+    def disconnect(self, address: str) -> None:
+        """Stop connecting to ``address`` (no publisher of the topic is there any more)."""
+        self._post(lambda: self._connections.disconnect(address))
 
     @property
     def dropped(self) -> int:
@@ -130,7 +154,7 @@ class SubscriptionReader:
         if self._thread is not threading.current_thread():
             self._thread.join()
 
-    def _post(self, command: Callable[[], None]) -> None:
+    def _post(self, command: Callable[[], object]) -> None:
         if not self._closed:
             self._posted.append(command)
             self._wake()
@@ -148,9 +172,10 @@ class SubscriptionReader:
             poller = zmq.Poller()
             poller.register(self._sock, zmq.POLLIN)
             poller.register(self._wake_r.fileno(), zmq.POLLIN)
+            poller.register(self._connections.monitor, zmq.POLLIN)
             while not self._closed:
                 try:
-                    poller.poll(0 if len(self._pending) else int(IDLE_POLL * 1000))
+                    poller.poll(self._poll_timeout())
                     self._turn()
                 except zmq.ContextTerminated:  # the node went away without closing us
                     return
@@ -158,9 +183,21 @@ class SubscriptionReader:
                     self._count("io_errors")
                     _LOG.exception("unexpected error reading %s", self.fqn)
         finally:
+            self._connections.close()
             self._sock.close(linger=0)
             self._wake_r.close()
             self._wake_w.close()
+
+    def _poll_timeout(self) -> int:
+        """Milliseconds to wait: none with messages pending, else until the connections
+        have something to do, at most IDLE_POLL."""
+        if len(self._pending):
+            return 0
+        wait = IDLE_POLL
+        deadline = self._connections.next_deadline()
+        if deadline is not None:
+            wait = min(wait, max(0.0, deadline - time.monotonic()))
+        return int(wait * 1000) + 1
 
     def _turn(self) -> None:
         with contextlib.suppress(BlockingIOError):
@@ -168,26 +205,25 @@ class SubscriptionReader:
         while self._posted:
             self._posted.popleft()()
         self._drain()
+        self._connections.turn()
         end = time.monotonic() + DELIVERY_SLICE
         while not self._closed:
             try:
                 payload, info = self._pending.get(block=False)
             except (queue.Empty, QueueClosedError):
+                self._trimmer.idle()  # memory of a burst of large messages goes back
                 return
             self._deliver(payload, info)
             if time.monotonic() >= end:
                 return
 
-    def _connect(self, address: str) -> None:
-        if address in self._connected:
-            return
-        try:
-            self._sock.connect(address)
-        except zmq.ZMQError as error:
-            self._count("frames_malformed")
-            _LOG.debug("cannot connect to publisher %r: %s", address, error)
-            return
-        self._connected.add(address)
+    def _refused(self, address: str) -> None:
+        self._reject(
+            Rejection.OVERSIZE,
+            f"a message from {address} was larger than {self._limit} bytes "
+            "(GZ_TRANSPORT_MAX_MESSAGE_SIZE), or not in ZeroMQ framing: libzmq dropped the "
+            "connection before buffering it; reconnecting",
+        )
 
     def _drain(self) -> None:
         for _ in range(READ_BATCH):
@@ -195,33 +231,46 @@ class SubscriptionReader:
                 frames = receive_message(self._sock)
             except zmq.Again:
                 return
-            try:
-                info = self._info(frames)
-            except RemoteProtocolError as error:
-                self._count("frames_malformed")
-                _LOG.debug("dropped ZMQ message: %s", error)
-                continue
-            if info is not None:
+            verdict = self._verdict(frames)
+            if isinstance(verdict, MessageInfo):
                 self.received += 1
-                self._keep((frames[2], info))
+                self._trimmer.received(len(frames[2]))
+                self._keep((frames[2], verdict))
+            elif verdict is not None:
+                self._reject(*verdict)
 
-    def _info(self, frames: list[Frame]) -> MessageInfo | None:
-        """What the callback is told about a message, None if it is not for us (another topic
-        with our name as prefix, or a type we do not accept); cached per topic, sender, type."""
+    def _verdict(self, frames: list[Frame]) -> Verdict:
+        """What to do with a message (see :data:`Verdict`); cached per topic, sender, type."""
         key = (frames[0], frames[1], frames[3]) if len(frames) == DATA_FRAMES else None
         if key is not None and key in self._infos:
             return self._infos[key]
-        message = decode_data(frames)
-        info = None
-        if message.topic == self.fqn and self._accepts(message.sender, message.msg_type):
-            info = MessageInfo(
-                self._name, message.msg_type, self._partition, message.sender, intra_process=False
-            )
+        verdict = self._judge(frames)
         if key is not None and all(isinstance(frame, bytes) for frame in key):
             if len(self._infos) >= INFO_CACHE_SIZE:
                 self._infos.clear()
-            self._infos[key] = info
-        return info
+            self._infos[key] = verdict
+        return verdict
+
+    def _judge(self, frames: list[Frame]) -> Verdict:
+        try:
+            message = decode_data(frames)
+        except RemoteProtocolError as error:
+            if bytes(frames[0]) != self._topic_frame:
+                self._count("frames_malformed")  # another topic's: not ours to report
+                return None
+            return Rejection.MALFORMED, f"{error} (from a process that is not Gazebo Transport?)"
+        if message.topic != self.fqn:
+            return None
+        if not self._accepts(message.sender, message.msg_type):
+            if self._takes(message.msg_type):
+                return None  # the other spelling of a message already taken (docs/protocol.md §9)
+            return (
+                Rejection.WRONG_TYPE,
+                f"the publisher at {message.sender} sends {message.msg_type}",
+            )
+        return MessageInfo(
+            self._name, message.msg_type, self._partition, message.sender, intra_process=False
+        )
 
     def _keep(self, item: Delivery) -> None:
         """Queue ``item``, dropping the oldest beyond ``size`` messages or ``max_bytes``."""

@@ -3,22 +3,25 @@
 §2.8.1 step 8: the exact fully qualified name (ZeroMQ filters by prefix), and a spelling
 the subscription takes from that sender (docs/protocol.md §9). A (topic, sender, type) seen
 before takes its cached route: no decoding, no matching; the node empties the cache whenever
-a subscription starts or ends (on the same thread).
+a subscription starts or ends (on the same thread). Subscriptions of the exact topic that
+do not take the message's type, or that get malformed frames, are told (``reject``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from ros_gz_bridge_py.transport.api import MessageInfo
+from ros_gz_bridge_py.errors import RemoteProtocolError
+from ros_gz_bridge_py.transport.api import MessageInfo, Rejection
 from ros_gz_bridge_py.transport.handles import Subscription
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
 
 #: Cached routes (topic, sender, type frames -> subscriptions, info); cleared beyond this size.
 ROUTE_CACHE_SIZE = 1024
-#: Where received data goes: the subscriptions that accept it, and what they are told.
-Route = tuple[tuple[Subscription, ...], MessageInfo]
+#: Where received data goes: the subscriptions that accept it, what they are told, and those
+#: of the topic that do not take its type.
+Route = tuple[tuple[Subscription, ...], MessageInfo, tuple[Subscription, ...]]
 
 
 class DataRouter:
@@ -46,31 +49,60 @@ class DataRouter:
         if len(frames) == DATA_FRAMES:
             route = self._routes.get((frames[0], frames[1], frames[3]))
             if route is not None:
-                self.received += 1
-                subs, info = route
+                subs, info, wrong = route
                 payload = frames[2]
                 for sub in subs:
                     sub.offer(payload, info)
+                self._wrong_type(wrong, info)
+                self.received += bool(subs)
                 return
         self._route(frames)
 
     def _route(self, frames: list[Frame]) -> None:
-        message = decode_data(frames)
+        try:
+            message = decode_data(frames)
+        except RemoteProtocolError as error:
+            ours = self._unqueued(_text_or_empty(frames[0]))
+            if not ours:
+                raise
+            for sub in ours:
+                sub.reject(Rejection.MALFORMED, str(error))
+            return
         # Queued subscriptions read their own sockets: a message for a topic that has only
         # those reached this socket by prefix (ZeroMQ matches prefixes) and is not ours.
-        subs = tuple(s for s in self._subscriptions(message.topic) if s.delivery is None)
+        subs = self._unqueued(message.topic)
         if not subs:
             return
-        self.received += 1
         name = (decompose(message.topic) or ("", message.topic))[1]
         info = MessageInfo(
             name, message.msg_type, self._partition, message.sender, intra_process=False
         )
         accepting = tuple(s for s in subs if s.accepts_from(message.sender, message.msg_type))
+        wrong = tuple(s for s in subs if not s.accepts(message.msg_type))
         key = (frames[0], frames[1], frames[3])
         if all(isinstance(frame, bytes) for frame in key):
             if len(self._routes) >= ROUTE_CACHE_SIZE:
                 self._routes.clear()
-            self._routes[key] = (accepting, info)
+            self._routes[key] = (accepting, info, wrong)
+        self.received += bool(accepting)
         for sub in accepting:
             sub.offer(message.payload, info)
+        self._wrong_type(wrong, info)
+
+    def _unqueued(self, fqn: str) -> tuple[Subscription, ...]:
+        return tuple(s for s in self._subscriptions(fqn) if s.delivery is None)
+
+    @staticmethod
+    def _wrong_type(subs: tuple[Subscription, ...], info: MessageInfo) -> None:
+        for sub in subs:
+            sub.reject(
+                Rejection.WRONG_TYPE,
+                f"the publisher at {info.publisher_address} sends {info.msg_type}",
+            )
+
+
+def _text_or_empty(frame: Frame) -> str:
+    try:
+        return bytes(frame).decode()
+    except UnicodeDecodeError:
+        return ""

@@ -10,6 +10,7 @@ the sockets and the discovery engine and hands them in.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import logging
 import time
@@ -33,6 +34,7 @@ from ros_gz_bridge_py.transport.zmq.wire import (
     decode_response,
     encode_request,
     encode_response,
+    is_tcp_endpoint,
 )
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
@@ -117,8 +119,13 @@ class ServiceRouter:
             self._count("requests_unhandled")
             _LOG.debug("no handler for service request %s", key)
             return
+        one_way = request.response_type in ONE_WAY_TYPES
+        if not one_way and not is_tcp_endpoint(request.response_address):
+            self._count("addresses_refused")  # docs/protocol.md §2.3.1: tcp:// only
+            _LOG.debug("service request with response address %r", request.response_address)
+            return
         ok, payload = self._run_handler(offer, bytes(request.payload))
-        if request.response_type in ONE_WAY_TYPES:
+        if one_way:
             return
         replier = self._io.replier
         _connect_once(replier, request.response_address, self._replier_connected)
@@ -140,6 +147,17 @@ class ServiceRouter:
         self._calls[call.request_uuid] = call
         if not self._dispatch(call):
             self._io.announce(self._io.engine.subscribe(call.fqn))
+
+    def provider_gone(self, address: str) -> None:
+        """A provider record went away: disconnect the requester from its address when no
+        provider is left there (the requester only sends, so no message is half read)."""
+        if address not in self._requester_connected:
+            return
+        if any(r.address == address for r in self._io.engine.all_publishers()):
+            return
+        self._requester_connected.discard(address)
+        with contextlib.suppress(zmq.ZMQError):
+            self._io.requester.disconnect(address)
 
     def provider_found(self, fqn: str) -> None:
         """A provider of ``fqn`` was discovered: send the calls that waited for one."""

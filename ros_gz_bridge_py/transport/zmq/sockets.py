@@ -6,6 +6,7 @@ import contextlib
 import socket
 import threading
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -13,6 +14,8 @@ import zmq
 
 from ros_gz_bridge_py.errors import TransportError
 from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.zmq.auth import ZAP_DOMAIN, ZapHandler
+from ros_gz_bridge_py.transport.zmq.connections import MAX_BACKOFF
 from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket
 
 
@@ -33,6 +36,8 @@ class NodeSockets:
     response_id: str
     wake_r: socket.socket
     wake_w: socket.socket
+    #: The ZAP handler when authentication is on (GZ_TRANSPORT_USERNAME/PASSWORD).
+    zap: ZapHandler | None = None
     pub_lock: threading.Lock = field(default_factory=threading.Lock)
 
     @property
@@ -58,8 +63,11 @@ class NodeSockets:
         self.wake_w.close()
 
 
-def open_sockets(settings: TransportSettings, host: str) -> NodeSockets:
-    """Every socket of a node, bound on ``host``.
+def open_sockets(
+    settings: TransportSettings, host: str, count: Callable[..., None] | None = None
+) -> NodeSockets:
+    """Every socket of a node, bound on ``host`` (``count``: the node's counters, for the ZAP
+    handler).
 
     Raises:
         TransportError: a socket cannot be opened (nothing is left open).
@@ -71,13 +79,18 @@ def open_sockets(settings: TransportSettings, host: str) -> NodeSockets:
         for port in (settings.msg_port, settings.srv_port):
             opened.append(DiscoverySocket(settings.multicast_ip, port, host))
         host = opened[0].interface_ip
+        zap = (
+            None
+            if settings.credentials is None
+            else ZapHandler(context, settings.credentials, count)
+        )
         replier_id, response_id = str(uuid.uuid4()), str(uuid.uuid4())
         sockets = NodeSockets(
             context=context,
             msg_udp=opened[0],
             srv_udp=opened[1],
-            pub=_bound(context, host, zmq.PUB, sndhwm=settings.sndhwm),
-            sub=_socket(context, zmq.SUB, rcvhwm=settings.rcvhwm),
+            pub=_publisher(context, host, settings),
+            sub=subscriber_socket(context, settings),
             replier=_bound(context, host, zmq.ROUTER, routing_id=replier_id, mandatory=True),
             requester=_socket(context, zmq.ROUTER, mandatory=True),
             responses=_bound(context, host, zmq.ROUTER, routing_id=response_id),
@@ -85,7 +98,10 @@ def open_sockets(settings: TransportSettings, host: str) -> NodeSockets:
             response_id=response_id,
             wake_r=wake_r,
             wake_w=wake_w,
+            zap=zap,
         )
+        for sock in (sockets.replier, sockets.requester, sockets.responses):
+            limit_input(sock, settings)
     except (OSError, zmq.ZMQError) as error:
         for udp in opened:
             udp.close()
@@ -97,6 +113,37 @@ def open_sockets(settings: TransportSettings, host: str) -> NodeSockets:
     wake_r.setblocking(False)
     wake_w.setblocking(False)
     return sockets
+
+
+def limit_input(sock: Any, settings: TransportSettings) -> None:
+    """Refuse frames over the maximum message size before they are buffered (§2.8.7), and
+    retry an address that failed with a growing delay, up to MAX_BACKOFF."""
+    sock.setsockopt(zmq.MAXMSGSIZE, settings.max_message_size)
+    sock.setsockopt(zmq.RECONNECT_IVL_MAX, int(MAX_BACKOFF * 1000))
+
+
+def subscriber_socket(context: Any, settings: TransportSettings) -> Any:
+    """A SUB socket: RCVHWM, the size limit, and a PLAIN client with credentials (§2.8.6)."""
+    sock = _socket(context, zmq.SUB, rcvhwm=settings.rcvhwm)
+    limit_input(sock, settings)
+    if settings.credentials is not None:
+        user, password = settings.credentials
+        sock.setsockopt(zmq.PLAIN_USERNAME, user.encode())
+        sock.setsockopt(zmq.PLAIN_PASSWORD, password.encode())
+    return sock
+
+
+def _publisher(context: Any, host: str, settings: TransportSettings) -> Any:
+    """The PUB socket: a PLAIN server in ZAP domain ``gz-auth`` with credentials (§2.8.6);
+    the ZAP handler (``auth.py``) must be bound before, or libzmq lets everyone in."""
+    sock = _socket(context, zmq.PUB)
+    if settings.sndhwm:
+        sock.setsockopt(zmq.SNDHWM, settings.sndhwm)
+    if settings.credentials is not None:
+        sock.setsockopt(zmq.ZAP_DOMAIN, ZAP_DOMAIN.encode())
+        sock.setsockopt(zmq.PLAIN_SERVER, 1)
+    sock.bind(f"tcp://{host}:*")
+    return sock
 
 
 def _socket(

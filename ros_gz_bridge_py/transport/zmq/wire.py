@@ -10,6 +10,7 @@ Decoders raise :class:`RemoteProtocolError` for anything a peer should not have 
 from __future__ import annotations
 
 import enum
+import re
 import struct
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -34,6 +35,17 @@ RESULT_OK = b"1"
 RESULT_FAILED = b"0"
 
 _LENGTH = struct.Struct("<H")
+#: A publisher address we connect to: ``tcp://`` with a host name, IPv4 or [IPv6], and a port.
+_TCP_ENDPOINT = re.compile(r"tcp://(?:[A-Za-z0-9.-]+|\[[0-9A-Fa-f:.]+\]):([0-9]{1,5})")
+_MAX_PORT = 65535
+
+
+def is_tcp_endpoint(address: str) -> bool:
+    """True for ``tcp://host:port`` (port 1-65535), the only addresses gz advertises and the
+    only ones we connect to when the network names them (docs/protocol.md §2.3.1): never
+    ``ipc://``, ``inproc://`` or an interface-qualified form."""
+    match = _TCP_ENDPOINT.fullmatch(address)
+    return match is not None and 0 < int(match[1]) <= _MAX_PORT
 
 
 class UnknownMessageTypeError(RemoteProtocolError):

@@ -9,6 +9,7 @@ Interoperability with real Gazebo is tested elsewhere (tests/interop, against ig
 
 from __future__ import annotations
 
+import dataclasses
 import socket
 import threading
 import time
@@ -20,7 +21,7 @@ import pytest
 from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import same_message
-from ros_gz_bridge_py.transport import BACKENDS, GzNode, MessageInfo
+from ros_gz_bridge_py.transport import BACKENDS, GzNode, MessageInfo, Rejection, TransportSettings
 from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER
 from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
 from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
@@ -65,20 +66,25 @@ def _free_port() -> int:
         return port
 
 
-def _zenoh_pair() -> tuple[GzNode, GzNode]:
+def _zenoh_pair(settings: TransportSettings | None = None) -> tuple[GzNode, GzNode]:
     where = f"tcp/127.0.0.1:{_free_port()}"
-    a = ZenohGzNode(config=endpoints_config("peer", listen=[where]))
-    b = ZenohGzNode(config=endpoints_config("peer", connect=[where]))
+    a = ZenohGzNode(settings=settings, config=endpoints_config("peer", listen=[where]))
+    b = ZenohGzNode(settings=settings, config=endpoints_config("peer", connect=[where]))
     return a, b
 
 
-def _memory_pair() -> tuple[GzNode, GzNode]:
+def _memory_pair(settings: TransportSettings | None = None) -> tuple[GzNode, GzNode]:
     network = MemoryNetwork()
-    return MemoryGzNode(network=network), MemoryGzNode(network=network)
+    return (
+        MemoryGzNode(settings=settings, network=network),
+        MemoryGzNode(settings=settings, network=network),
+    )
 
 
-MAKERS: dict[str, Callable[[], tuple[GzNode, GzNode]]] = {
-    "zeromq": lambda: (ZmqGzNode(), ZmqGzNode()),
+#: Two nodes of each backend that see each other, with the given settings (None: from the
+#: environment).
+MAKERS: dict[str, Callable[[TransportSettings | None], tuple[GzNode, GzNode]]] = {
+    "zeromq": lambda settings: (ZmqGzNode(settings=settings), ZmqGzNode(settings=settings)),
     "zenoh": _zenoh_pair,
     "memory": _memory_pair,
 }
@@ -91,8 +97,22 @@ def test_every_registered_backend_is_under_contract() -> None:
 @pytest.fixture(params=sorted(MAKERS))
 def pair(request: pytest.FixtureRequest) -> Iterator[tuple[GzNode, GzNode]]:
     """Two nodes of one backend that see each other."""
-    a, b = MAKERS[request.param]()
+    a, b = MAKERS[request.param](None)
     yield a, b
+    a.close()
+    b.close()
+
+
+#: The maximum message size of :func:`limited_pair`.
+SMALL_LIMIT = 100_000
+
+
+@pytest.fixture(params=sorted(MAKERS))
+def limited_pair(request: pytest.FixtureRequest) -> Iterator[tuple[str, GzNode, GzNode]]:
+    """Two nodes of one backend whose maximum message size is :data:`SMALL_LIMIT`."""
+    settings = dataclasses.replace(TransportSettings.from_env(), max_message_size=SMALL_LIMIT)
+    a, b = MAKERS[request.param](settings)
+    yield request.param, a, b
     a.close()
     b.close()
 
@@ -168,6 +188,46 @@ def test_another_type_is_not_delivered(pair: tuple[GzNode, GzNode]) -> None:
     pub = a.advertise(topic, GZ)
     assert publish_until(lambda: pub.publish(StringMsg(data="x")), lambda: bool(right.items))
     assert wrong.items == []
+
+
+def test_another_type_is_told_to_on_reject(pair: tuple[GzNode, GzNode]) -> None:
+    """issue 14: a message of the topic that a subscription does not take is counted and told,
+    never dropped without a word."""
+    a, b = pair
+    topic = unique("wrong")
+    told: list[tuple[Rejection, str]] = []
+    right = Inbox()
+    b.subscribe(topic, Inbox(), "gz.msgs.Int32", queue_size=10, on_reject=lambda *r: told.append(r))
+    b.subscribe(topic, right, GZ)
+    pub = a.advertise(topic, GZ)
+    assert publish_until(lambda: pub.publish(StringMsg(data="x")), lambda: bool(told))
+    assert told[0][0] is Rejection.WRONG_TYPE
+    assert GZ in told[0][1]
+    assert b.stats.messages_wrong_type >= 1
+
+
+def test_messages_over_the_size_limit_are_refused(
+    limited_pair: tuple[str, GzNode, GzNode],
+) -> None:
+    """issue 14: a message over ``max_message_size`` never reaches the callback, later ones
+    do. ZeroMQ and memory count it and tell ``on_reject``; Zenoh is given the limit and drops
+    such a message inside Zenoh, which reports nothing (docs/protocol.md §4.2)."""
+    backend, a, b = limited_pair
+    topic = unique("big")
+    inbox = Inbox()
+    told: list[tuple[Rejection, str]] = []
+    b.subscribe(topic, inbox, GZ, queue_size=10, on_reject=lambda *r: told.append(r))
+    pub = a.advertise(topic, GZ)
+    assert wait_until(pub.has_connections)
+    small = StringMsg(data="small").SerializeToString()
+    assert publish_until(lambda: pub.publish_raw(small), lambda: bool(inbox.items))
+    pub.publish(StringMsg(data="x" * (2 * SMALL_LIMIT)))
+    if backend != "zenoh":
+        assert wait_until(lambda: [r for r, _ in told] == [Rejection.OVERSIZE])
+        assert b.stats.messages_oversize == 1
+    before = len(inbox.items)
+    assert publish_until(lambda: pub.publish_raw(small), lambda: len(inbox.items) > before)
+    assert set(inbox.texts()) == {"small"}
 
 
 def test_local_delivery_and_ignore_local(pair: tuple[GzNode, GzNode]) -> None:

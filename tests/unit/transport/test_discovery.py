@@ -265,6 +265,29 @@ def test_bye_unadvertises_everything() -> None:
     assert list(engine.all_publishers()) == []
 
 
+def test_only_tcp_addresses_are_taken_from_advertisements() -> None:
+    """issue 14: a datagram must not make us connect to a unix socket or an in-process
+    endpoint; ``tcp://host:port`` only."""
+    engine = DiscoveryEngine(ME, 0.0)
+    refused = [
+        "ipc:///tmp/socket",
+        "inproc://zeromq.zap.01",
+        "tcp://127.0.0.1:0",
+        "tcp://127.0.0.1:70000",
+        "tcp://eth0;127.0.0.1:5",
+        "tcp://127.0.0.1",
+        "",
+    ]
+    for address in refused:
+        ad = datagram(DiscoveryType.ADVERTISE, pub=record(address=address))
+        assert engine.datagram_received(ad, "127.0.0.1", 0.0) == ([], [])
+    assert engine.counts["addresses_refused"] == len(refused)
+    for address in ("tcp://127.0.0.1:5000", "tcp://robot-1.local:6000", "tcp://[::1]:7000"):
+        ad = datagram(DiscoveryType.ADVERTISE, pub=record(address=address))
+        events = engine.datagram_received(ad, "127.0.0.1", 0.0)[1]
+        assert events[-1] == PublisherAdded(record(address=address))  # (after the moved one)
+
+
 def test_a_publisher_that_readvertises_rarely_stays_known() -> None:
     """gz-transport after 15 re-ADVERTISEs only on a change, for a new peer, or every tenth
     heartbeat: heartbeats alone must keep its records (docs/protocol.md §2.5)."""

@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import socket
 
-from ros_gz_bridge_py.transport.settings import TransportSettings, default_partition
+from ros_gz_bridge_py.transport.settings import (
+    DEFAULT_MAX_MESSAGE_SIZE,
+    TransportSettings,
+    default_partition,
+)
 
 
 def test_defaults_without_environment() -> None:
@@ -61,3 +65,25 @@ def test_hwm_and_implementation() -> None:
 def test_default_partition_uses_user_first() -> None:
     assert default_partition({"USER": "bob"}).endswith(":bob")
     assert ":" in default_partition({})
+
+
+def test_max_message_size() -> None:
+    assert TransportSettings.from_env({}).max_message_size == DEFAULT_MAX_MESSAGE_SIZE
+    assert DEFAULT_MAX_MESSAGE_SIZE < 200_000_000  # the attack's frames are refused
+    assert DEFAULT_MAX_MESSAGE_SIZE > 3840 * 2160 * 8  # a 4K image of 8 bytes per pixel is not
+    env = {"GZ_TRANSPORT_MAX_MESSAGE_SIZE": "1000", "IGN_TRANSPORT_MAX_MESSAGE_SIZE": "9"}
+    assert TransportSettings.from_env(env).max_message_size == 1000
+    assert TransportSettings.from_env({"IGN_TRANSPORT_MAX_MESSAGE_SIZE": "9"}).max_message_size == 9
+    for bad in ("-1", "lots", "0"):  # there is always a limit
+        settings = TransportSettings.from_env({"GZ_TRANSPORT_MAX_MESSAGE_SIZE": bad})
+        assert settings.max_message_size == DEFAULT_MAX_MESSAGE_SIZE
+
+
+def test_credentials_need_both_names_and_stay_out_of_repr() -> None:
+    both = {"GZ_TRANSPORT_USERNAME": "u", "GZ_TRANSPORT_PASSWORD": "p"}
+    assert TransportSettings.from_env(both).credentials == ("u", "p")
+    fortress = {"IGN_TRANSPORT_USERNAME": "u", "IGN_TRANSPORT_PASSWORD": "p"}
+    assert TransportSettings.from_env(fortress).credentials == ("u", "p")
+    assert TransportSettings.from_env({"GZ_TRANSPORT_USERNAME": "u"}).credentials is None
+    assert TransportSettings.from_env({**both, "GZ_TRANSPORT_PASSWORD": ""}).credentials is None
+    assert "p'" not in repr(TransportSettings.from_env(both))

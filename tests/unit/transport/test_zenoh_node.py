@@ -263,7 +263,7 @@ def test_bad_input_is_counted_and_skipped(pair: tuple[ZenohGzNode, Peer]) -> Non
     assert received.empty()
     after = node.stats
     assert after.frames_malformed == before.frames_malformed + 1
-    assert after.unknown_types == before.unknown_types + 1
+    assert after.messages_wrong_type == before.messages_wrong_type + 1
     assert after.payloads_undecodable == before.payloads_undecodable + 1
     assert wait_until(lambda: node.stats.datagrams_malformed > before.datagrams_malformed)
     assert node.stats.io_errors == 0

@@ -1,0 +1,110 @@
+"""Where a ZeroMQ node's data comes in: the shared SUB socket and the queued subscriptions'
+readers, connected to publishers as discovery learns them and disconnected when they go.
+
+§2.8.1 step 4 connects a SUB socket once per publisher address. We also disconnect: when
+the last remote record at an address goes away for a topic (UNADVERTISE, BYE, a process
+silent for 3 s, §2.5), the readers of that topic disconnect from it, and the shared socket
+does once no record at all is left there. gz never disconnects; without it, addresses of a
+peer that is gone are retried for ever (docs/protocol.md §2.8.7). Everything here runs on the
+I/O thread; readers do their part on their own threads.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, cast
+
+from ros_gz_bridge_py.transport.handles import Subscription
+from ros_gz_bridge_py.transport.zmq.connections import SubConnections
+from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader
+from ros_gz_bridge_py.transport.zmq.sockets import NodeSockets
+from ros_gz_bridge_py.transport.zmq.wire import PublisherRecord
+
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
+
+_LOG = logging.getLogger("ros_gz_bridge_py.transport")
+#: Seconds between two warnings about refused messages on the shared SUB socket.
+WARN_PERIOD = 5.0
+
+
+class DataIntake:
+    """The node's SUB connections and readers (I/O thread, except :meth:`open_reader`)."""
+
+    def __init__(
+        self, node: ZmqGzNode, sockets: NodeSockets, drain_shared: Callable[[], None]
+    ) -> None:
+        self._node = node
+        self._context = sockets.context
+        self.readers: list[SubscriptionReader] = []
+        self.shared = SubConnections(
+            sockets.sub,
+            drain=drain_shared,
+            on_refused=self._refused_shared,
+            count=node.count,
+            what="the node's SUB socket",
+        )
+        self._last_warning = 0.0
+
+    @property
+    def received(self) -> int:
+        """Messages the readers accepted."""
+        return sum(reader.received for reader in self.readers)
+
+    def open_reader(
+        self, sub: Subscription, size: int, on_start: Callable[[], None] | None
+    ) -> SubscriptionReader:
+        """A queued subscription's own SUB socket and thread (``reader.py``)."""
+        node = self._node
+        reader = SubscriptionReader(
+            self._context, fqn=sub.fqn, partition=node.partition, accepts=sub.accepts_from,
+            takes=sub.accepts, deliver=sub.run, reject=sub.reject, size=size,
+            settings=node.settings, count=node.count, on_start=on_start,
+        )  # fmt: skip
+        self.readers.append(reader)
+        return reader
+
+    def close_reader(self, reader: SubscriptionReader) -> None:
+        if reader in self.readers:
+            self.readers.remove(reader)
+
+    def connect(self, record: PublisherRecord, subs: Sequence[Subscription]) -> bool:
+        """§2.8.1 step 4: connect to ``record``'s address, the shared socket once per address
+        and each queued subscription's reader; False if the address cannot be connected."""
+        for sub in subs:
+            if sub.delivery is not None:
+                cast(SubscriptionReader, sub.delivery).connect(record.address)
+        if any(s.delivery is None for s in subs):
+            return self.shared.connect(record.address)
+        return True
+
+    def publisher_gone(self, record: PublisherRecord, remaining: Sequence[PublisherRecord]) -> None:
+        """``record`` went away; ``remaining`` are the remote records still known (all topics).
+
+        Readers of its topic disconnect when no record of the topic is left at its address;
+        the shared socket when no record at all is.
+        """
+        address = record.address
+        if any(r.address == address and r.topic == record.topic for r in remaining):
+            return
+        for sub in self._node.subscriptions(record.topic):
+            sub.forget(address)
+            if sub.delivery is not None:
+                cast(SubscriptionReader, sub.delivery).disconnect(address)
+        if address in self.shared.connected and not any(r.address == address for r in remaining):
+            self.shared.disconnect(address)
+
+    def _refused_shared(self, address: str) -> None:
+        """A message refused on the shared socket: its topic is unknown, so the node counts it."""
+        self._node.count("messages_oversize")
+        now = time.monotonic()
+        if now - self._last_warning >= WARN_PERIOD:
+            self._last_warning = now
+            _LOG.warning(
+                "dropped a message from %s larger than %d bytes (GZ_TRANSPORT_MAX_MESSAGE_SIZE) "
+                "or not in ZeroMQ framing; raise the limit if the publisher is legitimate",
+                address,
+                self._node.settings.max_message_size,
+            )
