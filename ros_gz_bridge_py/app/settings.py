@@ -52,6 +52,16 @@ LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
 CDR_WRITE_ENV = "ROS_GZ_BRIDGE_CDR_WRITE"
 
 
+#: The switches that are :class:`BridgeOptions` of the same names (how messages travel).
+MESSAGE_PATH_SWITCHES = (
+    "bulk_path",
+    "rcl_serialized_publish",
+    "bulk_nice",
+    "light_read",
+    "cdr_write",
+)
+
+
 @dataclass(frozen=True)
 class Switches:
     """The ``ROS_GZ_BRIDGE_*`` environment switches; the defaults are the fast settings."""
@@ -159,11 +169,7 @@ class SharedParameters:
             override_timestamps_with_wall_time=self.override_timestamps_with_wall_time,
             override_frame_id=self.override_frame_id,
             service_timeout=service_timeout,
-            bulk_path=switches.bulk_path,
-            rcl_serialized_publish=switches.rcl_serialized_publish,
-            bulk_nice=switches.bulk_nice,
-            light_read=switches.light_read,
-            cdr_write=switches.cdr_write,
+            **{name: getattr(switches, name) for name in MESSAGE_PATH_SWITCHES},
             gz_version=gz_version,
             max_rate=max_rate,
         )

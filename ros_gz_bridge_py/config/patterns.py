@@ -77,6 +77,18 @@ class TopicPattern:
         values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(spec)}
         return cls(**{**values, "direction": direction})
 
+    def completed(
+        self, ros_topic: str, gz_topic: str, types: tuple[str, str], direction: Direction
+    ) -> TopicBridgeSpec:
+        """The entry this pattern makes of one discovered topic (``types``: ROS, Gazebo): its
+        own settings, the rest completed."""
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(TopicBridgeSpec)}
+        ros_type, gz_type = types
+        return TopicBridgeSpec(**{
+            **values, "ros_topic": ros_topic, "gz_topic": gz_topic,
+            "ros_type": ros_type, "gz_type": gz_type, "direction": direction,
+        })  # fmt: skip
+
     @cached_property
     def _regex(self) -> re.Pattern[str]:
         parts = _WILDCARD.split(self.gz_topic)

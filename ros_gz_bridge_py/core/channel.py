@@ -46,6 +46,7 @@ from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.rate_limit import rate_limiter
 from ros_gz_bridge_py.errors import SizeMismatchError, UndecodableError
 from ros_gz_bridge_py.transport import GzNode, Rejection
+from ros_gz_bridge_py.transport.throttle import Throttle
 
 #: Minimum seconds between two log lines about conversion errors of one channel.
 ERROR_LOG_PERIOD = 5.0
@@ -178,7 +179,7 @@ class Channel(abc.ABC):
         self._logger = ctx.ros_node.get_logger()
         # Error counting: from the transport's thread and the delivery thread.
         self._error_lock = threading.Lock()
-        self._last_error_log: dict[Rejection, float] = {}
+        self._error_log = Throttle(ERROR_LOG_PERIOD)
         self.bulk: BulkPath | None = self.pair.bulk if ctx.options.bulk_path else None
         self._limiter = rate_limiter(spec.max_rate, ctx.options.max_rate)
 
@@ -244,10 +245,8 @@ class Channel(abc.ABC):
             by_reason = self.stats.errors_by_reason
             by_reason[reason.value] = count = by_reason.get(reason.value, 0) + 1
             self.stats.last_error = detail  # what was wrong: errors_by_reason
-            now = time.monotonic()
-            if now - self._last_error_log.get(reason, -ERROR_LOG_PERIOD) < ERROR_LOG_PERIOD:
+            if not self._error_log.ready(reason):
                 return
-            self._last_error_log[reason] = now
         hint = _HINTS.get(reason, "")
         self._logger.warning(
             f"{self.describe()}: message skipped ({reason.value}): {detail} "

@@ -193,18 +193,7 @@ def _from_pattern(
     if not ros_type:
         return None, why + where
     direction = pattern.direction or _direction(sighting)
-    spec = TopicBridgeSpec(
-        ros_topic=pattern.ros_name(sighting.topic, captures),
-        gz_topic=sighting.topic,
-        ros_type=ros_type,
-        gz_type=gz_type,
-        direction=direction,
-        lazy=pattern.lazy,
-        publisher_queue=pattern.publisher_queue,
-        subscriber_queue=pattern.subscriber_queue,
-        qos_profile=pattern.qos_profile,
-        frame_id=pattern.frame_id,
-        max_rate=pattern.max_rate,
-        source=pattern.source,
+    spec = pattern.completed(
+        pattern.ros_name(sighting.topic, captures), sighting.topic, (ros_type, gz_type), direction
     )
     return spec, ""

@@ -31,22 +31,13 @@ from typing import Any
 
 import numpy as np
 
-from ros_gz_bridge_py.ros.cdr_types import (
-    BASIC,
-    BODY,
-    CDR_LE_HEADER,
-    SEQUENCE_TYPES,
-    STRING_TYPES,
-    basic_of,
-    fields_of,
-    nested_class,
-)
+from ros_gz_bridge_py.ros import cdr_types as cdr
 
 #: Serializes one message to CDR bytes (with the encapsulation header).
 Writer = Callable[[Any], bytes]
 
 #: Basic types the writer handles (``char`` is left to rclpy: its Python type varies).
-_WRITABLE = {name: spec for name, spec in BASIC.items() if name != "char"}
+_WRITABLE = {name: spec for name, spec in cdr.BASIC.items() if name != "char"}
 _U32 = struct.Struct("<I").pack
 
 
@@ -129,7 +120,7 @@ class _Source:
                 self.emit(f"b += {bytes(pad)!r}", indent)
                 self.rem = (self.rem + pad) % self.known
             return
-        self.emit(f"b += _ZEROS[:({BODY} - len(b)) % {size}]", indent)
+        self.emit(f"b += _ZEROS[:({cdr.BODY} - len(b)) % {size}]", indent)
         self.known, self.rem = size, 0
 
     def advance(self, length: int) -> None:
@@ -143,7 +134,7 @@ class _Source:
 def _compile(msg_class: type[Any]) -> Writer:
     source = _Source()
     source.emit("def write(m):", 0)
-    source.emit(f"b = bytearray({CDR_LE_HEADER!r})", 1)
+    source.emit(f"b = bytearray({cdr.CDR_LE_HEADER!r})", 1)
     _struct(source, msg_class, "m", 1)
     source.emit("return bytes(b)", 1)
     namespace: dict[str, Any] = {
@@ -159,7 +150,7 @@ def _compile(msg_class: type[Any]) -> Writer:
 
 
 def _struct(source: _Source, msg_class: type[Any], expr: str, indent: int) -> None:
-    fields = fields_of(msg_class)
+    fields = cdr.fields_of(msg_class)
     if not fields:  # an empty message still carries one uint8 on the wire
         source.emit("b += b'\\x00'", indent)
         source.advance(1)
@@ -169,7 +160,7 @@ def _struct(source: _Source, msg_class: type[Any], expr: str, indent: int) -> No
     for name, slot in fields:
         if not name.isidentifier() or keyword.iskeyword(name):
             raise _UnwritableTypeError(name)
-        basic = basic_of(slot)
+        basic = cdr.basic_of(slot)
         if basic is not None:
             size, code = _basic(basic)
             if run and size != run_size:
@@ -201,15 +192,15 @@ def _pack_run(source: _Source, run: list[tuple[str, str]], size: int, indent: in
 
 def _field(source: _Source, slot: Any, expr: str, indent: int) -> None:
     kind = type(slot).__name__
-    if kind in STRING_TYPES:
+    if kind in cdr.STRING_TYPES:
         _string(source, expr, getattr(slot, "maximum_size", None), indent)
     elif kind == "NamespacedType":
         value = source.name("v")
         source.emit(f"{value} = {expr}", indent)
-        _struct(source, nested_class(slot), value, indent)
+        _struct(source, cdr.nested_class(slot), value, indent)
     elif kind == "Array":
         _elements(source, slot.value_type, expr, slot.size, indent)
-    elif kind in SEQUENCE_TYPES:
+    elif kind in cdr.SEQUENCE_TYPES:
         values = source.name("s")
         source.emit(f"{values} = {expr}", indent)
         bound = getattr(slot, "maximum_size", None)
@@ -239,7 +230,7 @@ def _string(source: _Source, expr: str, bound: int | None, indent: int) -> None:
 
 def _elements(source: _Source, slot: Any, expr: str, count: int | None, indent: int) -> None:
     """The elements of an array (``count`` of them) or of a sequence (its count written)."""
-    basic = basic_of(slot)
+    basic = cdr.basic_of(slot)
     if basic is not None:
         size, code = _basic(basic)
         if count is not None:
@@ -251,7 +242,7 @@ def _elements(source: _Source, slot: Any, expr: str, count: int | None, indent: 
         # are some, which matters for 8-byte elements alone.
         if size > 4:
             source.emit(f"if len({expr}):", indent)
-            source.emit(f"b += _ZEROS[:({BODY} - len(b)) % {size}]", indent + 1)
+            source.emit(f"b += _ZEROS[:({cdr.BODY} - len(b)) % {size}]", indent + 1)
         source.emit(f"b += _block({expr}, {code!r}, None)", indent)
         source.forget(min(size, 4))
         return

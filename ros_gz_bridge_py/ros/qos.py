@@ -37,35 +37,32 @@ DEFAULT_DEPTH = 10
 TF_STATIC_TOPIC = "/tf_static"
 
 
-def _clock_profile() -> QoSProfile:
-    # rclcpp::ClockQoS: keep-last 1, best effort, volatile.
-    return QoSProfile(
-        history=HistoryPolicy.KEEP_LAST,
-        depth=1,
-        reliability=ReliabilityPolicy.BEST_EFFORT,
-        durability=DurabilityPolicy.VOLATILE,
+def _keep_last(
+    depth: int,
+    reliability: ReliabilityPolicy,
+    durability: DurabilityPolicy,
+    lifespan: Duration | None = None,
+) -> QoSProfile:
+    profile = QoSProfile(
+        history=HistoryPolicy.KEEP_LAST, depth=depth, reliability=reliability, durability=durability
     )
-
-
-def _rosout_profile() -> QoSProfile:
-    # rclcpp::RosoutQoS: keep-last 1000, reliable, transient local, 10 s lifespan.
-    return QoSProfile(
-        history=HistoryPolicy.KEEP_LAST,
-        depth=1000,
-        reliability=ReliabilityPolicy.RELIABLE,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL,
-        lifespan=Duration(seconds=10),
-    )
+    if lifespan is not None:
+        profile.lifespan = lifespan
+    return profile
 
 
 #: ``qos_profile`` names (as the C++ bridge spells them) -> a function returning a fresh profile.
 NAMED_PROFILES: dict[str, Any] = {
-    "CLOCK": _clock_profile,
+    # rclcpp::ClockQoS
+    "CLOCK": lambda: _keep_last(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE),
     "SENSOR_DATA": lambda: QoSProfile(**_fields(qos_profile_sensor_data)),
     "PARAMETERS": lambda: QoSProfile(**_fields(qos_profile_parameters)),
     "SERVICES": lambda: QoSProfile(**_fields(qos_profile_services_default)),
     "PARAMETER_EVENTS": lambda: QoSProfile(**_fields(qos_profile_parameter_events)),
-    "ROSOUT": _rosout_profile,
+    # rclcpp::RosoutQoS
+    "ROSOUT": lambda: _keep_last(
+        1000, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL, Duration(seconds=10)
+    ),
     "SYSTEM_DEFAULT": lambda: QoSProfile(**_fields(qos_profile_system_default)),
     "BEST_AVAILABLE": lambda: QoSProfile(**_fields(qos_profile_best_available)),
 }

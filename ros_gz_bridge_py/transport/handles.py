@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, canonical_type
 from ros_gz_bridge_py.transport.api import MessageInfo, RejectCallback, Rejection
-from ros_gz_bridge_py.transport.delivery import Deliver, Payload
+from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue, Payload, payload_size
 from ros_gz_bridge_py.transport.wire_types import WireTypeCache
 
 if TYPE_CHECKING:
@@ -218,3 +218,26 @@ class ServiceOffer:
 def offer_key(fqn: str, request_type: str, response_type: str) -> tuple[str, str, str]:
     """What a call must match to reach an offer (either spelling of each type)."""
     return fqn, canonical_type(request_type), canonical_type(response_type)
+
+
+class ThreadDelivery:
+    """A queued subscription's :class:`DeliveryQueue` (the default :class:`Delivery`)."""
+
+    def __init__(self, sub: Subscription, size: int, on_start: Callable[[], None] | None) -> None:
+        self._queue: DeliveryQueue[tuple[Payload, MessageInfo]] = DeliveryQueue(
+            size,
+            lambda item: sub.run(*item),
+            f"gz-sub {sub.topic}",
+            weigh=payload_size,
+            on_start=on_start,
+        )
+
+    @property
+    def dropped(self) -> int:
+        return self._queue.dropped
+
+    def offer(self, payload: Payload, info: MessageInfo) -> int:
+        return self._queue.put((payload, info))
+
+    def close(self) -> None:
+        self._queue.close()

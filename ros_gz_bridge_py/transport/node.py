@@ -30,47 +30,29 @@ from ros_gz_bridge_py.transport.api import (
     MessageInfo,
     RejectCallback,
     ReplyCallback,
+    ServiceCall,
     ServiceHandler,
     TopicInfo,
     TransportStats,
 )
 from ros_gz_bridge_py.transport.delivery import (
     Deliver,
-    DeliveryQueue,
     Payload,
-    payload_size,
     raw_deliverer,
     typed_deliverer,
 )
-from ros_gz_bridge_py.transport.handles import Delivery, Publisher, ServiceOffer, Subscription
+from ros_gz_bridge_py.transport.handles import (
+    Delivery,
+    Publisher,
+    ServiceOffer,
+    Subscription,
+    ThreadDelivery,
+)
 from ros_gz_bridge_py.transport.names import fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.wire_types import SubscriberBook
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
-
-
-class ThreadDelivery:
-    """A queued subscription's :class:`DeliveryQueue` (the default :class:`Delivery`)."""
-
-    def __init__(self, sub: Subscription, size: int, on_start: Callable[[], None] | None) -> None:
-        self._queue: DeliveryQueue[tuple[Payload, MessageInfo]] = DeliveryQueue(
-            size,
-            lambda item: sub.run(*item),
-            f"gz-sub {sub.topic}",
-            weigh=payload_size,
-            on_start=on_start,
-        )
-
-    @property
-    def dropped(self) -> int:
-        return self._queue.dropped
-
-    def offer(self, payload: Payload, info: MessageInfo) -> int:
-        return self._queue.put((payload, info))
-
-    def close(self) -> None:
-        self._queue.close()
 
 
 class GzNode(abc.ABC):
@@ -83,6 +65,10 @@ class GzNode(abc.ABC):
 
     #: The spelling taken for peers whose Gazebo line nothing tells (None: our own).
     default_peer_spelling: ClassVar[Spelling | None] = None
+    #: The backend's record of a service call (its own state added to :class:`ServiceCall`).
+    call_class: ClassVar[type[ServiceCall]] = ServiceCall
+    #: The backend's subscription handle (a subclass where it keeps more per subscription).
+    subscription_class: ClassVar[type[Subscription]] = Subscription
 
     def __init__(
         self,
@@ -245,7 +231,9 @@ class GzNode(abc.ABC):
         on_reject: RejectCallback | None,
     ) -> Subscription:
         self._check_open()
-        sub = self._new_subscription(topic, self.fqn(topic), msg_type, deliver, ignore_local)
+        sub = self.subscription_class(
+            self, topic, self.fqn(topic), msg_type, deliver, ignore_local=ignore_local
+        )
         sub.on_reject = on_reject
         if queue_size is not None:
             sub.delivery = self._open_delivery(sub, queue_size, on_start)
@@ -272,12 +260,6 @@ class GzNode(abc.ABC):
     def subscriptions(self, fqn: str) -> tuple[Subscription, ...]:
         """The local subscriptions of ``fqn`` (a snapshot)."""
         return self._subscriptions.get(fqn, ())
-
-    def _new_subscription(
-        self, topic: str, fqn: str, msg_type: str, deliver: Deliver, ignore_local: bool
-    ) -> Subscription:
-        """The subscription handle (backends that keep more per subscription subclass it)."""
-        return Subscription(self, topic, fqn, msg_type, deliver, ignore_local=ignore_local)
 
     def _open_delivery(
         self, sub: Subscription, size: int, on_start: Callable[[], None] | None
@@ -350,7 +332,6 @@ class GzNode(abc.ABC):
             self.count("callback_errors")
             _LOG.exception("service reply callback raised")
 
-    @abc.abstractmethod
     def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
         self,
         service: str,
@@ -363,6 +344,12 @@ class GzNode(abc.ABC):
         """Call a provider of either spelling of the two types; ``callback(ok, reply)`` runs
         exactly once: (True/False, reply) on a reply, (None, b"") on timeout, (True, b"")
         once sent for a one-way call (response ``gz.msgs.Empty``)."""
+        self._check_open()
+        deadline = time.monotonic() + timeout
+        call = self.call_class(
+            self.fqn(service), bytes(request), request_type, response_type, deadline, callback
+        )
+        self._start_call(call)
 
     # --- discovery ---------------------------------------------------------------------------
 
@@ -488,6 +475,11 @@ class GzNode(abc.ABC):
     @abc.abstractmethod
     def _close_offer(self, offer: ServiceOffer) -> None:
         """Withdraw ``offer``."""
+
+    @abc.abstractmethod
+    def _start_call(self, call: Any) -> None:  # Any: each backend takes its call_class
+        """Start ``call`` (a :attr:`call_class`); its callback runs once, through
+        :meth:`finish_call`."""
 
     @abc.abstractmethod
     def _on_node_thread(self) -> bool:

@@ -54,20 +54,18 @@ def default_partition(env: Mapping[str, str]) -> str:
 
 
 def _port(env: Mapping[str, str], name: str, default: int) -> int:
-    raw = lookup(env, name)
-    if raw is None:
-        return default
-    try:
-        value = int(raw)
-    except ValueError:
-        value = -1
-    if not 0 <= value <= MAX_PORT:
-        _LOG.warning("ignoring %s=%r: not a port number; using %d", name, raw, default)
-        return default
-    return value
+    return _integer(env, name, default, MAX_PORT, "a port number")
 
 
 def _positive(env: Mapping[str, str], name: str, default: int) -> int:
+    return _integer(env, name, default, None, "a non-negative integer")
+
+
+def _integer(
+    env: Mapping[str, str], name: str, default: int, highest: int | None, what: str
+) -> int:
+    """The integer from 0 to ``highest`` in ``name``; ``default`` when unset, and with a
+    warning naming the value when it is not ``what``."""
     raw = lookup(env, name)
     if raw is None:
         return default
@@ -75,8 +73,8 @@ def _positive(env: Mapping[str, str], name: str, default: int) -> int:
         value = int(raw)
     except ValueError:
         value = -1
-    if value < 0:
-        _LOG.warning("ignoring %s=%r: not a non-negative integer; using %d", name, raw, default)
+    if value < 0 or (highest is not None and value > highest):
+        _LOG.warning("ignoring %s=%r: not %s; using %d", name, raw, what, default)
         return default
     return value
 

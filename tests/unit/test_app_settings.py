@@ -19,6 +19,7 @@ from ros_gz_bridge_py.app.settings import (
     EXECUTOR_ENV,
     FASTDDS_PROFILE_ENV,
     LIGHT_READ_ENV,
+    MESSAGE_PATH_SWITCHES,
     SERIALIZED_PUBLISH_ENV,
     ImageBridgeParameters,
     ParameterBridgeParameters,
@@ -338,3 +339,10 @@ def test_gz_version_defaults_to_the_process_environment(
         assert declare_image_bridge_parameters(node).shared.gz_version == "harmonic"
     finally:
         node.destroy_node()
+
+
+def test_every_message_path_switch_is_a_bridge_option() -> None:
+    """The switches handed to the bridge under the same names exist on both sides."""
+    option_fields = {f.name for f in dataclasses.fields(BridgeOptions)}
+    switch_fields = {f.name for f in dataclasses.fields(Switches)}
+    assert set(MESSAGE_PATH_SWITCHES) <= option_fields & switch_fields

@@ -35,7 +35,6 @@ from ros_gz_bridge_py.transport.api import (
     GraphEndpoint,
     MessageInfo,
     Rejection,
-    ReplyCallback,
     ServiceCall,
     ServiceHandler,
     TopicInfo,
@@ -97,6 +96,8 @@ DEFAULT_NETWORK = MemoryNetwork()
 
 class MemoryGzNode(GzNode):
     """A node on a :class:`MemoryNetwork` (default: the process-wide one)."""
+
+    call_class = _Call
 
     def __init__(
         self,
@@ -266,21 +267,9 @@ class MemoryGzNode(GzNode):
             self.network.offers = [o for o in self.network.offers if o is not offer]
         self._changed_everywhere()
 
-    def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
-        self,
-        service: str,
-        request: bytes,
-        request_type: str,
-        response_type: str,
-        timeout: float,
-        callback: ReplyCallback,
-    ) -> None:
-        """Call ``service``; ``callback`` runs exactly once on this node's worker thread."""
-        self._check_open()
-        call = _Call(
-            self.fqn(service), bytes(request), request_type, response_type,
-            time.monotonic() + timeout, callback, caller=self,
-        )  # fmt: skip
+    def _start_call(self, call: _Call) -> None:
+        """``call``'s callback runs exactly once on this node's worker thread."""
+        call.caller = self
 
         def start() -> None:
             self._pending.append(call)

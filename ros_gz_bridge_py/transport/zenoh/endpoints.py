@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 import zenoh
 
 from ros_gz_bridge_py.transport.api import MessageInfo, Rejection
-from ros_gz_bridge_py.transport.delivery import Deliver
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.names import decompose
 
@@ -40,19 +39,8 @@ class ZenohPublisher(Publisher):
 class ZenohSubscription(Subscription):
     """A subscription and its Zenoh subscriber and MS token."""
 
-    def __init__(
-        self,
-        node: ZenohGzNode,
-        topic: str,
-        fqn: str,
-        msg_type: str,
-        deliver: Deliver,
-        *,
-        ignore_local: bool,
-    ) -> None:
-        super().__init__(node, topic, fqn, msg_type, deliver, ignore_local=ignore_local)
-        #: The Zenoh subscriber and MS token, in declaration order.
-        self.entities: list[Any] = []
+    #: The Zenoh subscriber and MS token, in declaration order (set when the node opens it).
+    entities: list[Any]
 
 
 class ZenohServiceOffer(ServiceOffer):

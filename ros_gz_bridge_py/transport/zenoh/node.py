@@ -43,12 +43,11 @@ from ros_gz_bridge_py.msgs.names import Spelling, canonical_type, same_message
 from ros_gz_bridge_py.transport.api import (
     ONE_WAY_TYPES,
     GraphEndpoint,
-    ReplyCallback,
     ServiceCall,
     ServiceHandler,
     TopicInfo,
 )
-from ros_gz_bridge_py.transport.delivery import Deliver, Payload
+from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription, offer_key
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.node import GzNode
@@ -103,6 +102,8 @@ class ZenohGzNode(GzNode):
     """A Gazebo Transport node speaking gz-transport 15's Zenoh protocol."""
 
     default_peer_spelling: ClassVar[Spelling | None] = Spelling.GZ
+    subscription_class = ZenohSubscription
+    call_class = _Call
 
     def __init__(
         self,
@@ -211,14 +212,10 @@ class ZenohGzNode(GzNode):
             self.count("send_failures")
             _LOG.debug("Zenoh put on %s failed: %s", publisher.fqn, error)
 
-    def _new_subscription(
-        self, topic: str, fqn: str, msg_type: str, deliver: Deliver, ignore_local: bool
-    ) -> Subscription:
-        return ZenohSubscription(self, topic, fqn, msg_type, deliver, ignore_local=ignore_local)
-
     def _open_subscription(self, sub: Subscription) -> None:
         """The Zenoh subscriber, then the MS token (a gz publisher may put once it sees it)."""
-        entities = cast(ZenohSubscription, sub).entities
+        entities: list[Any] = []
+        cast(ZenohSubscription, sub).entities = entities
         fqn = sub.fqn
         entities.append(
             self._declare(
@@ -302,23 +299,11 @@ class ZenohGzNode(GzNode):
     def _on_node_thread(self) -> bool:
         return threading.current_thread() is self._thread
 
-    def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
-        self,
-        service: str,
-        request: bytes,
-        request_type: str,
-        response_type: str,
-        timeout: float,
-        callback: ReplyCallback,
-    ) -> None:
-        """Call ``service``; ``callback`` runs exactly once (see the module's threading notes)."""
-        call = _Call(
-            self.fqn(service), bytes(request), request_type, response_type,
-            time.monotonic() + timeout, callback,
-        )  # fmt: skip
+    def _start_call(self, call: _Call) -> None:
+        """``call``'s callback runs exactly once (see the module's threading notes)."""
         with self._lock:
             self._check_open()
-            if offer_key(call.fqn, request_type, response_type) in self._offers:
+            if offer_key(call.fqn, call.request_type, call.response_type) in self._offers:
                 self._local_calls.append(call)
                 self._calls_changed.notify_all()
                 return

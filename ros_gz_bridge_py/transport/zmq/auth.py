@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import hmac
 import logging
-import time
 from typing import Any
 
 import zmq
+
+from ros_gz_bridge_py.transport.throttle import Throttle
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 
@@ -41,7 +42,7 @@ class ZapHandler:
         self._user = credentials[0].encode()
         self._password = credentials[1].encode()
         self._count = count
-        self._last_warning = 0.0
+        self._warning = Throttle(WARN_PERIOD)
         self.refused = 0
         self.socket: Any = context.socket(zmq.REP)
         self.socket.setsockopt(zmq.LINGER, 0)
@@ -75,9 +76,7 @@ class ZapHandler:
         self.refused += 1
         if self._count is not None:
             self._count("auth_failures")
-        now = time.monotonic()
-        if now - self._last_warning >= WARN_PERIOD:
-            self._last_warning = now
+        if self._warning.ready():
             _LOG.warning(
                 "refused a subscriber from %s: wrong or missing credentials "
                 "(GZ_TRANSPORT_USERNAME/PASSWORD; %d refused so far)",

@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from ros_gz_bridge_py.transport.delivery import Deliver
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.zmq.wire import Frame, PublisherRecord, encode_data
 
@@ -40,20 +39,10 @@ class ZmqPublisher(Publisher):
 
 
 class ZmqSubscription(Subscription):
-    """A subscription with its record (announced in SUBSCRIBERS_REP answers, §2.4)."""
+    """A subscription with its record (announced in SUBSCRIBERS_REP answers, §2.4), set when
+    the node opens it."""
 
-    def __init__(
-        self,
-        node: ZmqGzNode,
-        topic: str,
-        fqn: str,
-        msg_type: str,
-        deliver: Deliver,
-        *,
-        ignore_local: bool,
-    ) -> None:
-        super().__init__(node, topic, fqn, msg_type, deliver, ignore_local=ignore_local)
-        self.record: PublisherRecord | None = None
+    record: PublisherRecord | None = None
 
     def reads_own_socket(self) -> bool:
         """True for a queued subscription: its reader has a SUB socket of its own."""

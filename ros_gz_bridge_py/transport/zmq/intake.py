@@ -12,11 +12,11 @@ I/O thread; readers do their part on their own threads.
 from __future__ import annotations
 
 import logging
-import time
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, cast
 
 from ros_gz_bridge_py.transport.handles import Subscription
+from ros_gz_bridge_py.transport.throttle import Throttle
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
 from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader
 from ros_gz_bridge_py.transport.zmq.sockets import NodeSockets
@@ -46,7 +46,7 @@ class DataIntake:
             count=node.count,
             what="the node's SUB socket",
         )
-        self._last_warning = 0.0
+        self._warning = Throttle(WARN_PERIOD)
 
     @property
     def received(self) -> int:
@@ -99,9 +99,7 @@ class DataIntake:
     def _refused_shared(self, address: str) -> None:
         """A message refused on the shared socket: its topic is unknown, so the node counts it."""
         self._node.count("messages_oversize")
-        now = time.monotonic()
-        if now - self._last_warning >= WARN_PERIOD:
-            self._last_warning = now
+        if self._warning.ready():
             _LOG.warning(
                 "dropped a message from %s larger than %d bytes (GZ_TRANSPORT_MAX_MESSAGE_SIZE) "
                 "or not in ZeroMQ framing; raise the limit if the publisher is legitimate",

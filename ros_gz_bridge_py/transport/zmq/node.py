@@ -32,12 +32,11 @@ import zmq
 from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError
 from ros_gz_bridge_py.transport.api import (
     GraphEndpoint,
-    ReplyCallback,
     Scope,
     ServiceHandler,
     TopicInfo,
 )
-from ros_gz_bridge_py.transport.delivery import Deliver, Payload
+from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.node import GzNode
 from ros_gz_bridge_py.transport.settings import TransportSettings
@@ -87,6 +86,9 @@ READ_BATCH = 64
 
 class ZmqGzNode(GzNode):
     """A Gazebo Transport node speaking the ZeroMQ protocol (gz-transport wire version 10)."""
+
+    subscription_class = ZmqSubscription
+    call_class = PendingCall
 
     def __init__(
         self,
@@ -235,11 +237,6 @@ class ZmqGzNode(GzNode):
                 self.count("send_failures")
                 _LOG.debug("publish on %s failed: %s", publisher.topic, error)
 
-    def _new_subscription(
-        self, topic: str, fqn: str, msg_type: str, deliver: Deliver, ignore_local: bool
-    ) -> Subscription:
-        return ZmqSubscription(self, topic, fqn, msg_type, deliver, ignore_local=ignore_local)
-
     def _open_delivery(
         self, sub: Subscription, size: int, on_start: Callable[[], None] | None
     ) -> SubscriptionReader:
@@ -313,20 +310,8 @@ class ZmqGzNode(GzNode):
         with contextlib.suppress(TransportError):
             self._call(lambda: self._services.remove_offer(cast(ZmqServiceOffer, offer)))
 
-    def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
-        self,
-        service: str,
-        request: bytes,
-        request_type: str,
-        response_type: str,
-        timeout: float,
-        callback: ReplyCallback,
-    ) -> None:
-        """Call ``service``; ``callback`` runs exactly once on the I/O thread."""
-        call = PendingCall(
-            self.fqn(service), bytes(request), request_type, response_type,
-            time.monotonic() + timeout, callback,
-        )  # fmt: skip
+    def _start_call(self, call: PendingCall) -> None:
+        """``call``'s callback runs exactly once on the I/O thread."""
         self._post(lambda: self._services.start_call(call))
 
     # --- what discovery knows ---------------------------------------------------------------
