@@ -12,10 +12,10 @@ they would cost a quarter more on TF and Twist.
 
 from __future__ import annotations
 
+import keyword
 from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
-from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -67,19 +67,15 @@ Entry = str | tuple[str, str] | tuple[str, Fill | Value] | tuple[str, str, Fill 
 
 
 def fields(*entries: Entry) -> Fill:
-    """The Fill that converts every entry in order, R→G and G→R alike."""
-    steps = [_steps(entry) for entry in entries]
-    steps_to_gz = [to_gz for to_gz, _ in steps]
-    steps_to_ros = [to_ros for _, to_ros in steps]
+    """The Fill that converts every entry in order, R→G and G→R alike.
 
-    def to_gz(ros: Any, gz: Any) -> None:
-        for step in steps_to_gz:
-            step(ros, gz)
-
-    def to_ros(gz: Any, ros: Any) -> None:
-        for step in steps_to_ros:
-            step(gz, ros)
-
+    Each direction is compiled once into one straight-line function (``gz.linear.x =
+    ros.linear.x`` and so on, the Fills and Values called directly), as fast as the same
+    conversion written by hand.
+    """
+    parts = [_parts(entry) for entry in entries]
+    to_gz = _compile("to_gz", [(ros, gz, how, _TO_GZ) for ros, gz, how in parts])
+    to_ros = _compile("to_ros", [(gz, ros, how, _TO_ROS) for ros, gz, how in parts])
     return Fill(to_gz, to_ros)
 
 
@@ -156,21 +152,54 @@ def fill_pair(
     return Pair.of(ros_class, gz_type, to_gz, to_ros, default_for_gz_type=default_for_gz_type)
 
 
-#: One entry in one direction: ``step(source_message, target_message)``.
-_Step = Callable[[Any, Any], None]
+#: Which half of a Fill or Value an entry uses in each direction.
+_TO_GZ, _TO_ROS = "to_gz", "to_ros"
 
 
-def _steps(entry: Entry) -> tuple[_Step, _Step]:
-    """The entry's R→G and G→R steps."""
-    ros_path, gz_path, how = _parts(entry)
-    if isinstance(how, Fill):
-        return _filling(ros_path, gz_path, how.to_gz), _filling(gz_path, ros_path, how.to_ros)
-    if isinstance(how, Value):
-        return _setting(ros_path, gz_path, how.to_gz), _setting(gz_path, ros_path, how.to_ros)
-    return _setting(ros_path, gz_path, same), _setting(gz_path, ros_path, same)
+def _compile(
+    name: str, steps: list[tuple[str, str, Fill | Value | None, str]]
+) -> Callable[[Any, Any], None]:
+    """``name(source, target)`` doing each step: (source path, target path, how, direction)."""
+    lines = [f"def {name}(source, target):"]
+    constants: dict[str, Any] = {}
+    for index, (source_path, target_path, how, direction) in enumerate(steps):
+        source, target = _path("source", source_path), _path("target", target_path)
+        if how is None:
+            lines.append(f"    {target} = {source}")
+            continue
+        convert = getattr(how, direction)
+        if convert is None:  # a Value that leaves this direction alone
+            continue
+        constants[f"_{index}"] = convert
+        if isinstance(how, Fill):
+            lines.append(f"    _{index}({source}, {target})")
+        elif convert is same:
+            lines.append(f"    {target} = {source}")
+        else:
+            lines.append(f"    {target} = _{index}({source})")
+    lines.append("    return None")
+    code = compile("\n".join(lines), f"<fields {name}>", "exec")
+    exec(code, constants)  # noqa: S102 - the source names only paths checked by _path
+    function: Callable[[Any, Any], None] = constants[name]
+    return function
+
+
+def _path(root: str, path: str) -> str:
+    """``root.a.b`` for the dotted ``path`` (``root`` for WHOLE).
+
+    Raises:
+        ValueError: a part of ``path`` is not an attribute name.
+    """
+    names = path.split(".") if path else []
+    for part in names:
+        if not part.isidentifier() or keyword.iskeyword(part):
+            msg = f"field path {path!r} has a part that is not an attribute name"
+            raise ValueError(msg)
+    return ".".join([root, *names])
 
 
 def _parts(entry: Entry) -> tuple[str, str, Fill | Value | None]:
+    """(ROS path, gz path, how) of a table entry."""
     if isinstance(entry, str):
         return entry, entry, None
     if isinstance(entry, Fill):
@@ -181,27 +210,3 @@ def _parts(entry: Entry) -> tuple[str, str, Fill | Value | None]:
     if isinstance(second, str):
         return first, second, None
     return first, first, second
-
-
-def _filling(source_path: str, target_path: str, fill: Callable[[Any, Any], None]) -> _Step:
-    get_source, get_target = _getter(source_path), _getter(target_path)
-    return lambda source, target: fill(get_source(source), get_target(target))
-
-
-def _setting(source_path: str, target_path: str, convert: Callable[[Any], Any] | None) -> _Step:
-    if convert is None:
-        return _leave_alone
-    get_source = _getter(source_path)
-    parent, _, name = target_path.rpartition(".")
-    get_parent = _getter(parent)
-    if convert is same:
-        return lambda source, target: setattr(get_parent(target), name, get_source(source))
-    return lambda source, target: setattr(get_parent(target), name, convert(get_source(source)))
-
-
-def _leave_alone(_source: Any, _target: Any) -> None:
-    pass
-
-
-def _getter(path: str) -> Callable[[Any], Any]:
-    return attrgetter(path) if path else same
