@@ -1,10 +1,10 @@
 """What the CDR reader and writer know of rosidl types: wire sizes, struct codes, field lists.
 
-Classic little-endian CDR (XCDR1, the encapsulation rmw_fastrtps writes): after the 4-byte
-encapsulation header every value is aligned to its own size, counted from the end of the
-header; strings are a ``uint32`` length that includes the terminating NUL, then the bytes and
-the NUL; sequences a ``uint32`` count, then the elements; a message with no field carries one
-``uint8``. The types are read from rclpy's own description of each message class
+Classic little-endian CDR (docs/cdr.md §1-§3) (XCDR1, the encapsulation rmw_fastrtps writes):
+after the 4-byte encapsulation header every value is aligned to its own size, counted from the
+end of the header; strings are a ``uint32`` length that includes the terminating NUL, then the
+bytes and the NUL; sequences a ``uint32`` count, then the elements; a message with no field
+carries one ``uint8``. The types are read from rclpy's own description of each message class
 (``get_fields_and_field_types`` and ``SLOT_TYPES``).
 """
 

@@ -13,11 +13,13 @@ with one statement per field, consecutive basic fields of one size packed by one
 writes rclpy messages and anything with the same attribute names. Numeric arrays are written
 as one block (numpy arrays and ``array.array`` through ``tobytes``).
 
-It writes what rclpy writes (tests compare every pair's ROS type byte for byte; rclpy leaves
-padding bytes uninitialised, this module writes zeros). A value it cannot write exactly as
-rclpy would (a number out of range, a list of the wrong length, a wide string type) raises
-from the writer; :class:`FastPublish` then publishes that message through rclpy, so the
-message is published or refused exactly as before. Little-endian hosts only.
+It writes what rclpy writes (docs/cdr.md §2-§4; tests compare every pair's ROS type byte for
+byte; rclpy leaves padding bytes uninitialised, this module writes zeros). A value it cannot
+write exactly as rclpy would (a number out of range, a list of the wrong length) raises from
+the writer;
+:class:`~ros_gz_bridge_py.ros.serialized_publisher.WrittenPublisher` then publishes that
+message through rclpy, so the message is published or refused exactly as before. A type with a
+field it does not write (``char``, wide strings) has no writer. Little-endian hosts only.
 """
 
 from __future__ import annotations

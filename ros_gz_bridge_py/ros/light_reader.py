@@ -9,10 +9,11 @@ subscribes to the serialized message instead and reads it here into
 ``float``/``bool``, strings as ``str``, numeric arrays and sequences as tuples, ``uint8``/
 ``byte`` ones as ``bytes``, nested sequences as lists): several times cheaper.
 
-A reader is compiled once per message class from rclpy's own type description
-(``get_fields_and_field_types`` and ``SLOT_TYPES``). Classic little-endian CDR only: a
-message in another encapsulation, and a type with ``wstring``, ``wchar`` or ``long double``,
-is left to rclpy (:func:`reader_for` returns None, :func:`read` returns None).
+The encoding read is stated in docs/cdr.md §1-§3. A reader is compiled once per message class
+from rclpy's own type description (``get_fields_and_field_types`` and ``SLOT_TYPES``). Classic
+little-endian CDR only: a message in another encapsulation, and a type with ``wstring``,
+``wchar`` or ``long double``, is left to rclpy (:func:`reader_for` returns None, :func:`read`
+returns None).
 """
 
 from __future__ import annotations
