@@ -65,7 +65,7 @@ def test_written_and_rclpy_published_messages_arrive_alike(make_rig: Any, world:
     assert written == through_rclpy
 
 
-def test_every_small_type_gets_a_writer_and_bulk_types_are_not_asked() -> None:
+def test_every_type_of_a_pair_without_a_bulk_path_gets_a_writer() -> None:
     """What a Gazebo -> ROS channel of each non-bulk pair publishes with."""
     classes = {pair.ros_class for pair in default_registry().pairs if pair.bulk is None}
     publisher = _FakePublisher()
