@@ -1,4 +1,4 @@
-"""A child process for ``test_transport_disconnect.py``: receives one ``ign topic -p`` message
+"""A child process for ``test_transport_disconnect.py``: receives one one-shot message
 and disconnects from the publisher once it says goodbye, in a process of its own, because the
 libzmq bug it is about aborts the process (``Assertion failed: !_more (src/fq.cpp)``).
 
@@ -8,8 +8,7 @@ MODE ``plain`` does what a SUB socket owner naively does: it polls (libzmq takes
 frame of the waiting message out of the pipe), sees the publisher's record go (UNADVERTISE,
 BYE), disconnects, then reads. MODE ``ours`` lets our node (a queued and a direct
 subscription) do it. Prints ``READY``, then ``RECEIVED n`` and ``DISCONNECTED n``, or
-``NO DATA`` (exit 3) when the one-shot never sent its message (ign-transport 11 sometimes does
-not, see test_transport_topics.py).
+``NO DATA`` (exit 3) when the one-shot message did not arrive.
 """
 
 from __future__ import annotations
@@ -77,7 +76,7 @@ def main() -> int:
     with ZmqGzNode() as node:
         if mode == "ours":
             return ours(node, topic)
-        node.subscribe(topic, lambda *_: None, STRING)  # NEW_CONNECTION: the CLI sends
+        node.subscribe(topic, lambda *_: None, STRING)  # NEW_CONNECTION: the one-shot sends
         node.topic_list()  # discovery initialised (2 s): listings answer at once from now on
         print("READY", flush=True)
         return plain(node, topic)

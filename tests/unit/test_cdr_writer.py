@@ -53,16 +53,18 @@ def _converted(pair: Pair) -> Any | None:
         return None
 
 
-@pytest.mark.parametrize("pair", PAIRS, ids=[f"{p.ros_type}-{p.gz_type}" for p in PAIRS])
+#: Pairs whose filled message converts both ways; the others refuse one of its values (an
+#: enum out of range, say), which their own tests check.
+CONVERTING = [pair for pair in PAIRS if _converted(pair) is not None]
+
+
+@pytest.mark.parametrize("pair", CONVERTING, ids=[f"{p.ros_type}-{p.gz_type}" for p in CONVERTING])
 def test_what_each_converter_makes_is_written_as_rclpy_writes_it(pair: Pair) -> None:
-    msg = _converted(pair)
-    if msg is None:
-        pytest.skip("the filled message does not convert (its errors are tested elsewhere)")
-    assert_same_cdr(msg)
+    assert_same_cdr(_converted(pair))
 
 
 def test_most_pairs_give_a_converted_message() -> None:
-    assert sum(_converted(pair) is not None for pair in PAIRS) >= len(PAIRS) * 3 // 4
+    assert len(CONVERTING) >= len(PAIRS) * 3 // 4
 
 
 def test_padding_after_strings_of_every_length() -> None:
