@@ -235,10 +235,20 @@ def ros_sub(
         while not stop.is_set():
             executor.spin_until_future_complete(never, timeout_sec=0.5)
 
-    threading.Thread(target=spin, daemon=True).start()
+    spinning = threading.Thread(target=spin, daemon=True)
+    spinning.start()
     stop.wait(seconds)
     recorder.report()
-    os._exit(0)  # rclpy's threads need no orderly goodbye
+    stop.set()
+    spinning.join(timeout=2)
+    # Leave the DDS graph in order: a reader that vanishes without a goodbye stays matched to
+    # the bridge's writer until the lease expires, and the writer's shared-memory sends to its
+    # dead port stall the next flow of that channel for about a second.
+    try:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    finally:
+        os._exit(0)  # nothing else of rclpy needs to wind down
 
 
 def _announce_match(matched: Callable[[], bool]) -> None:
