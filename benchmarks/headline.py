@@ -161,6 +161,28 @@ def per_type(stored: Stored | None) -> str:
     return "\n".join(lines)
 
 
+def cpu_notes(stored: Stored | None) -> list[str]:
+    """For each CPU-per-message goal missed: the bridge's cost beside the rclpy ends'."""
+    lines = []
+    for (kind, way, hz), quoted in CPU_PER_MESSAGE.items():
+        flow = None if stored is None else stored.flow(flow_key(way, kind, hz))
+        cost = None if flow is None else per_message_ms(flow.cpu, hz, flow)
+        if stored is None or cost is None or cost <= cpu_goal_ms(quoted):
+            continue
+        publisher, subscriber = _ends(stored, kind, hz)
+        if publisher is None or subscriber is None:
+            continue
+        lines.append(
+            f"- {SIZES[kind]} {way} at {hz / 1000:g} kHz: the bridge spent {cost:.3f} ms per "
+            f"message; an rclpy publisher and an rclpy subscriber of the same rate spent "
+            f"{publisher:.3f} + {subscriber:.3f} = {publisher + subscriber:.3f} ms "
+            f"({cost / (publisher + subscriber):.1f}x). The bridge does both ends of a hop "
+            "(a receive and a send, with the conversion between) in one Python process: the "
+            "Python work per message, not the transports, is what it pays."
+        )
+    return lines
+
+
 def clock_notes(stored: Stored | None) -> list[str]:
     """The starvation benchmark's account of where the clock was lost, from its stored run."""
     if stored is None:
@@ -203,6 +225,12 @@ def section() -> str:
         if stored is not None
     ]
     notes = clock_notes(clock)
+    cpu_missed = cpu_notes(costs)
+    cpu_text = ""
+    if cpu_missed:
+        cpu_text = (
+            "\nWhat bounds the CPU per message where it misses:\n" + "\n".join(cpu_missed) + "\n"
+        )
     return f"""## Headline (issue 15)
 
 Written by `make bench` (`benchmarks.headline`) from the last run of each benchmark (stored in
@@ -225,7 +253,7 @@ same rate, the same run: what a ROS node in Python spends on each end of the hop
 
 Where /clock was lost under the flood:
 {chr(10).join(notes) if notes else "- not measured yet (`benchmarks.starvation`)"}
-
+{cpu_text}
 Measured (2 cores shared with other work: every figure is noisy, the load averages say how
 busy the machine was):
 {chr(10).join(runs)}

@@ -46,7 +46,7 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
         "transport": lambda: transport.main(["--seconds", "1" if quick else "2"]),
         "images": lambda: images.main(["--seconds", str(flow)]),
         "sustained": lambda: sustained.main(
-            ["--seconds", "1.5" if quick else "3", "--rates", *(f"{hz:g}" for hz in rates)]
+            ["--seconds", "1.5" if quick else "5", "--rates", *(f"{hz:g}" for hz in rates)]
         ),
         "small_messages": lambda: small_messages.main(["--seconds", str(flow)]),
         "costs": lambda: costs.main(["--seconds", "1.5" if quick else "3"]),

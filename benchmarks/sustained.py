@@ -172,7 +172,7 @@ Goals (issue 15):
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seconds", type=float, default=3.0, help="publishing time per rate")
+    parser.add_argument("--seconds", type=float, default=5.0, help="publishing time per rate")
     parser.add_argument("--rates", type=float, nargs="+", default=list(RATES), help="Hz")
     args = parser.parse_args(argv)
     load = os.getloadavg()[0]
