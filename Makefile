@@ -7,6 +7,7 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.ros_gz_bridge_py-setup
+BENCH_STAMP := $(VENV)/.ros_gz_bridge_py-bench
 LOOPBACK := ../shared/tools/loopback-env
 # Keep ROS, Gazebo Transport and Zenoh traffic on this host (see DEVELOPERS.md).
 WITH_LOOPBACK := if [ -f $(LOOPBACK) ]; then source $(LOOPBACK); else source tools/loopback-env; fi;
@@ -38,7 +39,12 @@ test: lint typecheck unit
 demo: setup
 	$(WITH_LOOPBACK) $(PY) -m ros_gz_bridge_py.demo
 
-bench: setup
+# The benchmarks also need the `bench` extra (matplotlib, for the plots of BENCHMARKS.md).
+$(BENCH_STAMP): $(STAMP)
+	$(PY) -m pip install --quiet -e '.[ros,dev,bench]'
+	@touch $(BENCH_STAMP)
+
+bench: $(BENCH_STAMP)
 	$(WITH_LOOPBACK) $(PY) -m benchmarks.run
 
 # Ten minutes of mixed traffic and faults; writes SOAK.md (a short version runs in `make test`).

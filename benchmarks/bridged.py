@@ -95,20 +95,23 @@ Cases = tuple[tuple[str, float], ...]
 Ceilings = dict[tuple[str, float], FlowResult]
 
 
-def unbridged(seconds: float, cases: Cases, ends: tuple[str, str], label: str) -> Ceilings:
-    """Publisher -> subscriber (``ends``, worker roles) of each case with no bridge between."""
+def unbridged(
+    seconds: float, cases: Cases, ends: tuple[str, str], label: str, depth: int | None = None
+) -> Ceilings:
+    """Publisher -> subscriber (``ends``, worker roles) of each case with no bridge between
+    (``depth``: the history depth of the ROS ends, None: their default)."""
     env = bench_env()
     results = {}
     for kind, hz in cases:
         topic = topic_name(f"{label.replace(' ', '_')}_{kind}")
-        results[kind, hz] = run_flow(Flow(*ends, kind, seconds, hz), topic, env)
+        results[kind, hz] = run_flow(Flow(*ends, kind, seconds, hz, depth=depth), topic, env)
         print(f"{label} {kind} {hz:g}: {results[kind, hz]}", file=sys.stderr, flush=True)
     return results
 
 
-def ceilings(seconds: float, cases: Cases) -> Ceilings:
+def ceilings(seconds: float, cases: Cases, depth: int | None = None) -> Ceilings:
     """rclpy publisher -> rclpy subscriber of each case, no bridge, the bridge's settings."""
-    return unbridged(seconds, cases, ("ros-pub", "ros-sub"), "ceiling")
+    return unbridged(seconds, cases, ("ros-pub", "ros-sub"), "ceiling", depth)
 
 
 def through_bridge(

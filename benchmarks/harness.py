@@ -7,9 +7,11 @@ over the publishing window; its RSS from ``/proc/<pid>/status``.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import os
+import re
 import socket
 import sys
 import time
@@ -34,6 +36,11 @@ BIN = Path(sys.executable).parent
 LARGE_HWM = "20"
 #: Seconds between a subscriber seeing the bridge and the publisher starting (connections).
 SETTLE = 1.0
+#: The same for an rclpy subscriber of the bridge's publisher. It sees the bridge's writer
+#: before that writer delivers to it: with 1 s, 6 of 8 paced 1080p flows on a reused channel
+#: lost their first frames or stalled ~350 ms at the start (the bridge had published them
+#: all); with 3 s, none of 8 did.
+SETTLE_ROS = 3.0
 LARGE_KINDS = frozenset({"image640", "image1080", "cloud1mb"})
 #: One Gazebo partition for the whole run, so every process of it meets the others.
 PARTITION = f"bench-{os.getpid()}-{uuid.uuid4().hex[:6]}"
@@ -159,6 +166,42 @@ def gz_message_file(kind: str) -> Path:
     return path
 
 
+@dataclass(frozen=True)
+class Flood:
+    """A second stream that a flow's publisher process sends beside its own, from ``lead``
+    seconds before the flow's first message until just after its last, to a subscriber of its
+    own (``hz`` 0: back to back): through the bridge like the flow, or with ``bypass`` straight
+    to a subscriber on the publisher's side (the bridge then never sees it)."""
+
+    kind: str
+    topic: str
+    hz: float = 0.0
+    lead: float = 3.0
+    bypass: bool = False
+
+    def subscriber(self, flow: Flow) -> str:
+        """The role of the flood's subscriber."""
+        if not self.bypass:
+            return flow.subscriber
+        return "gz-sub" if flow.publisher == "gz-pub" else "ros-sub"
+
+
+def flood_options(flood: Flood | None, ign_peer: bool) -> list[str]:
+    """The publisher options of ``flood``: the C++ peer's (``tests/peer/flood.hh``), or the
+    Python workers'."""
+    if flood is None:
+        return []
+    rate = ["--flood", flood.topic, "--flood-hz", str(flood.hz), "--flood-lead", str(flood.lead)]
+    if not ign_peer:
+        return [*rate, "--flood-kind", flood.kind]
+    spec = KINDS[flood.kind]
+    return [
+        *rate,
+        *("--flood-type", spec.ignition_type, "--flood-file", str(gz_message_file(flood.kind))),
+        *("--flood-stamp", spec.gz_stamp_path, "--flood-wire-type", spec.gz_type),
+    ]
+
+
 def worker(
     role: str, topic: str, kind: str, seconds: float, env: Mapping[str, str], *extra: str
 ) -> PeerProcess:
@@ -230,7 +273,8 @@ def start_bridge(
 
 @dataclass(frozen=True)
 class FlowResult:
-    """What the subscriber of one flow measured, plus the bridge's CPU."""
+    """What the subscriber of one flow measured, plus the CPU shares (% of one core) of the
+    bridge and of the end processes over the publishing window."""
 
     sent: int
     received: int
@@ -239,6 +283,10 @@ class FlowResult:
     p99_us: float
     cpu: float | None
     error: str = ""
+    pub_cpu: float | None = None
+    sub_cpu: float | None = None
+    #: What the flood's own subscriber measured (flows with a :class:`Flood`).
+    flood: FlowResult | None = None
 
     @property
     def share(self) -> float:
@@ -262,6 +310,10 @@ class Flow:
     slow_ms: float = 0.0
     #: History depth of the ROS end, publisher or subscriber (None: the bridge's default, 10).
     depth: int | None = None
+    #: A named QoS profile of the ROS subscriber (``ros.qos.NAMED_PROFILES``; None: default).
+    qos_profile: str | None = None
+    #: A second stream from the same publisher process (see :class:`Flood`).
+    flood: Flood | None = None
 
 
 def run_flow(
@@ -273,45 +325,94 @@ def run_flow(
     bridge_pid: int | None = None,
     during: Callable[[], None] | None = None,
 ) -> FlowResult:
-    """Run ``flow`` on ``topic`` (``env``: the subscriber's, and the publisher's unless
+    """Run ``flow`` on ``topic`` (``env``: the subscribers', and the publisher's unless
     ``pub_env`` is given). With a bridge in between (``bridge_pid``) the subscriber first waits
     to see the bridge's publisher. ``during`` runs once publishing started (RSS sampling)."""
     pub_env = dict(pub_env or env)
-    if flow.publisher == "gz-pub" and flow.kind in LARGE_KINDS:
+    flood = flow.flood
+    if flow.publisher == "gz-pub" and LARGE_KINDS & {flow.kind, flood.kind if flood else ""}:
         for prefix in ("GZ_", "IGN_"):
             pub_env[f"{prefix}TRANSPORT_SNDHWM"] = LARGE_HWM
-    cpu = CpuWindow(bridge_pid)
-    extra = ("--slow-ms", str(flow.slow_ms)) if flow.slow_ms else ()
+    extra: tuple[str, ...] = ("--slow-ms", str(flow.slow_ms)) if flow.slow_ms else ()
     depth = () if flow.depth is None else ("--depth", str(flow.depth))
+    if flow.qos_profile is not None:
+        extra += ("--qos-profile", flow.qos_profile)
     sub_extra = (*extra, *depth) if flow.subscriber == "ros-sub" else extra
     pub_extra = ("--hz", str(flow.hz), *(depth if flow.publisher == "ros-pub" else ()))
-    sub = worker(flow.subscriber, topic, flow.kind, flow.seconds + 60, env, *sub_extra)
-    pub: PeerProcess | None = None
+    pub_extra += tuple(flood_options(flood, flow.publisher == "gz-pub" and uses_ign_peer(pub_env)))
+    lead = 0.0 if flood is None else flood.lead + MATCH_WAIT
+    ends: list[PeerProcess] = []
     try:
-        wait_for_line(sub, r"^READY$", 30)
+        flood_sub = None
+        if flood is not None:
+            role = flood.subscriber(flow)
+            flood_sub = _subscriber(
+                flow, role, flood.topic, flood.kind, env=pub_env if flood.bypass else env,
+                extra=(), bridge_pid=None if flood.bypass else bridge_pid,
+            )  # fmt: skip
+            ends.append(flood_sub)
+        sub = _subscriber(
+            flow, flow.subscriber, topic, flow.kind, env=env, extra=sub_extra, bridge_pid=bridge_pid
+        )
+        ends.append(sub)
         if bridge_pid is not None:
-            wait_for_line(sub, r"^MATCHED$", 20)
-            time.sleep(SETTLE)
+            time.sleep(SETTLE_ROS if flow.subscriber == "ros-sub" else SETTLE)
         pub = worker(flow.publisher, topic, flow.kind, flow.seconds, pub_env, *pub_extra)
+        ends.append(pub)
         wait_for_line(pub, r"^CONNECTED$", 40)
-        wait_for_line(pub, r"^START$", 10)
-        cpu.begin()
+        wait_for_line(pub, r"^START$", 10 + lead)
+        windows = [CpuWindow(pid) for pid in (bridge_pid, pub.pid, sub.pid)]
+        for window in windows:
+            window.begin()
         if during is not None:
             during()
         sent = int(wait_for_line(pub, r"^SENT (\d+)", flow.seconds + 30)[1])
-        cpu.end()
+        for window in windows:
+            window.end()
         time.sleep(1.0)  # the last messages drain
-        sub.stop(grace=15)
-        stats = wait_for_line(sub, STATS_LINE.pattern, 5)
+        stats = _stats(sub)
+        flooded = None
+        if flood_sub is not None:
+            flood_sent = int(wait_for_line(pub, r"^FLOOD_SENT (\d+)", 10)[1])
+            flooded = _result(flood_sent, _stats(flood_sub))
     except FlowFailure as error:
         return failed(error)
     finally:
-        sub.stop()
-        if pub is not None:
-            pub.stop()
-    return FlowResult(
-        sent, int(stats[1]), float(stats[4]), float(stats[5]), float(stats[6]), cpu.percent
+        for end in ends:
+            end.stop()
+    cpu, pub_cpu, sub_cpu = (window.percent for window in windows)
+    return dataclasses.replace(
+        _result(sent, stats, cpu), pub_cpu=pub_cpu, sub_cpu=sub_cpu, flood=flooded
     )
+
+
+def _subscriber(
+    flow: Flow,
+    role: str,
+    topic: str,
+    kind: str,
+    *,
+    env: Mapping[str, str],
+    extra: Sequence[str],
+    bridge_pid: int | None,
+) -> PeerProcess:
+    """A started subscriber of ``flow``, ready (and matched to the bridge, if any)."""
+    lead = 0.0 if flow.flood is None else flow.flood.lead
+    sub = worker(role, topic, kind, flow.seconds + lead + 60, env, *extra)
+    wait_for_line(sub, r"^READY$", 30)
+    if bridge_pid is not None:
+        wait_for_line(sub, r"^MATCHED$", 20)
+    return sub
+
+
+def _stats(sub: PeerProcess) -> re.Match[str]:
+    """The STATS line ``sub`` prints when stopped."""
+    sub.stop(grace=15)
+    return wait_for_line(sub, STATS_LINE.pattern, 5)
+
+
+def _result(sent: int, stats: re.Match[str], cpu: float | None = None) -> FlowResult:
+    return FlowResult(sent, int(stats[1]), float(stats[4]), float(stats[5]), float(stats[6]), cpu)
 
 
 def stop_all() -> None:

@@ -129,6 +129,19 @@ def _odometry() -> Any:
     return msg
 
 
+def _imu() -> Any:
+    from sensor_msgs.msg import Imu  # noqa: PLC0415
+
+    msg = Imu()
+    msg.header.frame_id = "imu_link"
+    msg.orientation.w = 1.0
+    msg.angular_velocity.z = 0.25
+    msg.linear_acceleration.z = 9.81
+    for covariance in ("orientation", "angular_velocity", "linear_acceleration"):
+        setattr(msg, f"{covariance}_covariance", [0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01])
+    return msg
+
+
 def _clock() -> Any:
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
 
@@ -153,6 +166,7 @@ KINDS = {
         Kind("tf20", "tf2_msgs/msg/TFMessage", "gz.msgs.Pose_V", lambda: _tf(20), "transform"),
         Kind("twist", "geometry_msgs/msg/Twist", "gz.msgs.Twist", _twist, "twist"),
         Kind("odometry", "nav_msgs/msg/Odometry", "gz.msgs.Odometry", _odometry, "header"),
+        Kind("imu", "sensor_msgs/msg/Imu", "gz.msgs.IMU", _imu, "header"),
         Kind("clock", "rosgraph_msgs/msg/Clock", "gz.msgs.Clock", _clock, "clock"),
     )
 }

@@ -1,7 +1,8 @@
 """Write one benchmark's section of BENCHMARKS.md, leaving the other sections as they are.
 
 Each benchmark owns the text between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->``;
-sections are kept in the order they were first written.
+sections are kept in the order they were first written, except the one written ``first``
+(the headline), which always comes right after the title.
 """
 
 from __future__ import annotations
@@ -37,12 +38,19 @@ def machine_line() -> str:
     )
 
 
-def write_section(name: str, body: str) -> None:
-    """Replace (or append) the section ``name`` of BENCHMARKS.md with ``body``."""
+def write_section(name: str, body: str, *, first: bool = False) -> None:
+    """Replace (or append) the section ``name`` of BENCHMARKS.md with ``body``; ``first``
+    puts it right after the title."""
     begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
     block = f"{begin}\n{body.rstrip()}\n\n_Machine: {machine_line()}._\n{end}\n"
     text = REPORT.read_text(encoding="utf-8") if REPORT.exists() else TITLE
-    if begin in text and end in text:
+    if first:
+        if begin in text and end in text:
+            head, rest = text.split(begin, 1)
+            text = head.rstrip("\n") + "\n\n" + rest.split(end, 1)[1].lstrip("\n")
+        rest = text[len(TITLE) :] if text.startswith(TITLE) else text
+        text = TITLE + "\n" + block + "\n" + rest.lstrip("\n")
+    elif begin in text and end in text:
         head, rest = text.split(begin, 1)
         _, tail = rest.split(end, 1)
         text = head + block + tail.lstrip("\n")

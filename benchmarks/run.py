@@ -1,8 +1,10 @@
 """``make bench``: every benchmark in one go, each bounded, rewriting BENCHMARKS.md.
 
 Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
-about 12 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
+about 16 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
 Each module writes its own section; a module that fails is reported and the others still run.
+Last, the headline is rewritten from the figures stored by ``sustained``, ``costs`` and
+``starvation`` (this run's, or their last run's when they were not run), and its plots drawn.
 The Gazebo ends of ZeroMQ flows are the C++ peer on the real ign-transport 11 (built on first
 use, see ``tests/gzpeer.py``); ``BENCH_GZ_END=python`` puts our Python workers there instead.
 """
@@ -18,26 +20,37 @@ from collections.abc import Callable
 
 from benchmarks import (
     conversion,
+    costs,
     discovery,
+    headline,
     images,
     memory,
     small_messages,
     starvation,
+    sustained,
     transport,
 )
 from benchmarks.harness import stop_all
 from benchmarks.report import write_section
 from ros_gz_bridge_py.ros.speed import PROFILE
 
+#: The offered 1080p rates of a quick run.
+QUICK_RATES = (30.0, 90.0, 150.0)
+
 
 def steps(quick: bool) -> dict[str, Callable[[], int]]:
     """Each benchmark with the phase lengths of a full (or quick) run."""
     flow = 1.5 if quick else 2.5
+    rates = QUICK_RATES if quick else sustained.RATES
     return {
         "conversion": lambda: conversion.main(["--seconds", "0.2" if quick else "0.5"]),
         "transport": lambda: transport.main(["--seconds", "1" if quick else "2"]),
         "images": lambda: images.main(["--seconds", str(flow)]),
+        "sustained": lambda: sustained.main(
+            ["--seconds", "1.5" if quick else "5", "--rates", *(f"{hz:g}" for hz in rates)]
+        ),
         "small_messages": lambda: small_messages.main(["--seconds", str(flow)]),
+        "costs": lambda: costs.main(["--seconds", "1.5" if quick else "3"]),
         "starvation": lambda: starvation.main(["--seconds", "3" if quick else "5"]),
         "discovery": lambda: discovery.main(
             ["--idle", "5" if quick else "10"] + (["--counts", "10", "100"] if quick else [])
@@ -68,6 +81,7 @@ def main(argv: list[str] | None = None) -> int:
         finally:
             stop_all()
         lines.append(f"- `{name}`: {outcome} in {time.monotonic() - began:.0f} s")
+    headline.main([])  # from the figures just measured and the stored ones of the others
     flags = (" --quick" if args.quick else "") + (f" --only {' '.join(names)}" if args.only else "")
     write_section(
         "run",

@@ -19,6 +19,7 @@ SIZES = {
     "twist": "Twist",
     "odometry": "Odometry",
     "tf20": "TFMessage (20)",
+    "imu": "Imu",
     "clock": "Clock",
 }
 

@@ -1,9 +1,11 @@
 """Benchmark endpoint processes: a ROS or Gazebo publisher or subscriber of one message kind.
 
-``python -m benchmarks.workers ROLE TOPIC KIND SECONDS [--hz HZ] [--slow-ms MS]`` with ROLE one
-of ``ros-pub``, ``ros-sub``, ``gz-pub``, ``gz-sub``. Lines printed, in order: ``READY`` (the
-endpoint exists), ``CONNECTED`` (publishers: a subscriber is matched), ``START``, then
-``SENT n SECONDS s``; subscribers print ``MATCHED`` when they see a publisher and, on SIGTERM
+``python -m benchmarks.workers ROLE TOPIC KIND SECONDS [--hz HZ] [--slow-ms MS] [--depth N]
+[--qos-profile NAME] [--flood TOPIC --flood-kind KIND --flood-hz HZ --flood-lead S]`` with ROLE
+one of ``ros-pub``, ``ros-sub``, ``gz-pub``, ``gz-sub``. Lines printed, in order: ``READY`` (the
+endpoint exists), ``CONNECTED`` (publishers: a subscriber is matched), with ``--flood``
+``FLOOD_START``, then ``START``, ``SENT n SECONDS s`` and with ``--flood`` ``FLOOD_SENT n``;
+subscribers print ``MATCHED`` when they see a publisher and, on SIGTERM
 or after SECONDS, the same ``STATS`` line as ``benchmarks.transport``. ROS ends use the speed
 settings of the bridge executables (Fast DDS SHM profile, EventsExecutor, allocator tuning);
 Gazebo ends use the backend ``GZ_TRANSPORT_IMPLEMENTATION`` names.
@@ -18,6 +20,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 from benchmarks.payloads import KINDS, GzPayloads, Kind, gz_stamp, now_ns, ros_stamp, stamp_ros
@@ -74,9 +77,60 @@ def _pace(hz: float) -> Callable[[], None]:
     return wait
 
 
-def _publish_loop(seconds: float, hz: float, send: Callable[[], None]) -> None:
+@dataclass(frozen=True)
+class FloodArgs:
+    """``--flood TOPIC --flood-kind KIND [--flood-hz HZ] [--flood-lead S]``."""
+
+    topic: str
+    kind: Kind
+    hz: float
+    lead: float
+
+
+class Flood:
+    """A second stream of a publisher process, as the C++ peer's ``--flood`` (its
+    ``tests/peer/flood.hh``): its own thread sends from its first subscriber on until
+    :meth:`stop`."""
+
+    def __init__(self, args: FloodArgs, connected: Callable[[], bool], send: Callable[[], None]):
+        self._args = args
+        self._stop = threading.Event()
+        self._started = threading.Event()
+        self.sent = 0
+        self._thread = threading.Thread(target=self._run, args=(connected, send), daemon=True)
+        self._thread.start()
+
+    def _run(self, connected: Callable[[], bool], send: Callable[[], None]) -> None:
+        while not connected() and not self._stop.is_set():
+            time.sleep(0.01)
+        self._started.set()
+        pace = _pace(self._args.hz)
+        while not self._stop.is_set():
+            pace()
+            send()
+            self.sent += 1
+
+    def wait_until_flowing(self) -> None:
+        """Wait until the flood has sent for its lead time (FLOOD_START once it sends)."""
+        if not self._started.wait(MATCH_WAIT):
+            say("FLOOD_NO_CONNECTIONS")
+            return
+        say("FLOOD_START")
+        time.sleep(self._args.lead)
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join()
+        say(f"FLOOD_SENT {self.sent}")
+
+
+def _publish_loop(
+    seconds: float, hz: float, send: Callable[[], None], flood: Flood | None = None
+) -> None:
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    if flood is not None:
+        flood.wait_until_flowing()
     pace = _pace(hz)
     say("START")
     start = now_ns()
@@ -102,17 +156,33 @@ def _ros_start() -> Any:
     return rclpy
 
 
-def _ros_qos(depth: int | None = None) -> Any:
+def _ros_qos(depth: int | None = None, profile: str | None = None) -> Any:
     from ros_gz_bridge_py.ros.qos import endpoint_qos  # noqa: PLC0415
 
-    return endpoint_qos(None, depth)
+    return endpoint_qos(profile, depth)
 
 
-def ros_pub(topic: str, kind: Kind, seconds: float, hz: float, depth: int | None) -> None:
+def _ros_flood(node: Any, args: FloodArgs | None) -> Flood | None:
+    if args is None:
+        return None
+    publisher = node.create_publisher(args.kind.pair.ros_class, args.topic, _ros_qos())
+    msg = args.kind.make_ros()
+
+    def send() -> None:
+        stamp_ros(args.kind, msg, now_ns())
+        publisher.publish(msg)
+
+    return Flood(args, lambda: publisher.get_subscription_count() > 0, send)
+
+
+def ros_pub(
+    topic: str, kind: Kind, seconds: float, hz: float, depth: int | None, *, flood: FloodArgs | None
+) -> None:
     rclpy = _ros_start()
     node = rclpy.create_node(f"bench_pub_{os.getpid()}")
     publisher = node.create_publisher(kind.pair.ros_class, topic, _ros_qos(depth))
     msg = kind.make_ros()
+    flooding = _ros_flood(node, flood)
     say("READY")
     deadline = time.monotonic() + MATCH_WAIT
     while publisher.get_subscription_count() == 0 and time.monotonic() < deadline:
@@ -127,13 +197,17 @@ def ros_pub(topic: str, kind: Kind, seconds: float, hz: float, depth: int | None
         stamp_ros(kind, msg, now_ns())
         publisher.publish(msg)
 
-    _publish_loop(seconds, hz, send)
+    _publish_loop(seconds, hz, send, flooding)
     time.sleep(0.5)
+    if flooding is not None:
+        flooding.stop()
     node.destroy_node()
     rclpy.try_shutdown()
 
 
-def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | None) -> None:
+def ros_sub(
+    topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | None, *, profile: str | None
+) -> None:
     """Spin on a daemon thread; the main thread waits for SIGTERM or ``seconds`` and reports,
     so the STATS line never depends on the executor shutting down cleanly under load."""
     rclpy = _ros_start()
@@ -148,7 +222,7 @@ def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | 
     def on_message(msg: Any) -> None:
         recorder.record(ros_stamp(kind, msg), 0)
 
-    node.create_subscription(kind.pair.ros_class, topic, on_message, _ros_qos(depth))
+    node.create_subscription(kind.pair.ros_class, topic, on_message, _ros_qos(depth, profile))
     say("READY")
     _announce_match(lambda: node.count_publishers(topic) > 0)
     stop = threading.Event()
@@ -161,10 +235,20 @@ def ros_sub(topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | 
         while not stop.is_set():
             executor.spin_until_future_complete(never, timeout_sec=0.5)
 
-    threading.Thread(target=spin, daemon=True).start()
+    spinning = threading.Thread(target=spin, daemon=True)
+    spinning.start()
     stop.wait(seconds)
     recorder.report()
-    os._exit(0)  # rclpy's threads need no orderly goodbye
+    stop.set()
+    spinning.join(timeout=2)
+    # Leave the DDS graph in order: a reader that vanishes without a goodbye stays matched to
+    # the bridge's writer until the lease expires, and the writer's shared-memory sends to its
+    # dead port stall the next flow of that channel for about a second.
+    try:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    finally:
+        os._exit(0)  # nothing else of rclpy needs to wind down
 
 
 def _announce_match(matched: Callable[[], bool]) -> None:
@@ -179,10 +263,21 @@ def _announce_match(matched: Callable[[], bool]) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def gz_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
+def _gz_flood(node: Any, args: FloodArgs | None) -> Flood | None:
+    if args is None:
+        return None
+    publisher = node.advertise(args.topic, args.kind.gz_type)
+    payloads = GzPayloads(args.kind)
+    return Flood(
+        args, publisher.has_connections, lambda: publisher.publish_raw(payloads.payload(now_ns()))
+    )
+
+
+def gz_pub(topic: str, kind: Kind, seconds: float, hz: float, flood: FloodArgs | None) -> None:
     payloads = GzPayloads(kind)
     with create_gz_node() as node:
         publisher = node.advertise(topic, kind.gz_type)
+        flooding = _gz_flood(node, flood)
         say("READY")
         deadline = time.monotonic() + MATCH_WAIT
         while not publisher.has_connections() and time.monotonic() < deadline:
@@ -192,8 +287,11 @@ def gz_pub(topic: str, kind: Kind, seconds: float, hz: float) -> None:
             return
         say("CONNECTED")
         time.sleep(SETTLE)
-        _publish_loop(seconds, hz, lambda: publisher.publish_raw(payloads.payload(now_ns())))
+        send = lambda: publisher.publish_raw(payloads.payload(now_ns()))  # noqa: E731
+        _publish_loop(seconds, hz, send, flooding)
         time.sleep(0.5)
+        if flooding is not None:
+            flooding.stop()
 
 
 def gz_sub(topic: str, kind: Kind, seconds: float, slow_s: float) -> None:
@@ -223,14 +321,29 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--hz", type=float, default=0.0, help="publishers: rate (0: flat out)")
     parser.add_argument("--slow-ms", type=float, default=0.0, help="subscribers: work per message")
     parser.add_argument("--depth", type=int, default=None, help="ros ends: history depth")
+    parser.add_argument("--qos-profile", help="ros-sub: a named profile (e.g. CLOCK)")
+    parser.add_argument("--flood", help="publishers: topic of a second stream (see Flood)")
+    parser.add_argument("--flood-kind", choices=sorted(KINDS), default="image1080")
+    parser.add_argument("--flood-hz", type=float, default=0.0, help="0: back to back")
+    parser.add_argument("--flood-lead", type=float, default=3.0, help="seconds before START")
     args = parser.parse_args(argv)
     kind = KINDS[args.kind]
+    flood = None
+    if args.flood:
+        flood = FloodArgs(args.flood, KINDS[args.flood_kind], args.flood_hz, args.flood_lead)
     if args.role == "ros-pub":
-        ros_pub(args.topic, kind, args.seconds, args.hz, args.depth)
+        ros_pub(args.topic, kind, args.seconds, args.hz, args.depth, flood=flood)
     elif args.role == "ros-sub":
-        ros_sub(args.topic, kind, args.seconds, args.slow_ms / 1000, args.depth)
+        ros_sub(
+            args.topic,
+            kind,
+            args.seconds,
+            args.slow_ms / 1000,
+            args.depth,
+            profile=args.qos_profile,
+        )
     elif args.role == "gz-pub":
-        gz_pub(args.topic, kind, args.seconds, args.hz)
+        gz_pub(args.topic, kind, args.seconds, args.hz, flood)
     else:
         gz_sub(args.topic, kind, args.seconds, args.slow_ms / 1000)
     return 0

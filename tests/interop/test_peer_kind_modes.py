@@ -100,3 +100,42 @@ def test_kind_pub_rejects_a_stamp_path_the_type_lacks(ign_peer: Path, tmp_path: 
     )  # fmt: skip
     assert peer.wait(10) == 2
     assert "stamp path header.nonsense: no field nonsense" in peer.output()
+
+
+def test_kind_pub_floods_a_second_topic_from_the_same_process(
+    ign_peer: Path, gz_node: Any, tmp_path: Path
+) -> None:
+    clock, image = message_class("gz.msgs.Clock"), message_class("gz.msgs.Image")
+    frame = image(width=4, height=2, data=bytes(range(24)))
+    frame.header.data.add(key="frame_id", value=["camera"])
+    (tmp_path / "clock.pb").write_bytes(b"")
+    (tmp_path / "image.pb").write_bytes(frame.SerializeToString())
+    clock_topic, image_topic = unique_name("kind_clock"), unique_name("kind_flood")
+    clocks, images = Inbox(), Inbox()
+    gz_node.subscribe_typed(clock_topic, clock, clocks, msg_type="gz.msgs.Clock")
+    gz_node.subscribe_typed(image_topic, image, images, msg_type="gz.msgs.Image")
+
+    peer = start_peer(
+        "kind-pub", clock_topic, "ignition.msgs.Clock", str(tmp_path / "clock.pb"), "0.5",
+        "--hz", "40", "--stamp", "sim", "--wire-type", "gz.msgs.Clock",
+        "--flood", image_topic, "--flood-type", "ignition.msgs.Image",
+        "--flood-file", str(tmp_path / "image.pb"), "--flood-stamp", "header.stamp",
+        "--flood-wire-type", "gz.msgs.Image", "--flood-hz", "100", "--flood-lead", "0.3",
+    )  # fmt: skip
+    wait_for_line(peer, r"^FLOOD_START$", 15)
+    wait_for_line(peer, r"^START$", 5)
+    sent = int(wait_for_line(peer, r"^SENT (\d+)", 15)[1])
+    flooded = int(wait_for_line(peer, r"^FLOOD_SENT (\d+)", 5)[1])
+    clocks.wait_for_count(sent, timeout=5)
+    arrived = images.wait_for_count(flooded, timeout=5)
+
+    # The flood ran from its lead before the first clock message to after the last one.
+    assert flooded >= 100 * (0.3 + 0.5) * 0.8
+    assert len(arrived) == flooded
+    last_clock = max(msg.sim.sec * NS + msg.sim.nsec for msg, _ in clocks.items())
+    stamps = [msg.header.stamp.sec * NS + msg.header.stamp.nsec for msg, _ in arrived]
+    assert stamps[-1] > last_clock
+    for msg, info in arrived:
+        assert info.msg_type == "gz.msgs.Image"
+        msg.header.ClearField("stamp")
+        assert msg == frame

@@ -9,13 +9,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <functional>
-#include <iterator>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include "flood.hh"
 #include "messages.hh"
 #include "modes.hh"
 #include "output.hh"
@@ -45,10 +45,12 @@ double Percentile(std::vector<double> &sorted, double fraction) {
 
 // Advertises TOPIC as `type`, waits up to --wait seconds (default 5) for a subscriber, then
 // calls `send(now)` back to back, or every 1/HZ s with --hz, for SECONDS; prints READY,
-// CONNECTED, START and `SENT n SECONDS s`. Returns the exit status.
+// CONNECTED, START and `SENT n SECONDS s`. `beforeStart`, when given, runs just before START.
+// Returns the exit status.
 int PublishFor(const Args &args, const std::string &topic, const std::string &type,
                double seconds, const std::function<void(ignition::transport::Node::Publisher &,
-                                                        std::int64_t)> &send) {
+                                                        std::int64_t)> &send,
+               const std::function<void()> &beforeStart = nullptr) {
   const double hz = args.Number("hz", 0);
   ignition::transport::Node node;
   auto pub = node.Advertise(topic, type);
@@ -65,6 +67,7 @@ int PublishFor(const Args &args, const std::string &topic, const std::string &ty
   }
   Line("CONNECTED");
   SleepFor(args.Number("settle", 0.3));
+  if (beforeStart) beforeStart();
   Line("START");
   const std::int64_t start = MonotonicNs();
   const std::int64_t end = start + static_cast<std::int64_t>(seconds * 1e9);
@@ -163,12 +166,6 @@ int RecordFor(const Args &args, const std::string &topic, const std::string &typ
   return 0;
 }
 
-std::string ReadFile(const std::string &path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UsageError("cannot read " + path);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 }  // namespace
 
 // bench-pub TOPIC SIZE SECONDS [--hz HZ] [--wait S]: publishes stamped Bytes of SIZE data
@@ -200,9 +197,11 @@ int RunBenchSub(const Args &args) {
                    });
 }
 
-// kind-pub TOPIC TYPE FILE SECONDS --stamp PATH [--hz HZ] [--wait S] [--wire-type WIRETYPE]:
-// publishes the TYPE message serialized in FILE with the send time written at PATH, serialized
-// anew for every message as a simulator does, advertised and sent as WIRETYPE (default TYPE).
+// kind-pub TOPIC TYPE FILE SECONDS --stamp PATH [--hz HZ] [--wait S] [--wire-type WIRETYPE]
+// [--flood TOPIC ...]: publishes the TYPE message serialized in FILE with the send time written
+// at PATH, serialized anew for every message as a simulator does, advertised and sent as
+// WIRETYPE (default TYPE). With --flood (see flood.hh) the same process also publishes a second
+// stream, from --flood-lead seconds before START until 0.5 s after SENT, then prints FLOOD_SENT.
 int RunKindPub(const Args &args) {
   const std::string type = args.Word(2, "TYPE");
   auto msg = MakeMessage(type, "");
@@ -212,12 +211,20 @@ int RunKindPub(const Args &args) {
   const StampPath stamp(*msg, args.Text("stamp", ""));
   const std::string wireType = args.Text("wire-type", type);
   std::string payload;
-  return PublishFor(args, args.Word(1, "TOPIC"), wireType, ToNumber(args.Word(4, "SECONDS"), "SECONDS"),
-                    [&](ignition::transport::Node::Publisher &pub, std::int64_t now) {
-                      stamp.Write(*msg, now);
-                      msg->SerializeToString(&payload);
-                      pub.PublishRaw(payload, wireType);
-                    });
+  std::unique_ptr<Flood> flood;
+  if (args.Has("flood")) flood = std::make_unique<Flood>(args);
+  const int status = PublishFor(
+      args, args.Word(1, "TOPIC"), wireType, ToNumber(args.Word(4, "SECONDS"), "SECONDS"),
+      [&](ignition::transport::Node::Publisher &pub, std::int64_t now) {
+        stamp.Write(*msg, now);
+        msg->SerializeToString(&payload);
+        pub.PublishRaw(payload, wireType);
+      },
+      [&] {
+        if (flood) flood->WaitUntilFlowing(args.Number("wait", 5));
+      });
+  if (flood) flood->Stop();
+  return status;
 }
 
 // kind-sub TOPIC TYPE SECONDS --stamp PATH [--count N] [--wire-type WIRETYPE]: parses every

@@ -24,7 +24,8 @@ constexpr char kUsage[] =
     "  bench-pub TOPIC SIZE SECONDS [--hz HZ] [--wait S]\n"
     "  bench-sub TOPIC SECONDS [--count N]\n"
     "  kind-pub TOPIC TYPE FILE SECONDS --stamp PATH [--hz HZ] [--wait S] [--settle S]\n"
-    "      [--wire-type WIRETYPE]\n"
+    "      [--wire-type WIRETYPE] [--flood TOPIC --flood-type TYPE --flood-file FILE\n"
+    "      --flood-stamp PATH [--flood-hz HZ] [--flood-wire-type WIRETYPE] [--flood-lead S]]\n"
     "  kind-sub TOPIC TYPE SECONDS --stamp PATH [--count N] [--wire-type WIRETYPE]\n";
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <atomic>
 #include <csignal>
 #include <cstdint>
+#include <fstream>
+#include <iterator>
 
 #include "args.hh"
 #include "output.hh"
@@ -51,6 +53,12 @@ void AppendField(std::string &payload, const std::string &spec) {
   AppendVarint(payload, (static_cast<std::uint64_t>(number) << 3) | kLengthDelimited);
   AppendVarint(payload, body.size());
   payload += body;
+}
+
+std::string ReadFile(const std::string &path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UsageError("cannot read " + path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 std::string PatternBytes(std::size_t size) {

@@ -20,6 +20,9 @@ std::unique_ptr<google::protobuf::Message> MakeMessage(const std::string &type,
 // `gz.msgs.IMU`, whose numbers differ from `ignition.msgs.IMU`.
 void AppendField(std::string &payload, const std::string &spec);
 
+// The contents of the file at `path`; throws UsageError when it cannot be read.
+std::string ReadFile(const std::string &path);
+
 // `size` pseudo-random bytes (xorshift), so a corrupted or truncated copy cannot pass a digest
 // check by accident the way a constant fill could.
 std::string PatternBytes(std::size_t size);

@@ -1,0 +1,270 @@
+"""The headline of BENCHMARKS.md: issue 15's figures at a glance, and the plots.
+
+Usage: ``.venv/bin/python -m benchmarks.headline`` (``benchmarks.run`` calls it last). It
+reads what ``sustained``, ``costs`` and ``starvation`` stored in ``benchmarks/results.json``,
+writes the ``headline`` section at the top of BENCHMARKS.md and draws the plots it links.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from benchmarks import plots, starvation
+from benchmarks.costs import GZ_TO_ROS, ROS_TO_GZ, flow_key, per_message_ms
+from benchmarks.harness import FlowResult
+from benchmarks.reference import (
+    CLOCK_UNDER_FLOOD,
+    CPU_PER_FRAME_30HZ,
+    CPU_PER_MESSAGE,
+    GOAL_CLOCK_SHARE,
+    GOAL_CPU_PER_FRAME_30HZ_MS,
+    GOAL_LATENCY_30HZ_MS,
+    GOAL_SUSTAINED_HZ,
+    LATENCY_30HZ,
+    QUOTED,
+    SUSTAINED_1080P,
+    cpu_goal_ms,
+)
+from benchmarks.report import write_section
+from benchmarks.results import Stored, load
+from benchmarks.sustained import PACED_HZ, highest, side_flows
+from benchmarks.tables import SIZES, verdict
+
+HEADER = (
+    "| figure | this bridge | ceiling, same run | goal (issue 15) "
+    f"| C++ ros_gz_bridge ({QUOTED}) |\n|---|---|---|---|---|"
+)
+CASES = [("GZ->ROS", kind, hz) for kind, hz in GZ_TO_ROS]
+CASES += [("ROS->GZ", kind, hz) for kind, hz in ROS_TO_GZ]
+
+
+def _ms(value: float | None) -> str:
+    return "-" if value is None else f"{value:.3f}"
+
+
+def _latency(flow: FlowResult) -> str:
+    return f"{flow.median_us / 1000:.1f} ms (p99 {flow.p99_us / 1000:.1f} ms)"
+
+
+def _rate(hz: float | None, offered: list[float]) -> str:
+    if hz is None:
+        return f"below {min(offered):g} Hz"
+    return f"{hz:g} Hz" + (" (the highest offered)" if hz == max(offered) else "")
+
+
+def image_rows(stored: Stored | None) -> list[str]:
+    """Highest sustainable 1080p rate; latency and CPU per frame at 30 Hz."""
+    if stored is None:
+        return ["| 1080p Gazebo -> ROS | not measured yet (`benchmarks.sustained`) ||||"]
+    bridge, ceiling = side_flows(stored, "bridge"), side_flows(stored, "ceiling")
+    best, offered = highest(bridge), sorted(bridge)
+    met = best is not None and best >= GOAL_SUSTAINED_HZ
+    rows = [
+        "| Highest sustainable 1080p rate, Gazebo -> ROS (>= 99% delivered, p99 < 100 ms) "
+        f"| **{_rate(best, offered)}** | {_rate(highest(ceiling), offered)} "
+        f"| >= {GOAL_SUSTAINED_HZ:g} Hz: {verdict(met, f'{GOAL_SUSTAINED_HZ - (best or 0):g} Hz')}"
+        f" | {SUSTAINED_1080P.cpp_text()} |"
+    ]
+    paced, base = bridge.get(PACED_HZ), ceiling.get(PACED_HZ)
+    if paced is None or paced.error:
+        return rows
+    median = paced.median_us / 1000
+    late = f"{median - GOAL_LATENCY_30HZ_MS:.2f} ms"
+    rows.append(
+        f"| 1080p Gazebo -> ROS at {PACED_HZ:g} Hz, latency median | **{_latency(paced)}** "
+        f"| {'-' if base is None or base.error else _latency(base)} "
+        f"| <= {GOAL_LATENCY_30HZ_MS:g} ms: {verdict(median <= GOAL_LATENCY_30HZ_MS, late)} "
+        f"| {LATENCY_30HZ.cpp_text()} |"
+    )
+    frame = per_message_ms(paced.cpu, PACED_HZ, paced)
+    if frame is not None:
+        over = f"{frame - GOAL_CPU_PER_FRAME_30HZ_MS:.2f} ms"
+        rows.append(
+            f"| 1080p Gazebo -> ROS at {PACED_HZ:g} Hz, bridge CPU per frame "
+            f"| **{frame:.2f} ms** | - | <= {GOAL_CPU_PER_FRAME_30HZ_MS:g} ms: "
+            f"{verdict(frame <= GOAL_CPU_PER_FRAME_30HZ_MS, over)} "
+            f"| {CPU_PER_FRAME_30HZ.cpp_text()} |"
+        )
+    return rows
+
+
+def clock_row(stored: Stored | None) -> str:
+    what = "/clock at 1 kHz received while 1080p frames flood the same Gazebo process"
+    default = None if stored is None else stored.flow(starvation.DEFAULT.name)
+    if stored is None or default is None or default.error:
+        return f"| {what} | not measured yet (`benchmarks.starvation`) ||||"
+    ceiling = stored.flow(starvation.CEILING.name)
+    gap = f"{(GOAL_CLOCK_SHARE - default.share) * 100:.1f} points"
+    return (
+        f"| {what} (depth-10 subscriber) | **{default.share:.1%}**, latency "
+        f"{_latency(default)} | {'-' if ceiling is None else f'{ceiling.share:.1%}'} "
+        f"| >= {GOAL_CLOCK_SHARE:.0%}: {verdict(default.share >= GOAL_CLOCK_SHARE, gap)} "
+        f"| {CLOCK_UNDER_FLOOD.cpp_text()} |"
+    )
+
+
+def _ends(stored: Stored, kind: str, hz: float) -> tuple[float | None, float | None]:
+    """CPU per message of the rclpy publisher and subscriber at the same rate (ms)."""
+    ceiling = stored.flow(flow_key("ceiling", kind, hz))
+    if ceiling is None:
+        return None, None
+    return (
+        per_message_ms(ceiling.pub_cpu, hz, ceiling),
+        per_message_ms(ceiling.sub_cpu, hz, ceiling),
+    )
+
+
+def cpu_rows(stored: Stored | None) -> list[str]:
+    """The issue's three CPU-per-message goals."""
+    rows = []
+    for (kind, way, hz), quoted in CPU_PER_MESSAGE.items():
+        what = f"CPU per message, {SIZES[kind]} {way} at {hz / 1000:g} kHz"
+        flow = None if stored is None else stored.flow(flow_key(way, kind, hz))
+        cost = None if flow is None else per_message_ms(flow.cpu, hz, flow)
+        if stored is None or flow is None or cost is None:
+            rows.append(f"| {what} | not measured yet (`benchmarks.costs`) ||||")
+            continue
+        publisher, subscriber = _ends(stored, kind, hz)
+        end = f"rclpy publisher {_ms(publisher)} ms, subscriber {_ms(subscriber)} ms"
+        bar = cpu_goal_ms(quoted)
+        misses = [f"{cost - bar:.3f} ms ({cost / bar:.1f}x)"] if cost > bar else []
+        if flow.received < flow.sent:
+            misses.append(f"{flow.sent - flow.received} messages not delivered")
+        rows.append(
+            f"| {what}, every message delivered | **{cost:.3f} ms** "
+            f"({flow.received}/{flow.sent} delivered) | {end} "
+            f"| <= {bar:.3f} ms: {verdict(not misses, ' and '.join(misses))} "
+            f"| {quoted.cpp_text()} |"
+        )
+    return rows
+
+
+def per_type(stored: Stored | None) -> str:
+    """CPU per delivered message of every type, direction and rate measured."""
+    if stored is None:
+        return "Not measured yet (`benchmarks.costs`)."
+    lines = [
+        "| message | direction | rate | bridge, ms per message | rclpy publisher, ms "
+        "| rclpy subscriber, ms | delivered/sent |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for way, kind, hz in CASES:
+        flow = stored.flow(flow_key(way, kind, hz))
+        if flow is None:
+            continue
+        publisher, subscriber = _ends(stored, kind, hz)
+        lines.append(
+            f"| {SIZES[kind]} | {way} | {hz / 1000:g} kHz "
+            f"| **{_ms(per_message_ms(flow.cpu, hz, flow))}** | {_ms(publisher)} "
+            f"| {_ms(subscriber)} | {flow.received}/{flow.sent} |"
+        )
+    return "\n".join(lines)
+
+
+def cpu_notes(stored: Stored | None) -> list[str]:
+    """For each CPU-per-message goal missed: the bridge's cost beside the rclpy ends'."""
+    lines = []
+    for (kind, way, hz), quoted in CPU_PER_MESSAGE.items():
+        flow = None if stored is None else stored.flow(flow_key(way, kind, hz))
+        cost = None if flow is None else per_message_ms(flow.cpu, hz, flow)
+        if stored is None or cost is None or cost <= cpu_goal_ms(quoted):
+            continue
+        publisher, subscriber = _ends(stored, kind, hz)
+        if publisher is None or subscriber is None:
+            continue
+        lines.append(
+            f"- {SIZES[kind]} {way} at {hz / 1000:g} kHz: the bridge spent {cost:.3f} ms per "
+            f"message; an rclpy publisher and an rclpy subscriber of the same rate spent "
+            f"{publisher:.3f} + {subscriber:.3f} = {publisher + subscriber:.3f} ms "
+            f"({cost / (publisher + subscriber):.1f}x). The bridge does both ends of a hop "
+            "(a receive and a send, with the conversion between) in one Python process: the "
+            "Python work per message, not the transports, is what it pays."
+        )
+    return lines
+
+
+def clock_notes(stored: Stored | None) -> list[str]:
+    """The starvation benchmark's account of where the clock was lost, from its stored run."""
+    if stored is None:
+        return []
+    runs = {}
+    for phase in starvation.PHASES:
+        flow = stored.flow(phase.name)
+        if flow is None:
+            return []
+        numbers = stored.numbers
+        names = [f"{phase.name} bridge {counter}" for counter in ("in", "out", "dropped")]
+        counted = None
+        if all(name in numbers for name in names):
+            counted = (int(numbers[names[0]]), int(numbers[names[1]]), int(numbers[names[2]]))
+        runs[phase.name] = starvation.ClockRun(phase, flow, counted)
+    return starvation.bounds(runs)
+
+
+def draw(sustained: Stored | None, costs: Stored | None) -> str:
+    """Draw the plots and link them (or say why they are not drawn)."""
+    try:
+        links = []
+        if sustained is not None:
+            links.append(
+                f"![1080p: delivered rate and p99 latency]({plots.sustained_plot(sustained)})"
+            )
+        if costs is not None:
+            links.append(f"![CPU per delivered message per type]({plots.costs_plot(costs)})")
+    except ImportError:
+        return "Plots not drawn: matplotlib is missing (`make bench` installs `.[bench]`)."
+    return "\n\n".join(links)
+
+
+def section() -> str:
+    sustained, costs, clock = load("sustained"), load("costs"), load("starvation")
+    rows = [*image_rows(sustained), clock_row(clock), *cpu_rows(costs)]
+    runs = [
+        f"- `{name}`: {stored.run_line()}"
+        for name, stored in (("sustained", sustained), ("costs", costs), ("starvation", clock))
+        if stored is not None
+    ]
+    notes = clock_notes(clock)
+    cpu_missed = cpu_notes(costs)
+    cpu_text = ""
+    if cpu_missed:
+        cpu_text = (
+            "\nWhat bounds the CPU per message where it misses:\n" + "\n".join(cpu_missed) + "\n"
+        )
+    return f"""## Headline (issue 15)
+
+Written by `make bench` (`benchmarks.headline`) from the last run of each benchmark (stored in
+`benchmarks/results.json`; when and under what load below). Each figure stands beside its
+ceiling, measured in the same run: rclpy -> rclpy with the bridge's speed settings. The C++
+ros_gz_bridge cannot be built here: its figures are quoted from issue 15, which measured it
+side by side with this bridge on this machine type (medians of three rounds); none of them is
+measured by these benchmarks. Details, and every other figure, in the sections below.
+
+{HEADER}
+{chr(10).join(rows)}
+
+CPU per delivered message, per type (a fixed rate, histories deep enough that every message
+arrives; the rclpy columns are the publisher and subscriber processes of rclpy -> rclpy at the
+same rate, the same run: what a ROS node in Python spends on each end of the hop):
+
+{per_type(costs)}
+
+{draw(sustained, costs)}
+
+Where /clock was lost under the flood:
+{chr(10).join(notes) if notes else "- not measured yet (`benchmarks.starvation`)"}
+{cpu_text}
+Measured (2 cores shared with other work: every figure is noisy, the load averages say how
+busy the machine was):
+{chr(10).join(runs)}
+"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    del argv  # no options
+    write_section("headline", section(), first=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,111 @@
+"""The PNG plots of BENCHMARKS.md, drawn from ``benchmarks/results.json`` (matplotlib, Agg).
+
+matplotlib comes with the ``bench`` extra (``pip install '.[bench]'``, which ``make bench``
+does); it is imported only inside the functions that draw, so nothing else needs it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from benchmarks.costs import GZ_TO_ROS, ROS_TO_GZ, flow_key, per_message_ms
+from benchmarks.reference import CPU_PER_MESSAGE, QUOTED, SUSTAINED_P99_MS, cpu_goal_ms
+from benchmarks.results import COSTS_PNG, SUSTAINED_PNG, Stored
+from benchmarks.sustained import side_flows
+from benchmarks.tables import SIZES
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+ROOT = Path(__file__).resolve().parent.parent
+#: The bars of the CPU plot: the bridge, then the rclpy ends of the ceiling flow.
+BARS = ("bridge", "rclpy publisher", "rclpy subscriber")
+
+
+def _agg() -> None:
+    import matplotlib  # noqa: PLC0415 - the optional bench extra, only when drawing
+
+    matplotlib.use("Agg")
+
+
+def sustained_plot(stored: Stored) -> str:
+    """Delivered rate and p99 latency against the offered rate, bridge and ceiling."""
+    _agg()
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    figure, (rates, latencies) = plt.subplots(2, 1, sharex=True, figsize=(7, 6.5))
+    top = 0.0
+    for side, style, label in (
+        ("bridge", "o-", "parameter_bridge, Gazebo -> ROS"),
+        ("ceiling", "s--", "ceiling: rclpy -> rclpy"),
+    ):
+        flows = {hz: flow for hz, flow in side_flows(stored, side).items() if not flow.error}
+        offered = list(flows)
+        top = max([top, *offered])
+        rates.plot(offered, [flow.rate for flow in flows.values()], style, label=label)
+        latencies.plot(offered, [flow.p99_us / 1000 for flow in flows.values()], style, label=label)
+    rates.plot([0, top], [0, top], ":", color="grey", label="delivered = offered")
+    latencies.axhline(SUSTAINED_P99_MS, color="grey", linestyle=":", label="sustainable limit")
+    rates.set_ylabel("delivered frames/s")
+    latencies.set_ylabel("p99 latency, ms")
+    latencies.set_xlabel("offered rate, Hz (1920x1080 rgb8 images)")
+    rates.set_title(f"1080p Gazebo -> ROS ({stored.when}, load {stored.load_before:.2f})")
+    for axes in (rates, latencies):
+        axes.grid(alpha=0.3)
+        axes.legend(fontsize=8)
+    return _save(figure, SUSTAINED_PNG)
+
+
+def _costs(stored: Stored, way: str, kind: str, hz: float) -> list[float]:
+    """The bars of one case, ms per message (0 where not measured)."""
+    flow, ceiling = stored.flow(flow_key(way, kind, hz)), stored.flow(flow_key("ceiling", kind, hz))
+    values = [per_message_ms(flow.cpu, hz, flow) if flow else None]
+    if ceiling is not None:
+        values += [per_message_ms(cpu, hz, ceiling) for cpu in (ceiling.pub_cpu, ceiling.sub_cpu)]
+    return [value or 0.0 for value in values] + [0.0] * (len(BARS) - len(values))
+
+
+def costs_plot(stored: Stored) -> str:
+    """CPU per delivered message per type and direction: the bridge, the rclpy ends of the
+    same rate, and the quoted C++ bar."""
+    _agg()
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    cases = [("GZ->ROS", kind, hz) for kind, hz in GZ_TO_ROS]
+    cases += [("ROS->GZ", kind, hz) for kind, hz in ROS_TO_GZ]
+    labels = [f"{SIZES[kind]} {way} {hz / 1000:g} kHz" for way, kind, hz in cases]
+    values = [_costs(stored, *case) for case in cases]
+    figure, axes = plt.subplots(figsize=(8, 0.6 * len(cases) + 1.5))
+    height = 0.27
+    for bar, name in enumerate(BARS):
+        positions = [i + (bar - 1) * height for i in range(len(cases))]
+        axes.barh(positions, [case[bar] for case in values], height=height, label=name)
+    quoted = [
+        (i - height, cpu_goal_ms(CPU_PER_MESSAGE[key[1], key[0], key[2]]))
+        for i, key in enumerate(cases)
+        if (key[1], key[0], key[2]) in CPU_PER_MESSAGE
+    ]
+    if quoted:
+        axes.scatter(
+            [ms for _, ms in quoted], [at for at, _ in quoted], marker="|", s=300, color="black",
+            label=f"C++ bridge, the goal ({QUOTED})",
+        )  # fmt: skip
+    axes.set_yticks(range(len(cases)), labels, fontsize=8)
+    axes.invert_yaxis()
+    axes.set_xlabel("CPU time per delivered message, ms")
+    axes.set_title(f"CPU per message ({stored.when}, load {stored.load_before:.2f})")
+    axes.grid(axis="x", alpha=0.3)
+    axes.legend(fontsize=7, loc="lower right")
+    return _save(figure, COSTS_PNG)
+
+
+def _save(figure: Figure, relative: str) -> str:
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    path = ROOT / relative
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.tight_layout()
+    figure.savefig(path, dpi=100, metadata={"Software": None})
+    plt.close(figure)
+    return relative
