@@ -178,6 +178,10 @@ class Soak:
             time.sleep(0.1)
 
     def _finish(self) -> None:
+        # The ROS side stops publishing and prints its final counts; the commands still on
+        # their way then reach Gazebo, so both ends count the same commands.
+        self.ros.stop()
+        time.sleep(0.5)
         stats = lines(self.ros, "STATS ")
         self.figures.ros = json.loads(stats[-1]) if stats else {}
         self.figures.commands_at_gazebo = len(lines(self.echo, "MSG "))
