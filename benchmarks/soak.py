@@ -180,7 +180,7 @@ class Soak:
     def _finish(self) -> None:
         # The ROS side stops publishing and prints its final counts; the commands still on
         # their way then reach Gazebo, so both ends count the same commands.
-        self.ros.stop()
+        self.ros.stop(grace=5.0)
         time.sleep(0.5)
         stats = lines(self.ros, "STATS ")
         self.figures.ros = json.loads(stats[-1]) if stats else {}

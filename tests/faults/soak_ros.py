@@ -29,6 +29,8 @@ CMD_PERIOD = 0.02
 CALL_PERIOD = 0.2
 CHURN_PERIOD = 2.0
 MAX_WAITING_CALLS = 10
+#: Seconds the node lives on after its last command, so that command reaches the bridge.
+LINGER = 0.5
 
 
 class Counts:
@@ -77,7 +79,9 @@ def main() -> int:
         while not stop.requested and time.monotonic() < end:
             executor.spin_once(timeout_sec=0.005)
             now = time.monotonic()
-            if now >= next_cmd:
+            # Commands start once the bridge's subscription is matched: a volatile reliable
+            # writer does not keep what it wrote before.
+            if now >= next_cmd and publisher.get_subscription_count() > 0:
                 counts.cmd_sent += 1
                 message = Twist()
                 message.linear.x = float(counts.cmd_sent)
@@ -104,6 +108,10 @@ def main() -> int:
             if now >= next_stats:
                 print_stats(counts, len(waiting))
                 next_stats = now + 1.0
+        # Reliable samples just written are delivered while the node lives, not after.
+        linger_until = time.monotonic() + LINGER
+        while time.monotonic() < linger_until:
+            executor.spin_once(timeout_sec=0.05)
         print_stats(counts, len(waiting))
         node.destroy_node()
         rclpy.try_shutdown()
