@@ -165,6 +165,15 @@ def started() -> Iterator[list[PeerProcess]]:
         process.stop()
 
 
+@pytest.fixture
+def probe(request: pytest.FixtureRequest) -> Iterator[RosSide]:
+    """The ROS side of one test, a node named after its module (``test_x`` -> ``x_probe``)."""
+    module = request.module.__name__.rsplit(".", 1)[-1].removeprefix("test_")
+    side = RosSide(f"{module}_probe")
+    yield side
+    side.close()
+
+
 @pytest.fixture(scope="module")
 def ros_side() -> Iterator[RosSide]:
     side = RosSide(f"behaviour_test_{threading.get_ident() % 100000}")

@@ -15,7 +15,6 @@ import os
 import re
 import socket
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -28,6 +27,7 @@ from tests.bridge.behaviour_harness import (
     WAIT,
     RosSide,
     bridge_command,
+    probe,
     publish_until,
     started,
 )
@@ -41,18 +41,11 @@ from tests.gzpeer import (
     wait_until,
 )
 
-__all__ = ["started"]
+__all__ = ["probe", "started"]
 
 pytestmark = [pytest.mark.ros, pytest.mark.peer]
 
 GAZEBO_SIDE = Path(__file__).resolve().parent / "e2e_zenoh_gazebo.py"
-
-
-@pytest.fixture
-def probe() -> Iterator[RosSide]:
-    side = RosSide("discovered_probe")
-    yield side
-    side.close()
 
 
 def ros_topics(ros: RosSide) -> dict[str, list[str]]:

@@ -6,13 +6,11 @@ side is the real C++ Fortress peer.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 from sensor_msgs.msg import Image
 from std_msgs.msg import String
 
-from tests.bridge.behaviour_harness import WAIT, RosSide, bridge_command, relative, started
+from tests.bridge.behaviour_harness import WAIT, RosSide, bridge_command, probe, relative, started
 from tests.bridge.image_frames import image_bridge_command, rgb_text_proto
 from tests.gzpeer import (
     PeerProcess,
@@ -24,16 +22,9 @@ from tests.gzpeer import (
     wait_until,
 )
 
-__all__ = ["started"]
+__all__ = ["probe", "started"]
 
 pytestmark = [pytest.mark.ros, pytest.mark.peer]
-
-
-@pytest.fixture
-def probe() -> Iterator[RosSide]:
-    side = RosSide("namespaces_probe")
-    yield side
-    side.close()
 
 
 def test_a_namespaced_command_line_bridge_and_image_bridge_publish_under_it(

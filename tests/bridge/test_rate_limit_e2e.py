@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from std_msgs.msg import String
 
-from tests.bridge.behaviour_harness import WAIT, RosSide, bridge_command, started
+from tests.bridge.behaviour_harness import WAIT, RosSide, bridge_command, probe, started
 from tests.gzpeer import (
     PeerProcess,
     require_peer,
@@ -28,18 +27,11 @@ from tests.gzpeer import (
     wait_until,
 )
 
-__all__ = ["started"]
+__all__ = ["probe", "started"]
 
 pytestmark = [pytest.mark.ros, pytest.mark.peer]
 
 WINDOW = 4.0
-
-
-@pytest.fixture
-def probe() -> Iterator[RosSide]:
-    side = RosSide("rate_probe")
-    yield side
-    side.close()
 
 
 def _statuses(diagnostics: list[DiagnosticArray], ros_topic: str) -> list[dict[str, str]]:

@@ -9,7 +9,6 @@ started (Fortress subscribers announce no type: the entry gives it), and ROS mes
 from __future__ import annotations
 
 import re
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -20,6 +19,7 @@ from tests.bridge.behaviour_harness import (
     WAIT,
     RosSide,
     bridge_command,
+    probe,
     publish_until,
     started,
 )
@@ -33,16 +33,9 @@ from tests.gzpeer import (
     wait_until,
 )
 
-__all__ = ["started"]
+__all__ = ["probe", "started"]
 
 pytestmark = [pytest.mark.ros, pytest.mark.peer]
-
-
-@pytest.fixture
-def probe() -> Iterator[RosSide]:
-    side = RosSide("templates_probe")
-    yield side
-    side.close()
 
 
 def test_one_templated_entry_bridges_two_robots_and_a_wildcard_takes_a_late_topic(
