@@ -138,7 +138,13 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
             return USAGE_EXIT
         if stop.requested:
             return 0
-        serve(node, bridge, stop, events_executor=switches.events_executor)
+        serve(
+            node,
+            bridge,
+            stop,
+            events_executor=switches.events_executor,
+            dds_event_batch=switches.dds_event_batch,
+        )
     finally:
         if bridge is not None:
             bridge.close()

@@ -174,7 +174,13 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 return discover_yaml(node, cli, params, discover_seconds, values)
             bridge, discovered = build_bridge(node, cli, params, switches, values)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
-            serve(node, bridge, stop, events_executor=switches.events_executor)
+            serve(
+                node,
+                bridge,
+                stop,
+                events_executor=switches.events_executor,
+                dds_event_batch=switches.dds_event_batch,
+            )
         finally:
             if diagnostics is not None:
                 diagnostics.close()

@@ -41,7 +41,11 @@ from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.channel import Channel, ChannelState
 from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
-from ros_gz_bridge_py.ros.runtime import make_executor, spin_until_stopped
+from ros_gz_bridge_py.ros.runtime import (
+    batch_dds_event_threads,
+    make_executor,
+    spin_until_stopped,
+)
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 #: Prefix of every DiagnosticStatus name, as ``ros_gz_bridge: <direction> <ros name>``.
@@ -338,10 +342,20 @@ def table_on_signal(
         signal.signal(signum, previous)
 
 
-def serve(ros_node: Any, bridge: Bridge, stop: StopSignal, *, events_executor: bool) -> None:
+def serve(
+    ros_node: Any,
+    bridge: Bridge,
+    stop: StopSignal,
+    *,
+    events_executor: bool,
+    dds_event_batch: bool,
+) -> None:
     """What both executables do once their bridges exist: spin ``ros_node`` until ``stop`` or
     rclpy shutdown, printing the status table on SIGUSR1 meanwhile. ``events_executor``: see
-    :func:`~ros_gz_bridge_py.ros.runtime.make_executor`."""
+    :func:`~ros_gz_bridge_py.ros.runtime.make_executor`; ``dds_event_batch``:
+    :func:`~ros_gz_bridge_py.ros.runtime.batch_dds_event_threads` first."""
+    if dds_event_batch:
+        batch_dds_event_threads()
     executor = make_executor(events=events_executor)
     executor.add_node(ros_node)
     with table_on_signal(bridge):

@@ -11,6 +11,7 @@ peer and our node, and land in rclpy. Every field is checked on arrival.
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -21,6 +22,7 @@ from geometry_msgs.msg import Twist
 from sensor_msgs.msg import Image, PointCloud2, PointField
 
 from ros_gz_bridge_py.app.settings import BULK_PATH_ENV as BULK_ENV
+from ros_gz_bridge_py.app.settings import DDS_EVENT_BATCH_ENV
 from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.errors import ConversionError
@@ -57,7 +59,11 @@ WIDTH, HEIGHT = 6, 4
 VARIANTS = {
     "bulk": {},
     "bulk-rclpy-publish": {"ROS_GZ_BRIDGE_SERIALIZED_PUBLISH": "rclpy"},
-    "object": {"ROS_GZ_BRIDGE_BULK_PATH": "off", "ROS_GZ_BRIDGE_LIGHT_READ": "off"},
+    "object": {
+        "ROS_GZ_BRIDGE_BULK_PATH": "off",
+        "ROS_GZ_BRIDGE_LIGHT_READ": "off",
+        DDS_EVENT_BATCH_ENV: "off",
+    },
 }
 
 
@@ -233,6 +239,28 @@ def test_gazebo_to_ros_image_from_the_real_peer(
     bulk = VARIANTS[bridge.variant].get(BULK_ENV) != "off"
     expected = [BULK_THREAD_NICE, BULK_THREAD_NICE] if bulk else []
     assert thread_nice_values(bridge.process.pid) == expected
+
+
+def test_only_fast_dds_event_threads_are_batched(bridge: RunningBridge) -> None:
+    """Fast DDS's event thread runs under SCHED_BATCH once the bridge serves (so its wake-ups
+    do not preempt the thread writing a message), unless switched off; no other thread does."""
+    expected = set() if VARIANTS[bridge.variant].get(DDS_EVENT_BATCH_ENV) == "off" else {"dds.ev"}
+    wait_until(
+        lambda: batched_thread_names(bridge.process.pid) == expected,
+        WAIT,
+        f"SCHED_BATCH on exactly {expected or 'no thread'}",
+    )
+
+
+def batched_thread_names(pid: int) -> set[str]:
+    """The names (up to the last dot) of ``pid``'s threads under SCHED_BATCH."""
+    names = set()
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        with contextlib.suppress(OSError):
+            if os.sched_getscheduler(int(tid)) == os.SCHED_BATCH:
+                with open(f"/proc/{pid}/task/{tid}/comm", encoding="utf-8") as comm:
+                    names.add(comm.read().strip().rsplit(".", 1)[0])
+    return names
 
 
 def thread_nice_values(pid: int) -> list[int]:

@@ -16,6 +16,7 @@ from ros_gz_bridge_py.app.settings import (
     BULK_NICE_ENV,
     BULK_PATH_ENV,
     CDR_WRITE_ENV,
+    DDS_EVENT_BATCH_ENV,
     EXECUTOR_ENV,
     FASTDDS_PROFILE_ENV,
     LIGHT_READ_ENV,
@@ -40,6 +41,7 @@ OFF_SWITCHES = {
     BULK_PATH_ENV: "bulk_path",
     LIGHT_READ_ENV: "light_read",
     CDR_WRITE_ENV: "cdr_write",
+    DDS_EVENT_BATCH_ENV: "dds_event_batch",
 }
 #: Each choice switch, the value that chooses, and the field it sets False.
 CHOICES = {
@@ -64,6 +66,7 @@ def test_nothing_set_is_the_fast_defaults() -> None:
         bulk_nice=BULK_THREAD_NICE,
         light_read=True,
         cdr_write=True,
+        dds_event_batch=True,
         warnings=(),
     )
 
@@ -129,6 +132,7 @@ def test_every_switch_at_once() -> None:
         BULK_NICE_ENV: "0",
         LIGHT_READ_ENV: "false",
         CDR_WRITE_ENV: "off",
+        DDS_EVENT_BATCH_ENV: "No",
     }
     assert read_switches(env) == Switches(
         events_executor=False,
@@ -138,6 +142,7 @@ def test_every_switch_at_once() -> None:
         bulk_nice=0,
         light_read=False,
         cdr_write=False,
+        dds_event_batch=False,
     )
 
 
