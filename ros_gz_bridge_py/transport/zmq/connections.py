@@ -117,8 +117,15 @@ class SubConnections:
 
     def next_deadline(self) -> float | None:
         """When :meth:`turn` next has something to do (None: only on a monitor event)."""
+        if not self._dropped and not self._due:
+            return None
         times = [t + CONFIRM_AFTER for t in self._dropped.values()] + list(self._due.values())
         return min(times) if times else None
+
+    def is_due(self, now: float) -> bool:
+        """True when :meth:`turn` has something to do at ``now`` besides monitor events."""
+        deadline = self.next_deadline()
+        return deadline is not None and deadline <= now
 
     def turn(self, now: float | None = None) -> None:
         """Read the monitor, confirm drops libzmq does not retry, reconnect what is due."""
