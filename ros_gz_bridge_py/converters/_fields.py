@@ -22,6 +22,7 @@ import numpy as np
 
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros.constructors import constructor
 
 #: The path of a message itself: ``("pose", WHOLE, POSE)`` fills the whole gz message from the
 #: ROS ``pose`` (a Stamped body), and back.
@@ -82,6 +83,7 @@ def fields(*entries: Entry) -> Fill:
 def each(fill: Fill, new_ros: Callable[[], Any]) -> Fill:
     """The Fill of a list of submessages: one gz element added per ROS item, and the ROS list
     replaced by one new item (``new_ros()``) per gz element."""
+    new_ros = _fast(new_ros)
 
     def to_gz(ros_items: Any, gz_items: Any) -> None:
         for item in ros_items:
@@ -116,6 +118,11 @@ def numbers(typecode: str) -> Fill:
 STRINGS = repeated(list)
 
 
+def _fast(new_ros: Callable[[], Any]) -> Callable[[], Any]:
+    """``new_ros``, or for a message class the faster :func:`constructor` of the same object."""
+    return constructor(new_ros) if isinstance(new_ros, type) else new_ros
+
+
 def _filled(fill: Fill, gz: Any, ros: Any) -> Any:
     fill.to_ros(gz, ros)
     return ros
@@ -130,6 +137,7 @@ def converters(
     gz message does not carry.
     """
     gz_class = message_class(gz_type)
+    new_ros = _fast(new_ros)
 
     def to_gz(ros: Any) -> Any:
         gz = gz_class()

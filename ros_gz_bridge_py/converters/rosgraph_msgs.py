@@ -21,8 +21,10 @@ from ros_gz_bridge_py.converters.builtin_interfaces import (
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros.constructors import constructor
 
 GzClock = message_class("gz.msgs.Clock")
+_new_clock = constructor(Clock)
 
 _NS_PER_S = 10**9
 
@@ -39,7 +41,7 @@ def clock_to_ros(gz: Any) -> Any:
         msg = f"gz.msgs.Clock sim.sec={sec} is negative: ROS cannot store a negative time point"
         raise ConversionError(msg)
     total = sec * _NS_PER_S + to_uint32(gz.sim.nsec)
-    ros = Clock()
+    ros = _new_clock()
     whole, ros.clock.nanosec = divmod(total, _NS_PER_S)
     ros.clock.sec = to_int32(whole)
     return ros

@@ -59,8 +59,10 @@ from ros_gz_bridge_py.converters.sensor_msgs_scan import (
 )
 from ros_gz_bridge_py.converters.std_msgs import HEADER
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros.constructors import constructor
 
 GzModel = message_class("gz.msgs.Model")
+_new_joint_state = constructor(JointState)
 
 
 def _known_power_supply_status(status: int) -> int:
@@ -133,7 +135,7 @@ def joint_state_to_gz(ros: Any) -> Any:
 
 
 def joint_state_to_ros(gz: Any) -> Any:
-    ros = JointState()
+    ros = _new_joint_state()
     HEADER.to_ros(gz.header, ros.header)
     joints = gz.joint
     ros.name = [joint.name for joint in joints]
