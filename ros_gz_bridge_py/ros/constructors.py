@@ -4,7 +4,7 @@ A generated message ``__init__`` imports each nested message class, reads its ke
 arguments, builds every nested message through its own ``__init__`` and stores each field
 through its property setter: an ``Odometry()`` costs ~12.5 µs, a ``TransformStamped()``
 ~5.4 µs, more than half of converting the message. A converter fills every field it maps
-anyway, so all it needs is a message holding the defaults.
+anyway, so all it needs is a message holding the defaults (docs/environment.md §2).
 
 :func:`constructor` compiles, once per class, a function that makes the same object: an
 instance of the same class whose slots hold what ``__init__`` would have stored (nested

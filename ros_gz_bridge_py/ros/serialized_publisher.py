@@ -26,10 +26,13 @@ _RCL_RET_OK = 0
 
 
 class _SerializedMessage(ctypes.Structure):
-    """rcl_serialized_message_t (rcutils_uint8_array_t): buffer, length, capacity, allocator."""
+    """rcl_serialized_message_t (rcutils_uint8_array_t): buffer, length, capacity, allocator.
+
+    ``buffer`` given a ``bytes`` object points into it (no copy) and keeps it alive.
+    """
 
     _fields_ = (
-        ("buffer", ctypes.c_void_p),
+        ("buffer", ctypes.c_char_p),
         ("buffer_length", ctypes.c_size_t),
         ("buffer_capacity", ctypes.c_size_t),
         ("allocator", ctypes.c_void_p * 5),
@@ -75,8 +78,7 @@ class SerializedPublisher:
         if self._rcl is None:
             self._publisher.publish(cdr)
             return
-        address = ctypes.cast(ctypes.c_char_p(cdr), ctypes.c_void_p).value
-        message = _SerializedMessage(address, len(cdr), len(cdr))
+        message = _SerializedMessage(cdr, len(cdr), len(cdr))
         with self._handle:
             ret = self._rcl.publish_serialized(self._pointer, ctypes.byref(message), None)
         if ret != _RCL_RET_OK:
