@@ -66,6 +66,8 @@ DELIVERY_SLICE = 0.001
 IDLE_POLL = 0.25
 #: Messages read from the socket per drain, so a flood cannot hold the thread in reading.
 READ_BATCH = 256
+#: ``zmq.POLLIN`` as a plain int: ``&`` with the enum runs Python code (enum.Flag.__and__).
+_POLLIN = int(zmq.POLLIN)
 #: What a message's (topic, sender, type) frames make of it: what the callback is told, a
 #: rejection (reason, detail), or None (another topic's).
 Verdict = MessageInfo | tuple[Rejection, str] | None
@@ -240,7 +242,7 @@ class SubscriptionReader:
     def _drain(self) -> None:
         sock = self._sock
         for _ in range(READ_BATCH):
-            if not sock.getsockopt(zmq.EVENTS) & zmq.POLLIN:  # cheaper than raising zmq.Again
+            if not sock.getsockopt(zmq.EVENTS) & _POLLIN:  # cheaper than raising zmq.Again
                 return
             frames = receive_message(sock)
             verdict = self._verdict(frames)
