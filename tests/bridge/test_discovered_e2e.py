@@ -11,9 +11,7 @@ values go both ways. ``--discover`` prints a YAML that, fed back, bridges the sa
 from __future__ import annotations
 
 import json
-import os
 import re
-import socket
 import sys
 from pathlib import Path
 
@@ -40,6 +38,7 @@ from tests.gzpeer import (
     wait_for_line,
     wait_until,
 )
+from tests.loopback import free_port, zenoh_env
 
 __all__ = ["probe", "started"]
 
@@ -112,37 +111,15 @@ def test_auto_bridge_follows_real_fortress_peers(
     assert bridge.output().count(f"Not bridging Gazebo {fortress_sub}") == 1
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port: int = sock.getsockname()[1]
-        return port
-
-
-def _zenoh_env(listen: list[str], connect: list[str]) -> dict[str, str]:
-    overrides = {
-        "mode": '"peer"',
-        "scouting/multicast/enabled": "false",
-        "scouting/gossip/enabled": "false",
-        "listen/endpoints": json.dumps(listen),
-        "connect/endpoints": json.dumps(connect),
-    }
-    return dict(
-        os.environ,
-        GZ_TRANSPORT_IMPLEMENTATION="zenoh",
-        GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE=";".join(f"{k}={v}" for k, v in overrides.items()),
-    )
-
-
 def test_auto_bridge_over_zenoh_carries_values_both_ways(
     probe: RosSide, started: list[PeerProcess]
 ) -> None:
     stem = unique_name("zauto")
     pose_gz, cmd_gz = f"{stem}/model/a::b/pose", f"{stem}/cmd_vel"
-    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
     bridge = start_process(
         bridge_command(ros_args=["-p", "auto_bridge:=true", "-p", "subscription_heartbeat:=200"]),
-        _zenoh_env([endpoint], []),
+        zenoh_env("peer", [endpoint], []),
     )
     started.append(bridge)
     wait_for_line(bridge, r"Following Gazebo discovery", timeout=30)
@@ -152,7 +129,7 @@ def test_auto_bridge_over_zenoh_carries_values_both_ways(
         "seconds": 40,
     }
     gazebo = start_process(
-        [sys.executable, str(GAZEBO_SIDE), json.dumps(spec)], _zenoh_env([], [endpoint])
+        [sys.executable, str(GAZEBO_SIDE), json.dumps(spec)], zenoh_env("peer", [], [endpoint])
     )
     started.append(gazebo)
     wait_for_line(gazebo, r"^READY", timeout=30)

@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import functools
 import json
-import os
-import socket
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +31,7 @@ from tests.bridge.e2e_harness import (
 )
 from tests.bridge.e2e_values import TWIST_TO_GZ, mismatches, sample_for
 from tests.gzpeer import PeerProcess, wait_for_line
+from tests.loopback import free_port, zenoh_env
 
 pytestmark = [pytest.mark.ros]
 
@@ -41,30 +40,6 @@ HERE = Path(__file__).resolve().parent
 GAZEBO_SIDE = HERE / "e2e_zenoh_gazebo.py"
 ROUTER = HERE / "e2e_zenoh_router.py"
 ENTRIES = read_entries(CONFIG)
-
-
-def free_port() -> int:
-    """A TCP port on 127.0.0.1 that nothing listens on right now."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-        return port
-
-
-def zenoh_env(mode: str, listen: list[str], connect: list[str]) -> dict[str, str]:
-    """Our environment plus the gz-transport 15 Zenoh settings for one process."""
-    overrides = {
-        "mode": json.dumps(mode),
-        "scouting/multicast/enabled": "false",
-        "scouting/gossip/enabled": "false",
-        "listen/endpoints": json.dumps(listen),
-        "connect/endpoints": json.dumps(connect),
-    }
-    return dict(
-        os.environ,
-        GZ_TRANSPORT_IMPLEMENTATION="zenoh",
-        GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE=";".join(f"{k}={v}" for k, v in overrides.items()),
-    )
 
 
 @dataclass

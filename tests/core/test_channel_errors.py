@@ -8,9 +8,8 @@ rclpy node of its own context; another memory node plays the Gazebo publishers.
 from __future__ import annotations
 
 import dataclasses
-import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -25,6 +24,7 @@ from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError, Undecoda
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import Rejection, TransportSettings
 from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
+from tests.polling import wait_until
 
 STRING = "gz.msgs.StringMsg"
 IMAGE = "gz.msgs.Image"
@@ -32,15 +32,6 @@ StringMsg = message_class(STRING)
 GzImage = message_class(IMAGE)
 LIMIT = 1000
 RGB_INT8 = 3
-
-
-def wait_until(condition: Callable[[], bool], timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 class Setup:

@@ -10,7 +10,6 @@ Interoperability with real Gazebo is tested elsewhere (tests/interop, against ig
 from __future__ import annotations
 
 import dataclasses
-import socket
 import threading
 import time
 import uuid
@@ -27,20 +26,12 @@ from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
 from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
 from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
+from tests.loopback import free_port
+from tests.polling import wait_until
 
 GZ, IGN = "gz.msgs.StringMsg", "ignition.msgs.StringMsg"
 StringMsg = message_class(GZ)
 LIMIT = 10.0
-
-
-def wait_until(condition: Callable[[], bool]) -> bool:
-    """Poll ``condition``; tests assert on the outcome, never on the time taken."""
-    deadline = time.monotonic() + LIMIT
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def publish_until(publish: Callable[[], None], condition: Callable[[], bool]) -> bool:
@@ -59,15 +50,8 @@ def unique(name: str) -> str:
     return f"/{name}_{uuid.uuid4().hex[:8]}"
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port: int = sock.getsockname()[1]
-        return port
-
-
 def _zenoh_pair(settings: TransportSettings | None = None) -> tuple[GzNode, GzNode]:
-    where = f"tcp/127.0.0.1:{_free_port()}"
+    where = f"tcp/127.0.0.1:{free_port()}"
     a = ZenohGzNode(settings=settings, config=endpoints_config("peer", listen=[where]))
     b = ZenohGzNode(settings=settings, config=endpoints_config("peer", connect=[where]))
     return a, b

@@ -23,17 +23,9 @@ from ros_gz_bridge_py.transport.zmq.wire import (
     PublisherRecord,
     encode_discovery,
 )
+from tests.polling import wait_until
 
 COUNT = 2000
-
-
-def wait_until(condition: Callable[[], bool], timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def free_udp_port_pair() -> int:

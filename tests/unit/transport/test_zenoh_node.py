@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import json
 import queue
-import socket
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +30,8 @@ from ros_gz_bridge_py.transport.zenoh.config import (
     session_config,
 )
 from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
+from tests.loopback import free_port
+from tests.polling import wait_until
 
 PEER_SCRIPT = Path(__file__).with_name("zenoh_peer.py")
 ROOT = PEER_SCRIPT.parents[3]
@@ -41,24 +42,8 @@ StringMsg = message_class(STRING)
 LIMIT = 10.0
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port: int = sock.getsockname()[1]
-        return port
-
-
 def endpoint(port: int) -> str:
     return f"tcp/127.0.0.1:{port}"
-
-
-def wait_until(condition: Callable[[], bool]) -> bool:
-    deadline = time.monotonic() + LIMIT
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 class Peer:

@@ -12,7 +12,7 @@ import sys
 import textwrap
 import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -23,20 +23,12 @@ from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import MessageInfo, Rejection, TransportSettings
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
 from ros_gz_bridge_py.transport.zmq.wire import ServiceRequest, encode_request
+from tests.polling import wait_until
 from tests.rogue import FakePeer, RoguePublisher, TrapListeners
 
 STRING = "gz.msgs.StringMsg"
 StringMsg = message_class(STRING)
 LIMIT = 1_000_000
-
-
-def wait_until(condition: Callable[[], bool], timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def unique(name: str) -> str:

@@ -14,18 +14,9 @@ from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
 from ros_gz_bridge_py.transport import MessageInfo, create_gz_node
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
+from tests.polling import wait_until
 
 StringMsg = message_class("gz.msgs.StringMsg")
-
-
-def wait_until(condition: Callable[[], bool], timeout: float = 10.0) -> bool:
-    """Poll ``condition``; the tests assert on the outcome, never on the time taken."""
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def publish_until(publish: Callable[[], None], condition: Callable[[], bool]) -> bool:
