@@ -8,6 +8,9 @@
 namespace peer {
 namespace {
 
+// How long Stop waits after the last publish before the count is printed.
+constexpr double kFlushSeconds = 0.3;
+
 std::unique_ptr<google::protobuf::Message> ReadMessage(const Args &args) {
   const std::string type = args.Text("flood-type", "");
   auto msg = MakeMessage(type, "");
@@ -68,6 +71,9 @@ void Flood::Stop() {
   if (!thread_.joinable()) return;
   stop_ = true;
   thread_.join();
+  // ZeroMQ writes from its own I/O thread and the process exits soon after FLOOD_SENT: give
+  // the last messages published time to leave, so every message counted is on the wire.
+  SleepFor(kFlushSeconds);
   Line("FLOOD_SENT " + std::to_string(sent_.load()));
 }
 

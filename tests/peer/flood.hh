@@ -34,7 +34,7 @@ class Flood {
   // Waits (at most `wait` seconds) until the flood has published for --flood-lead seconds;
   // prints FLOOD_START when it publishes, FLOOD_NO_CONNECTIONS when nobody subscribed.
   void WaitUntilFlowing(double wait);
-  // Stops the thread and prints `FLOOD_SENT n`. Idempotent.
+  // Stops the thread, lets the last messages leave, and prints `FLOOD_SENT n`. Idempotent.
   void Stop();
 
  private:
