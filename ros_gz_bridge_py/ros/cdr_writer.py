@@ -9,9 +9,10 @@ against ~12 µs).
 A writer is compiled once per message class from rclpy's own type description: Python source
 with one statement per field, consecutive basic fields of one size packed by one
 ``struct.Struct``, alignment padding left out wherever the offset is known when compiling (a
-``Pose`` after a ``Header`` is padded once, not seven times). It reads attributes only, so it
-writes rclpy messages and anything with the same attribute names. Numeric arrays are written
-as one block (numpy arrays and ``array.array`` through ``tobytes``).
+``Pose`` after a ``Header`` is padded once, not seven times). It reads each field from the
+slot behind rclpy's property (``m._x``: the getter is a Python call that only returns it), so
+a message's nested messages must be of their declared classes, as rclpy's own publish requires
+too. Numeric arrays are written as one block (numpy arrays and ``array.array`` through ``tobytes``).
 
 It writes what rclpy writes (docs/cdr.md §2-§4; tests compare every pair's ROS type byte for
 byte; rclpy leaves padding bytes uninitialised, this module writes zeros). A value it cannot
@@ -162,21 +163,34 @@ def _struct(source: _Source, msg_class: type[Any], expr: str, indent: int) -> No
     for name, slot in fields:
         if not name.isidentifier() or keyword.iskeyword(name):
             raise _UnwritableTypeError(name)
+        value = f"{expr}.{_stored(msg_class, name)}"
         basic = cdr.basic_of(slot)
         if basic is not None:
             size, code = _basic(basic)
             if run and size != run_size:
                 _pack_run(source, run, run_size, indent)
                 run = []
-            run.append((f"{expr}.{name}", code))
+            run.append((value, code))
             run_size = size
             continue
         if run:
             _pack_run(source, run, run_size, indent)
             run = []
-        _field(source, slot, f"{expr}.{name}", indent)
+        _field(source, slot, value, indent)
     if run:
         _pack_run(source, run, run_size, indent)
+
+
+def _stored(msg_class: type[Any], name: str) -> str:
+    """Where ``msg_class`` keeps field ``name``: its slot ``_name`` behind the property
+    ``name`` in rclpy's classes (read directly: the property getter is a Python call per field,
+    that only returns the slot), else the attribute ``name`` itself."""
+    slot = f"_{name}"
+    if isinstance(getattr(msg_class, name, None), property) and slot in getattr(
+        msg_class, "__slots__", ()
+    ):
+        return slot
+    return name
 
 
 def _basic(typename: str) -> tuple[int, str]:

@@ -11,6 +11,7 @@ padding, and both must read back as the same message.
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -135,3 +136,17 @@ def _clock(**stamp: Any) -> Any:
     for name, value in stamp.items():
         object.__setattr__(time, f"_{name}", value)  # what a C extension could leave
     return Clock(clock=time)
+
+
+def test_a_nested_message_of_another_class_is_refused() -> None:
+    """The writer reads the slots behind rclpy's properties, so a nested object of another
+    class, even one with the same attribute names, is refused (the channel then hands the
+    message to rclpy, which decides)."""
+    from geometry_msgs.msg import Pose  # noqa: PLC0415
+
+    msg = Pose()
+    msg._position = SimpleNamespace(x=1.0, y=2.0, z=3.0)
+    writer = cdr_writer.writer_for(Pose)
+    assert writer is not None
+    with pytest.raises(AttributeError):
+        writer(msg)
