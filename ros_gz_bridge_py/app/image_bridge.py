@@ -176,8 +176,10 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
     if stop is not None and stop.requested:
         return 0
     switches = read_switches()
-    apply_speed_settings(fastdds_profile=switches.fastdds_profile)
+    cleaned = apply_speed_settings(fastdds_profile=switches.fastdds_profile)
     rclpy.init(args=[argv[0], *ros_args], signal_handler_options=SignalHandlerOptions.NO)
+    if cleaned:
+        rclpy.logging.get_logger(NODE_NAME).info(cleaned)
     if stop is not None:
         return run(topics, switches, stop)
     with StopSignal() as own:

@@ -148,8 +148,10 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
     if stop is not None and stop.requested:
         return 0
     switches = read_switches()
-    apply_speed_settings(fastdds_profile=switches.fastdds_profile)
+    cleaned = apply_speed_settings(fastdds_profile=switches.fastdds_profile)
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    if cleaned:
+        rclpy.logging.get_logger(NODE_NAME).info(cleaned)
     with contextlib.ExitStack() as scope:
         if stop is None:
             stop = scope.enter_context(StopSignal())

@@ -30,7 +30,7 @@ from typing import Any
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import get_default_context
 
-from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
+from ros_gz_bridge_py.ros.speed import apply_fastdds_profile, remove_zombie_segments
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 M_TRIM_THRESHOLD = -1
@@ -50,12 +50,16 @@ def tune_threads() -> None:
     sys.setswitchinterval(SWITCH_INTERVAL)
 
 
-def apply_speed_settings(*, fastdds_profile: bool) -> None:
+def apply_speed_settings(*, fastdds_profile: bool) -> str | None:
     """Everything the executables set before ``rclpy.init``: allocator, GIL, and the Fast DDS
-    profile unless ``fastdds_profile`` is False."""
+    profile unless ``fastdds_profile`` is False. Returns what to log once the node exists: the
+    zombie Fast DDS segments removed, if any."""
     tune_allocator()
     tune_threads()
-    apply_fastdds_profile(enabled=fastdds_profile)
+    if apply_fastdds_profile(enabled=fastdds_profile) is None:
+        return None
+    removed = remove_zombie_segments()
+    return removed.describe() if removed.segments else None
 
 
 def tune_allocator() -> bool:

@@ -8,6 +8,11 @@ is applied only when the user has not chosen otherwise: the RMW is Fast DDS (uns
 ``FASTDDS_DEFAULT_PROFILES_FILE`` is set, and it is not switched off (``enabled=False``; the
 executables' ``ROS_GZ_BRIDGE_FASTDDS_PROFILE=off``, read by :mod:`ros_gz_bridge_py.app.settings`).
 
+A process killed before it closes its participant leaves its segment in ``/dev/shm``: with this
+profile 64 MB of memory each, until reboot. Where the profile is applied, the executables first
+remove the segments whose owner is gone (:func:`remove_zombie_segments`, as ``fastdds shm
+clean`` does; docs/environment.md §2).
+
 The profile replaces Fast DDS's built-in transports with SHM + UDPv4. With
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` / ``ROS_LOCALHOST_ONLY=1`` the bridge plus an rclpy
 subscriber were checked with ``tcpdump -i eth0 udp`` to send nothing off the host.
@@ -15,8 +20,11 @@ subscriber were checked with ``tcpdump -i eth0 udp`` to send nothing off the hos
 
 from __future__ import annotations
 
+import fcntl
 import logging
 import os
+import re
+import time
 from collections.abc import Mapping, MutableMapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +34,13 @@ PROFILE_ENVS = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE
 FAST_DDS_RMW = "rmw_fastrtps_cpp"
 
 _LOG = logging.getLogger(__name__)
+
+#: Where Fast DDS keeps its shared memory on Linux. Each segment ``fastrtps_<16 characters>``
+#: has a lock file ``<segment>_el`` that its owner holds (``flock``) as long as it lives.
+SHM_DIR = Path("/dev/shm")  # noqa: S108 - Fast DDS's fixed place, not a temporary file
+_SEGMENT_LOCK = re.compile(r"^fastrtps_[0-9a-z]{16}_el$")
+#: A lock file younger than this may belong to a segment being made (created, then locked).
+ZOMBIE_MIN_AGE = 10.0
 
 
 @dataclass(frozen=True)
@@ -48,6 +63,46 @@ def decide(env: Mapping[str, str], *, enabled: bool) -> ProfileDecision:
         if env.get(name):
             return ProfileDecision(False, f"{name} is set by the user")
     return ProfileDecision(True, f"Fast DDS with no user profile: applying {PROFILE}")
+
+
+@dataclass(frozen=True)
+class Removed:
+    """What :func:`remove_zombie_segments` removed."""
+
+    segments: int
+    size: int
+
+    def describe(self) -> str:
+        return (
+            f"removed {self.segments} Fast DDS shared-memory segments "
+            f"({self.size / 2**20:.0f} MB) left by processes that exited without closing them"
+        )
+
+
+def remove_zombie_segments(shm_dir: Path = SHM_DIR, min_age: float = ZOMBIE_MIN_AGE) -> Removed:
+    """Remove the Fast DDS segments whose lock file no process holds, older than ``min_age``
+    seconds. A segment's lock is taken (non-blocking) before it is removed, so a live one is
+    never touched."""
+    segments = size = 0
+    try:
+        names = os.listdir(shm_dir)
+    except OSError:
+        return Removed(0, 0)
+    now = time.time()
+    for name in filter(_SEGMENT_LOCK.match, names):
+        lock, segment = shm_dir / name, shm_dir / name.removesuffix("_el")
+        try:
+            if now - lock.stat().st_mtime < min_age:
+                continue
+            with lock.open("ab") as held:
+                fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)  # OSError: its owner lives
+                found = segment.stat().st_size if segment.exists() else 0
+                segment.unlink(missing_ok=True)
+                lock.unlink()
+        except OSError:
+            continue
+        segments, size = segments + 1, size + found
+    return Removed(segments, size)
 
 
 def apply_fastdds_profile(

@@ -1,13 +1,24 @@
-"""When the executables apply the Fast DDS shared-memory profile (ros_speed.py)."""
+"""When the executables apply the Fast DDS shared-memory profile (ros_speed.py), and the zombie
+segments they remove first."""
 
 from __future__ import annotations
 
+import fcntl
+import os
+import time
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import pytest
 
 from ros_gz_bridge_py.app.settings import read_switches
-from ros_gz_bridge_py.ros.speed import PROFILE, apply_fastdds_profile, decide
+from ros_gz_bridge_py.ros.speed import (
+    PROFILE,
+    Removed,
+    apply_fastdds_profile,
+    decide,
+    remove_zombie_segments,
+)
 
 NS = {"f": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
 
@@ -62,3 +73,46 @@ def test_profile_is_a_default_participant_with_a_large_shm_segment() -> None:
     assert types == {"SHM", "UDPv4"}
     shm = next(d for d in kinds.values() if d.findtext("f:type", namespaces=NS) == "SHM")
     assert int(shm.findtext("f:segment_size", "0", NS)) >= 64 * 1024 * 1024
+
+
+# --- zombie Fast DDS segments --------------------------------------------------------------
+
+
+def _segment(shm: Path, name: str, size: int, age: float) -> Path:
+    """A segment and its lock file, as Fast DDS lays them out, the lock ``age`` seconds old."""
+    (shm / name).write_bytes(bytes(size))
+    lock = shm / f"{name}_el"
+    lock.write_bytes(b"")
+    then = time.time() - age
+    os.utime(lock, (then, then))
+    return lock
+
+
+def test_segments_whose_owner_is_gone_are_removed_and_live_ones_kept(tmp_path: Path) -> None:
+    _segment(tmp_path, "fastrtps_0123456789abcdef", 3000, age=60)
+    _segment(tmp_path, "fastrtps_00000000000000aa", 2000, age=60)
+    held = _segment(tmp_path, "fastrtps_fedcba9876543210", 1000, age=60)
+    _segment(tmp_path, "fastrtps_1111111111111111", 500, age=1)  # being made, maybe
+    _segment(tmp_path, "fastrtps_port7411", 100, age=60)  # ports are left alone
+    (tmp_path / "other_el").write_bytes(b"")
+    with held.open("ab") as owner:
+        fcntl.flock(owner, fcntl.LOCK_EX | fcntl.LOCK_NB)  # a live process holds its lock
+        removed = remove_zombie_segments(tmp_path, min_age=10)
+    assert (removed.segments, removed.size) == (2, 5000)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "fastrtps_1111111111111111",
+        "fastrtps_1111111111111111_el",
+        "fastrtps_fedcba9876543210",
+        "fastrtps_fedcba9876543210_el",
+        "fastrtps_port7411",
+        "fastrtps_port7411_el",
+        "other_el",
+    ]
+    assert removed.describe() == (
+        "removed 2 Fast DDS shared-memory segments (0 MB) left by processes that exited "
+        "without closing them"
+    )
+
+
+def test_no_shared_memory_directory_removes_nothing(tmp_path: Path) -> None:
+    assert remove_zombie_segments(tmp_path / "missing") == Removed(0, 0)
