@@ -12,7 +12,7 @@ import os
 import sys
 
 from benchmarks.bridged import backend, ceilings, through_bridge
-from benchmarks.harness import GZ_ENDS, FlowResult
+from benchmarks.harness import GZ_ENDS, PYTHON_THREADS, THREAD_GROUPS, FlowResult
 from benchmarks.reference import CPU_PER_MESSAGE, QUOTED, cpu_goal_ms
 from benchmarks.report import write_section
 from benchmarks.results import store
@@ -29,12 +29,14 @@ GZ_TO_ROS = (
 )
 ROS_TO_GZ = (("odometry", 1000.0), ("odometry", 5000.0), ("twist", 1000.0), ("twist", 5000.0))
 
-
+#: The thread groups of the split columns, in order, and the column's title.
+SPLIT_GROUPS = (PYTHON_THREADS, *(name for name, _ in THREAD_GROUPS))
+SPLIT_COLUMN = "of which " + " / ".join(SPLIT_GROUPS) + " threads, ms"
 HEADER = (
     "| message | direction | rate | delivered/sent | median ms | bridge CPU "
-    "| bridge CPU per message, ms | rclpy publisher per message, ms "
+    f"| bridge CPU per message, ms | {SPLIT_COLUMN} | rclpy publisher per message, ms "
     f"| rclpy subscriber per message, ms | C++ bridge per message, ms ({QUOTED}) |\n"
-    "|---|---|---|---|---|---|---|---|---|---|"
+    "|---|---|---|---|---|---|---|---|---|---|---|"
 )
 
 
@@ -45,6 +47,25 @@ def per_message_ms(cpu: float | None, hz: float, result: FlowResult) -> float | 
     if cpu is None or delivered_rate <= 0 or result.error:
         return None
     return cpu / 100 / delivered_rate * 1000
+
+
+def thread_split_ms(hz: float, result: FlowResult) -> dict[str, float] | None:
+    """The bridge's CPU time per delivered message (ms) by thread group
+    (:data:`~benchmarks.harness.THREAD_GROUPS`), where measured."""
+    split: dict[str, float] = {}
+    for group, cpu in (result.bridge_threads or {}).items():
+        ms = per_message_ms(cpu, hz, result)
+        if ms is None:
+            return None
+        split[group] = ms
+    return split or None
+
+
+def split_text(split: dict[str, float] | None) -> str:
+    """``0.140 / 0.014 / 0.007``: the split in the order of :data:`SPLIT_GROUPS`."""
+    if split is None:
+        return "-"
+    return " / ".join(f"{split.get(group, 0.0):.3f}" for group in SPLIT_GROUPS)
 
 
 def flow_key(way: str, kind: str, hz: float) -> str:
@@ -60,7 +81,7 @@ def _row(row: Row, way: str) -> str:
     result, ceiling = row.result, row.ceiling
     what = f"| {SIZES[row.kind]} | {way} | {row.hz:,.0f} Hz"
     if result.error:
-        return f"{what} | failed: {result.error} ||||||"
+        return f"{what} | failed: {result.error} |||||||"
     quoted = CPU_PER_MESSAGE.get((row.kind, way, row.hz))
     pub = sub = None
     if ceiling is not None:
@@ -69,6 +90,7 @@ def _row(row: Row, way: str) -> str:
     return (
         f"{what} | {result.received}/{result.sent} | {result.median_us / 1000:.2f} "
         f"| {result.cpu or 0:.0f}% | **{_ms(per_message_ms(result.cpu, row.hz, result))}** "
+        f"| {split_text(thread_split_ms(row.hz, result))} "
         f"| {_ms(pub)} | {_ms(sub)} | {quoted.cpp_text() if quoted else '-'} |"
     )
 
@@ -118,7 +140,12 @@ One parameter_bridge (ZeroMQ) with a channel per message type and direction; eac
 publishes at a fixed rate for {seconds:g} s, one row at a time. Every message must arrive:
 histories of {PACED_DEPTH} messages on the ROS ends and in the bridge's channels (YAML
 `publisher_queue` / `subscriber_queue`). **Bridge CPU per message** = the bridge process's CPU
-time over the publishing window (/proc/<pid>/stat, all threads) / the messages delivered. The
+time over the publishing window (/proc/<pid>/stat, all threads) / the messages delivered; the
+split beside it is each thread's run time from the scheduler (/proc/<pid>/task/<tid>/schedstat)
+over the same window, by thread name: libzmq's I/O thread (`ZMQbg/IO/0`), Fast DDS's threads
+(`dds.*`), and the Python threads (the channel's reader, which receives, converts and publishes,
+and the ROS executor on the main thread, which takes ROS messages and converts and publishes
+them to Gazebo). The
 ceiling columns are rclpy -> rclpy at the same rate and depth, in the same run: the CPU the
 rclpy publisher process (stamping and publishing a message object) and the rclpy subscriber
 process (taking and recording it) spend per message, what a ROS node in Python pays for each

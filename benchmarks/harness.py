@@ -116,22 +116,54 @@ def rss_mb(pid: int) -> float:
     return 0.0
 
 
-class CpuWindow:
-    """CPU share (percent of one core) of ``pid`` between :meth:`begin` and :meth:`end`."""
+#: Thread groups of a bridge process, by the start of the thread's name (``comm``): the
+#: threads libzmq and Fast DDS start name themselves; Python's threads keep the process name.
+THREAD_GROUPS = (("libzmq I/O", "ZMQbg/"), ("Fast DDS", "dds."))
+PYTHON_THREADS = "Python"
 
-    def __init__(self, pid: int | None) -> None:
+
+def thread_group_seconds(pid: int) -> dict[str, float]:
+    """CPU seconds of ``pid``'s live threads by group (:data:`THREAD_GROUPS`, the rest
+    :data:`PYTHON_THREADS`), from the scheduler's nanosecond run time (``schedstat``)."""
+    seconds = dict.fromkeys([PYTHON_THREADS, *(name for name, _ in THREAD_GROUPS)], 0.0)
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{tid}/comm", encoding="utf-8") as comm:
+                name = comm.read().strip()
+            with open(f"/proc/{pid}/task/{tid}/schedstat", encoding="ascii") as schedstat:
+                run_ns = int(schedstat.read().split()[0])
+        except (OSError, ValueError, IndexError):  # the thread ended meanwhile
+            continue
+        group = next((g for g, prefix in THREAD_GROUPS if name.startswith(prefix)), None)
+        seconds[group or PYTHON_THREADS] += run_ns / 1e9
+    return seconds
+
+
+class CpuWindow:
+    """CPU share (percent of one core) of ``pid`` between :meth:`begin` and :meth:`end`;
+    with ``by_thread``, also of each thread group (:func:`thread_group_seconds`)."""
+
+    def __init__(self, pid: int | None, *, by_thread: bool = False) -> None:
         self.pid = pid
+        self._by_thread = by_thread
         self._start = (0.0, 0.0)
+        self._groups: dict[str, float] = {}
         self.percent: float | None = None
+        self.groups: dict[str, float] | None = None
 
     def begin(self) -> None:
         if self.pid is not None:
+            if self._by_thread:
+                self._groups = thread_group_seconds(self.pid)
             self._start = (time.monotonic(), cpu_seconds(self.pid))
 
     def end(self) -> None:
         if self.pid is not None:
-            wall = time.monotonic() - self._start[0]
-            self.percent = 100 * (cpu_seconds(self.pid) - self._start[1]) / max(wall, 1e-9)
+            wall = max(time.monotonic() - self._start[0], 1e-9)
+            self.percent = 100 * (cpu_seconds(self.pid) - self._start[1]) / wall
+            if self._by_thread:
+                now = thread_group_seconds(self.pid)
+                self.groups = {g: 100 * (now[g] - self._groups[g]) / wall for g in now}
 
 
 # --- processes --------------------------------------------------------------------------------
@@ -287,6 +319,8 @@ class FlowResult:
     sub_cpu: float | None = None
     #: What the flood's own subscriber measured (flows with a :class:`Flood`).
     flood: FlowResult | None = None
+    #: The bridge's CPU share by thread group (:data:`THREAD_GROUPS`), where measured.
+    bridge_threads: dict[str, float] | None = None
 
     @property
     def share(self) -> float:
@@ -361,7 +395,7 @@ def run_flow(
         ends.append(pub)
         wait_for_line(pub, r"^CONNECTED$", 40)
         wait_for_line(pub, r"^START$", 10 + lead)
-        windows = [CpuWindow(pid) for pid in (bridge_pid, pub.pid, sub.pid)]
+        windows = [CpuWindow(bridge_pid, by_thread=True), CpuWindow(pub.pid), CpuWindow(sub.pid)]
         for window in windows:
             window.begin()
         if during is not None:
@@ -382,7 +416,11 @@ def run_flow(
             end.stop()
     cpu, pub_cpu, sub_cpu = (window.percent for window in windows)
     return dataclasses.replace(
-        _result(sent, stats, cpu), pub_cpu=pub_cpu, sub_cpu=sub_cpu, flood=flooded
+        _result(sent, stats, cpu),
+        pub_cpu=pub_cpu,
+        sub_cpu=sub_cpu,
+        flood=flooded,
+        bridge_threads=windows[0].groups,
     )
 
 

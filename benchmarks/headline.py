@@ -10,8 +10,17 @@ from __future__ import annotations
 import sys
 
 from benchmarks import plots, starvation
-from benchmarks.costs import GZ_TO_ROS, ROS_TO_GZ, flow_key, per_message_ms
-from benchmarks.harness import FlowResult
+from benchmarks.costs import (
+    GZ_TO_ROS,
+    ROS_TO_GZ,
+    SPLIT_COLUMN,
+    SPLIT_GROUPS,
+    flow_key,
+    per_message_ms,
+    split_text,
+    thread_split_ms,
+)
+from benchmarks.harness import PYTHON_THREADS, FlowResult
 from benchmarks.reference import (
     CLOCK_UNDER_FLOOD,
     CPU_PER_FRAME_30HZ,
@@ -144,9 +153,9 @@ def per_type(stored: Stored | None) -> str:
     if stored is None:
         return "Not measured yet (`benchmarks.costs`)."
     lines = [
-        "| message | direction | rate | bridge, ms per message | rclpy publisher, ms "
-        "| rclpy subscriber, ms | delivered/sent |",
-        "|---|---|---|---|---|---|---|",
+        f"| message | direction | rate | bridge, ms per message | {SPLIT_COLUMN} "
+        "| rclpy publisher, ms | rclpy subscriber, ms | delivered/sent |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for way, kind, hz in CASES:
         flow = stored.flow(flow_key(way, kind, hz))
@@ -155,7 +164,8 @@ def per_type(stored: Stored | None) -> str:
         publisher, subscriber = _ends(stored, kind, hz)
         lines.append(
             f"| {SIZES[kind]} | {way} | {hz / 1000:g} kHz "
-            f"| **{_ms(per_message_ms(flow.cpu, hz, flow))}** | {_ms(publisher)} "
+            f"| **{_ms(per_message_ms(flow.cpu, hz, flow))}** "
+            f"| {split_text(thread_split_ms(hz, flow))} | {_ms(publisher)} "
             f"| {_ms(subscriber)} | {flow.received}/{flow.sent} |"
         )
     return "\n".join(lines)
@@ -167,20 +177,37 @@ def cpu_notes(stored: Stored | None) -> list[str]:
     for (kind, way, hz), quoted in CPU_PER_MESSAGE.items():
         flow = None if stored is None else stored.flow(flow_key(way, kind, hz))
         cost = None if flow is None else per_message_ms(flow.cpu, hz, flow)
-        if stored is None or cost is None or cost <= cpu_goal_ms(quoted):
+        if stored is None or flow is None or cost is None or cost <= cpu_goal_ms(quoted):
             continue
         publisher, subscriber = _ends(stored, kind, hz)
         if publisher is None or subscriber is None:
             continue
         lines.append(
             f"- {SIZES[kind]} {way} at {hz / 1000:g} kHz: the bridge spent {cost:.3f} ms per "
-            f"message; an rclpy publisher and an rclpy subscriber of the same rate spent "
-            f"{publisher:.3f} + {subscriber:.3f} = {publisher + subscriber:.3f} ms "
-            f"({cost / (publisher + subscriber):.1f}x). The bridge does both ends of a hop "
-            "(a receive and a send, with the conversion between) in one Python process: the "
-            "Python work per message, not the transports, is what it pays."
+            f"message{_by_thread(thread_split_ms(hz, flow), cpu_goal_ms(quoted))} An rclpy "
+            f"publisher and an rclpy subscriber of the same rate spent {publisher:.3f} + "
+            f"{subscriber:.3f} = {publisher + subscriber:.3f} ms: the bridge makes both ends "
+            "of a hop, with the conversion between, in one Python process."
         )
     return lines
+
+
+def _by_thread(split: dict[str, float] | None, bar: float) -> str:
+    """Where the bridge's CPU went by thread, and what that leaves the C++ bridge's own thread
+    (the end of a sentence)."""
+    if split is None:
+        return "."
+    python = split.get(PYTHON_THREADS, 0.0)
+    transports = sum(ms for group, ms in split.items() if group != PYTHON_THREADS)
+    others = " and ".join(f"{g} threads {split.get(g, 0.0):.3f}" for g in SPLIT_GROUPS[1:])
+    return (
+        f", of which its Python threads {python:.3f} ms, {others}. If libzmq's and Fast DDS's "
+        f"threads cost the C++ bridge what they cost us ({transports:.3f} ms), its "
+        f"{bar:.3f} ms leaves about {max(bar - transports, 0.0):.3f} ms for its callback "
+        "thread (the receive, the conversion and the DDS write or ZeroMQ send), the work our "
+        f"Python threads do in {python:.3f} ms: out of reach while that work runs in the "
+        "interpreter (docs/environment.md, where a small message's CPU goes)."
+    )
 
 
 def clock_notes(stored: Stored | None) -> list[str]:

@@ -9,7 +9,15 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from benchmarks.costs import GZ_TO_ROS, ROS_TO_GZ, flow_key, per_message_ms
+from benchmarks.costs import (
+    GZ_TO_ROS,
+    ROS_TO_GZ,
+    SPLIT_GROUPS,
+    flow_key,
+    per_message_ms,
+    thread_split_ms,
+)
+from benchmarks.harness import PYTHON_THREADS
 from benchmarks.reference import CPU_PER_MESSAGE, QUOTED, SUSTAINED_P99_MS, cpu_goal_ms
 from benchmarks.results import COSTS_PNG, SUSTAINED_PNG, Stored
 from benchmarks.sustained import side_flows
@@ -19,7 +27,8 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 ROOT = Path(__file__).resolve().parent.parent
-#: The bars of the CPU plot: the bridge, then the rclpy ends of the ceiling flow.
+#: The bars of the CPU plot: the bridge (split by thread group where measured), then the rclpy
+#: ends of the ceiling flow.
 BARS = ("bridge", "rclpy publisher", "rclpy subscriber")
 
 
@@ -78,9 +87,17 @@ def costs_plot(stored: Stored) -> str:
     values = [_costs(stored, *case) for case in cases]
     figure, axes = plt.subplots(figsize=(8, 0.6 * len(cases) + 1.5))
     height = 0.27
-    for bar, name in enumerate(BARS):
-        positions = [i + (bar - 1) * height for i in range(len(cases))]
-        axes.barh(positions, [case[bar] for case in values], height=height, label=name)
+    left = [0.0] * len(cases)
+    segments = _bridge_segments(stored, cases, [case[0] for case in values])
+    colours = ("tab:blue", "navy", "tab:cyan")
+    for (name, widths), colour in zip(segments.items(), colours, strict=False):
+        positions = [i - height for i in range(len(cases))]
+        axes.barh(positions, widths, height=height, left=left, color=colour, label=name)
+        left = [a + b for a, b in zip(left, widths, strict=True)]
+    for bar, (name, colour) in enumerate(zip(BARS[1:], ("tab:orange", "tab:green"), strict=True)):
+        positions = [i + bar * height for i in range(len(cases))]
+        widths = [case[bar + 1] for case in values]
+        axes.barh(positions, widths, height=height, color=colour, label=name)
     quoted = [
         (i - height, cpu_goal_ms(CPU_PER_MESSAGE[key[1], key[0], key[2]]))
         for i, key in enumerate(cases)
@@ -98,6 +115,28 @@ def costs_plot(stored: Stored) -> str:
     axes.grid(axis="x", alpha=0.3)
     axes.legend(fontsize=7, loc="lower right")
     return _save(figure, COSTS_PNG)
+
+
+def _bridge_segments(
+    stored: Stored, cases: list[tuple[str, str, float]], totals: list[float]
+) -> dict[str, list[float]]:
+    """The bridge's bar of each case split by thread group where measured (each group's share
+    of the threads' run time, of the process's CPU per message), by label."""
+    shares = []
+    for way, kind, hz in cases:
+        flow = stored.flow(flow_key(way, kind, hz))
+        split = None if flow is None else thread_split_ms(hz, flow)
+        total = sum(split.values()) if split else 0.0
+        shares.append({g: ms / total for g, ms in split.items()} if split and total else None)
+    if not any(shares):
+        return {"bridge": totals}
+    return {
+        f"bridge: {group} threads": [
+            total * (share[group] if share else float(group == PYTHON_THREADS))
+            for total, share in zip(totals, shares, strict=True)
+        ]
+        for group in SPLIT_GROUPS
+    }
 
 
 def _save(figure: Figure, relative: str) -> str:
