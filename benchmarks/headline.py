@@ -88,13 +88,28 @@ def image_rows(stored: Stored | None) -> list[str]:
     frame = per_message_ms(paced.cpu, PACED_HZ, paced)
     if frame is not None:
         over = f"{frame - GOAL_CPU_PER_FRAME_30HZ_MS:.2f} ms"
+        split = thread_split_ms(PACED_HZ, paced)
+        of_which = ""
+        if split is not None:
+            of_which = f" ({' / '.join(SPLIT_GROUPS)} threads: {split_text(split)})"
         rows.append(
             f"| 1080p Gazebo -> ROS at {PACED_HZ:g} Hz, bridge CPU per frame "
-            f"| **{frame:.2f} ms** | - | <= {GOAL_CPU_PER_FRAME_30HZ_MS:g} ms: "
+            f"| **{frame:.2f} ms**{of_which} | {_frame_ends(base)} "
+            f"| <= {GOAL_CPU_PER_FRAME_30HZ_MS:g} ms: "
             f"{verdict(frame <= GOAL_CPU_PER_FRAME_30HZ_MS, over)} "
             f"| {CPU_PER_FRAME_30HZ.cpp_text()} |"
         )
     return rows
+
+
+def _frame_ends(ceiling: FlowResult | None) -> str:
+    """The rclpy ends' CPU per frame in the ceiling flow at the paced rate."""
+    if ceiling is None or ceiling.error:
+        return "-"
+    ends = [per_message_ms(cpu, PACED_HZ, ceiling) for cpu in (ceiling.pub_cpu, ceiling.sub_cpu)]
+    if None in ends:
+        return "-"
+    return f"rclpy publisher {ends[0]:.2f} ms, subscriber {ends[1]:.2f} ms"
 
 
 def clock_row(stored: Stored | None) -> str:

@@ -34,6 +34,8 @@ RATES = (30.0, 60.0, 90.0, 120.0, 150.0, 180.0)
 KIND = "image1080"
 #: The rate the latency and CPU-per-frame goals are judged at.
 PACED_HZ = 30.0
+#: The side the uncounted first flow through the fresh bridge is stored under.
+WARM_UP = "warm-up"
 HEADER = (
     "| offered | bridge msg/s | delivered/sent | median ms | p99 ms | bridge CPU "
     "| bridge CPU per frame, ms | sustainable | ceiling msg/s | delivered/sent | median ms "
@@ -62,12 +64,12 @@ def highest(results: dict[float, FlowResult]) -> float | None:
 
 
 def flow_key(side: str, hz: float) -> str:
-    """The name a flow is stored under: ``bridge 30`` or ``ceiling 30``."""
+    """The name a flow is stored under: ``bridge 30``, ``ceiling 30`` or ``warm-up 30``."""
     return f"{side} {hz:g}"
 
 
 def side_flows(stored: Stored, side: str) -> dict[float, FlowResult]:
-    """The stored flows of one side (``bridge`` or ``ceiling``), by offered rate."""
+    """The stored flows of one side (``bridge``, ``ceiling`` or ``warm-up``), by offered rate."""
     flows = {}
     for key, flow in stored.flows.items():
         name, _, hz = key.partition(" ")
@@ -136,14 +138,29 @@ def goals(bridge: dict[float, FlowResult], ceiling: dict[float, FlowResult]) -> 
     return lines
 
 
+def warm_up_text(hz: float, seconds: float, warm: FlowResult) -> str:
+    """What the uncounted first flow through the fresh bridge showed."""
+    if warm.error:
+        return f"The uncounted first flow ({hz:g} Hz) failed: {warm.error}."
+    return (
+        f"Before the rates below, the fresh bridge carries one flow of {seconds:g} s at "
+        f"{hz:g} Hz that is not counted, so that every row measures a bridge that has carried "
+        f"frames. That first flow: {warm.received}/{warm.sent} frames, median "
+        f"{warm.median_us / 1000:.2f} ms, p99 {warm.p99_us / 1000:.2f} ms (a fresh bridge's "
+        "first conversions and writes of 6 MB samples to Fast DDS are slower than later ones: "
+        "docs/environment.md, a fresh bridge's first frames)."
+    )
+
+
 def run(seconds: float, rates: list[float]) -> tuple[str, dict[str, FlowResult]]:
     cases = tuple((KIND, hz) for hz in rates)
     ceiling = ceilings(seconds, cases)
-    rows = through_bridge(seconds, backend("zeromq"), ceiling, cases, ())
+    warm, *rows = through_bridge(seconds, backend("zeromq"), ceiling, (cases[0], *cases), ())
     bridge = {row.hz: row.result for row in rows}
     base = {hz: ceiling[KIND, hz] for hz in rates}
     flows = {flow_key("bridge", hz): r for hz, r in bridge.items()}
     flows |= {flow_key("ceiling", hz): r for hz, r in base.items()}
+    flows[flow_key(WARM_UP, warm.hz)] = warm.result
     table = "\n".join(_row(hz, bridge[hz], base[hz]) for hz in rates)
     flags = f" --seconds {seconds:g} --rates {' '.join(f'{hz:g}' for hz in rates)}"
     return (
@@ -158,6 +175,7 @@ the same run, with the bridge's speed settings. A rate is **sustainable** when >
 {SUSTAINED_SHARE:.0%} of the frames arrive with a p99 latency under {SUSTAINED_P99_MS:g} ms;
 the highest sustainable rate is the highest offered rate up to which every offered rate was.
 Bridge CPU per frame = the bridge process's CPU time over the window / the frames delivered.
+{warm_up_text(warm.hz, seconds, warm.result)}
 {GZ_ENDS} Plot: [delivered rate and p99 latency against the offered rate]({SUSTAINED_PNG}).
 
 {HEADER}
