@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from benchmarks.bridged import Backend, backend, bridge_process, flow_through
 from benchmarks.harness import (
     GZ_ENDS,
+    LARGE_HWM,
     Flood,
     Flow,
     FlowResult,
@@ -177,7 +178,9 @@ def bounds(runs: dict[str, ClockRun]) -> list[str]:
             f"- Of the {result.sent} clock messages sent under the flood, the bridge received "
             f"{received} ({received / result.sent:.1%}; {result.sent - received - dropped} "
             "never reached its queue: the Gazebo publisher drops what exceeds its send queue of "
-            f"20 messages), dropped {dropped} in its own queue and published {published}; the "
+            f"{LARGE_HWM} messages, set so (GZ_TRANSPORT_SNDHWM) for the whole flooding process "
+            "to bound its queue of 6 MB frames, where Gazebo's default is 1000), dropped "
+            f"{dropped} in its own queue and published {published}; the "
             f"subscriber took {result.received} of those ({took:.1%})."
         )
     hop = runs[HOP.name].result
