@@ -90,8 +90,8 @@ def costs_plot(stored: Stored) -> str:
     left = [0.0] * len(cases)
     segments = _bridge_segments(stored, cases, [case[0] for case in values])
     colours = ("tab:blue", "navy", "tab:cyan")
+    positions = [i - height for i in range(len(cases))]
     for (name, widths), colour in zip(segments.items(), colours, strict=False):
-        positions = [i - height for i in range(len(cases))]
         axes.barh(positions, widths, height=height, left=left, color=colour, label=name)
         left = [a + b for a, b in zip(left, widths, strict=True)]
     for bar, (name, colour) in enumerate(zip(BARS[1:], ("tab:orange", "tab:green"), strict=True)):
