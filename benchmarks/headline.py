@@ -104,12 +104,10 @@ def image_rows(stored: Stored | None) -> list[str]:
 
 def _frame_ends(ceiling: FlowResult | None) -> str:
     """The rclpy ends' CPU per frame in the ceiling flow at the paced rate."""
-    if ceiling is None or ceiling.error:
+    publisher, subscriber = _ends_of(ceiling, PACED_HZ)
+    if publisher is None or subscriber is None:
         return "-"
-    ends = [per_message_ms(cpu, PACED_HZ, ceiling) for cpu in (ceiling.pub_cpu, ceiling.sub_cpu)]
-    if None in ends:
-        return "-"
-    return f"rclpy publisher {ends[0]:.2f} ms, subscriber {ends[1]:.2f} ms"
+    return f"rclpy publisher {publisher:.2f} ms, subscriber {subscriber:.2f} ms"
 
 
 def clock_row(stored: Stored | None) -> str:
@@ -129,7 +127,11 @@ def clock_row(stored: Stored | None) -> str:
 
 def _ends(stored: Stored, kind: str, hz: float) -> tuple[float | None, float | None]:
     """CPU per message of the rclpy publisher and subscriber at the same rate (ms)."""
-    ceiling = stored.flow(flow_key("ceiling", kind, hz))
+    return _ends_of(stored.flow(flow_key("ceiling", kind, hz)), hz)
+
+
+def _ends_of(ceiling: FlowResult | None, hz: float) -> tuple[float | None, float | None]:
+    """CPU per message (ms) of a ceiling flow's rclpy publisher and subscriber."""
     if ceiling is None:
         return None, None
     return (
