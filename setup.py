@@ -1,5 +1,26 @@
-"""colcon's ament_python build runs ``setup.py``; the metadata is in ``pyproject.toml``."""
+"""Setuptools entry for the optional native data plane; the metadata is in ``pyproject.toml``.
 
-from setuptools import setup
+colcon's ament_python build runs this file too. The extension is optional: where no C compiler
+or Python headers exist, or the build fails, the package installs without it and the bridge
+runs on the Python path (``ros_gz_bridge_py.native`` logs once why; docs/native.md §1).
+"""
 
-setup()
+from setuptools import Extension, setup
+
+NATIVE_SOURCES = [
+    "ros_gz_bridge_py/native/_native.c",
+    "ros_gz_bridge_py/native/transcode.c",
+]
+
+setup(
+    ext_modules=[
+        Extension(
+            "ros_gz_bridge_py.native._native",
+            sources=NATIVE_SOURCES,
+            depends=["ros_gz_bridge_py/native/transcode.h"],
+            extra_compile_args=["-O2", "-std=gnu11", "-Wall", "-Wextra", "-fvisibility=hidden"],
+            libraries=["dl"],
+            optional=True,
+        )
+    ]
+)

@@ -34,34 +34,6 @@ from ros_gz_bridge_py.converters._fields import WHOLE, Fill, each, fields, fill_
 from ros_gz_bridge_py.converters.std_msgs import FRAMES, HEADER
 
 
-def fill_gz_vector3(ros: Any, gz: Any) -> None:
-    """ROS Vector3 or Point -> gz Vector3d (marks the submessage present)."""
-    gz.x = ros.x
-    gz.y = ros.y
-    gz.z = ros.z
-
-
-def fill_ros_vector3(gz: Any, ros: Any) -> None:
-    """gz Vector3d -> ROS Vector3 or Point."""
-    ros.x = gz.x
-    ros.y = gz.y
-    ros.z = gz.z
-
-
-def fill_gz_quaternion(ros: Any, gz: Any) -> None:
-    gz.x = ros.x
-    gz.y = ros.y
-    gz.z = ros.z
-    gz.w = ros.w
-
-
-def fill_ros_quaternion(gz: Any, ros: Any) -> None:
-    ros.x = gz.x
-    ros.y = gz.y
-    ros.z = gz.z
-    ros.w = gz.w
-
-
 def fill_gz_covariance(values: Iterable[float], gz_float_v: Any) -> None:
     """Append every ROS covariance value to a gz Float_V (float64 -> float32, lossy)."""
     gz_float_v.SetInParent()
@@ -74,8 +46,9 @@ def fill_ros_covariance(gz_float_v: Any, ros: Any) -> None:
     ros[:] = list(data) if len(data) == len(ros) else [0.0] * len(ros)
 
 
-VECTOR3 = Fill(fill_gz_vector3, fill_ros_vector3)
-QUATERNION = Fill(fill_gz_quaternion, fill_ros_quaternion)
+#: ROS Vector3 or Point <-> gz Vector3d (writing a field marks the gz submessage present).
+VECTOR3 = fields("x", "y", "z")
+QUATERNION = fields("x", "y", "z", "w")
 #: A fixed-size ROS covariance array <-> a gz Float_V; a gz one of another size reads as zeros.
 COVARIANCE = Fill(fill_gz_covariance, fill_ros_covariance)
 

@@ -17,6 +17,7 @@ LAYERS: tuple[frozenset[str], ...] = (
     frozenset({"ros"}),
     frozenset({"bulk"}),
     frozenset({"converters"}),
+    frozenset({"native"}),
     frozenset({"core"}),
     frozenset({"app", "demo"}),
     frozenset({"cli", "__init__"}),

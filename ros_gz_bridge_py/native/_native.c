@@ -1,0 +1,102 @@
+/* The Python face of the native data plane (docs/native.md).
+ *
+ * Program: one pair's transcoder, loaded from the words program.py compiles.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include "transcode.h"
+
+typedef struct {
+    PyObject_HEAD
+    struct rgb_program program;
+    int32_t *words; /* schema then ops, owned */
+    struct rgb_out out;
+} ProgramObject;
+
+static void program_dealloc(ProgramObject *self) {
+    rgb_out_free(&self->out);
+    PyMem_Free(self->words);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static int program_init(ProgramObject *self, PyObject *args, PyObject *kwds) {
+    static char *keywords[] = {"schema", "ops", NULL};
+    Py_buffer schema, ops;
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*y*", keywords, &schema, &ops)) return -1;
+    int result = -1;
+    if (schema.len % 4 || ops.len % 4) {
+        PyErr_SetString(PyExc_ValueError, "schema and ops are int32 words");
+        goto done;
+    }
+    size_t schema_len = (size_t)schema.len / 4, ops_len = (size_t)ops.len / 4;
+    int32_t *words = PyMem_Malloc((schema_len + ops_len + 1) * 4);
+    if (words == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    memcpy(words, schema.buf, (size_t)schema.len);
+    memcpy(words + schema_len, ops.buf, (size_t)ops.len);
+    const char *why = "";
+    if (rgb_load(&self->program, words, schema_len, words + schema_len, ops_len, &why)) {
+        PyMem_Free(words);
+        PyErr_Format(PyExc_ValueError, "not a native program: %s", why);
+        goto done;
+    }
+    PyMem_Free(self->words);
+    self->words = words;
+    result = 0;
+done:
+    PyBuffer_Release(&schema);
+    PyBuffer_Release(&ops);
+    return result;
+}
+
+/* to_cdr(payload) -> (status, bytes or None) */
+static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
+    if (self->words == NULL) {
+        PyErr_SetString(PyExc_ValueError, "program not loaded");
+        return NULL;
+    }
+    Py_buffer payload;
+    if (PyObject_GetBuffer(arg, &payload, PyBUF_SIMPLE)) return NULL;
+    enum rgb_status status =
+        rgb_to_cdr(&self->program, payload.buf, (size_t)payload.len, &self->out);
+    PyBuffer_Release(&payload);
+    if (status != RGB_OK) return Py_BuildValue("(iO)", (int)status, Py_None);
+    return Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
+}
+
+static PyMethodDef program_methods[] = {
+    {"to_cdr", (PyCFunction)program_to_cdr, METH_O,
+     "to_cdr(payload) -> (status, cdr or None): 0 ok, 1 undecodable, 2 conversion, 3 fallback"},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyTypeObject ProgramType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.Program",
+    .tp_basicsize = sizeof(ProgramObject),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "One pair's Gazebo -> ROS transcoder (docs/native.md).",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)program_init,
+    .tp_dealloc = (destructor)program_dealloc,
+    .tp_methods = program_methods,
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, .m_name = "_native",
+    .m_doc = "The native data plane of ros_gz_bridge_py (docs/native.md).", .m_size = -1,
+};
+
+PyMODINIT_FUNC PyInit__native(void) {
+    if (PyType_Ready(&ProgramType) < 0) return NULL;
+    PyObject *m = PyModule_Create(&module);
+    if (m == NULL) return NULL;
+    Py_INCREF(&ProgramType);
+    if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}

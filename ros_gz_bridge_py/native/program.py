@@ -1,0 +1,480 @@
+"""Compile a pair's declaration into the words of a native program (docs/native.md §2-§3).
+
+The program is read from what the converters are declared with, not written a second time:
+the :func:`~ros_gz_bridge_py.converters._fields.fields` tables (``Fill.shape``) say which
+Gazebo field each ROS field comes from; the ROS type description (rclpy's, as the CDR writer
+reads it) gives the wire order and types; the protobuf descriptors give field numbers and
+types. The few hand-written pieces the tables build on (times, headers, covariances, the Clock
+and JointState converters) are named in :data:`_LEAVES` and :data:`_WHOLE`, each beside the
+native op that does the same; tests compare the bytes of both paths for every pair that
+compiles. Anything else (a Value of another function, a Fill of hand-written code, a default
+the program cannot write) makes the pair :class:`NotExpressible`: it stays on the Python path.
+"""
+
+from __future__ import annotations
+
+import struct
+from array import array
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from ros_gz_bridge_py.converters._fields import Each, Fill, Table, Value, declaration_of, same
+from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time, to_int32, to_uint32
+from ros_gz_bridge_py.converters.geometry_msgs import fill_ros_covariance
+from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.converters.rosgraph_msgs import clock_to_ros
+from ros_gz_bridge_py.converters.sensor_msgs import joint_state_to_ros
+from ros_gz_bridge_py.converters.std_msgs import (
+    CHILD_FRAME_ID_KEY,
+    FRAME_ID_KEY,
+    FRAMES,
+    HEADER,
+)
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.ros import cdr_types as cdr
+
+# Ops (transcode.c).
+OP_END, OP_NUM, OP_CONST, OP_STR, OP_CONST_STR, OP_HEADER_STR = 0, 1, 2, 3, 4, 5
+OP_FIXED_LIST, OP_SEQ_MSG, OP_COLUMN, OP_COLUMN_STR, OP_CLOCK, OP_CONST_BLOCK = 6, 7, 8, 9, 10, 11
+CONV_EXACT, CONV_WRAP = 0, 1
+#: ROS basic types as the program numbers them, with their struct codes.
+ROS_KINDS: dict[str, tuple[int, str]] = {
+    "boolean": (1, "?"),
+    "uint8": (2, "B"),
+    "octet": (2, "B"),
+    "int8": (3, "b"),
+    "int16": (4, "h"),
+    "uint16": (5, "H"),
+    "int32": (6, "i"),
+    "uint32": (7, "I"),
+    "int64": (8, "q"),
+    "uint64": (9, "Q"),
+    "float": (10, "f"),
+    "double": (11, "d"),
+}
+_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP = 9, 11, 12, 10
+#: Most fields a message of the schema may have (transcode.c keeps one bit per field).
+_MAX_FIELDS = 64
+
+
+class NotExpressibleError(Exception):
+    """The pair's conversion has a step a native program cannot express."""
+
+
+Path = tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Copy:
+    """The ROS field takes the Gazebo field at ``gz`` (``wrap``: with C integer narrowing)."""
+
+    gz: Path
+    wrap: bool = False
+
+
+@dataclass(frozen=True)
+class HeaderText:
+    """A string from the gz Header at ``gz``: the first or last ``data`` entry named ``key``
+    that has a value, its first value with ``::`` as ``/`` (``std_msgs.py``)."""
+
+    gz: Path
+    key: str
+    last: bool
+
+
+@dataclass(frozen=True)
+class FixedList:
+    """A fixed ROS array from the repeated gz field at ``gz``: its values when there are as
+    many, else zeros (``fill_ros_covariance``)."""
+
+    gz: Path
+
+
+@dataclass(frozen=True)
+class Sequence:
+    """A ROS sequence of messages, one per element of the repeated gz field at ``gz``."""
+
+    gz: Path
+    element: Mapping[Path, Source]
+    new_ros: Callable[[], Any]
+
+
+@dataclass(frozen=True)
+class Column:
+    """A ROS sequence of plain values: the field ``field`` of each element of the repeated gz
+    field at ``gz`` (``joint_state_to_ros``)."""
+
+    gz: Path
+    field: Path
+
+
+@dataclass(frozen=True)
+class ClockPart:
+    """Seconds (0) or nanoseconds (1) of ``clock_to_ros``'s normalised time at ``gz``."""
+
+    gz: Path
+    part: int
+
+
+Source = Copy | HeaderText | FixedList | Sequence | Column | ClockPart
+Assignments = dict[Path, Source]
+
+
+def _split(path: str) -> Path:
+    return tuple(path.split(".")) if path else ()
+
+
+def _time(ros: Path, gz: Path, out: Assignments) -> None:
+    """``fill_ros_time``: both parts narrowed as C++ does."""
+    out[(*ros, "sec")] = Copy((*gz, "sec"), wrap=True)
+    out[(*ros, "nanosec")] = Copy((*gz, "nsec"), wrap=True)
+
+
+def _header(ros: Path, gz: Path, out: Assignments) -> None:
+    """``fill_ros_header``: the stamp and the last ``frame_id`` entry."""
+    _time((*ros, "stamp"), (*gz, "stamp"), out)
+    out[(*ros, "frame_id")] = HeaderText(gz, FRAME_ID_KEY, last=True)
+
+
+def _frames(ros: Path, gz: Path, out: Assignments) -> None:
+    """``FRAMES``: the header, and the first ``child_frame_id`` entry."""
+    _header((*ros, "header"), (*gz, "header"), out)
+    out[(*ros, "child_frame_id")] = HeaderText((*gz, "header"), CHILD_FRAME_ID_KEY, last=False)
+
+
+def _covariance(ros: Path, gz: Path, out: Assignments) -> None:
+    out[ros] = FixedList((*gz, "data"))
+
+
+#: The hand-written Fills the tables build on, by their ``to_ros`` half.
+_LEAVES: dict[Callable[[Any, Any], None], Callable[[Path, Path, Assignments], None]] = {
+    fill_ros_time: _time,
+    HEADER.to_ros: _header,
+    FRAMES.to_ros: _frames,
+    fill_ros_covariance: _covariance,
+}
+#: Value functions and whether they narrow (C integer semantics) on the way.
+_VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint32: True}
+
+
+def _joint_state(out: Assignments) -> None:
+    _header(("header",), ("header",), out)
+    out[("name",)] = Column(("joint",), ("name",))
+    out[("position",)] = Column(("joint",), ("axis1", "position"))
+    out[("velocity",)] = Column(("joint",), ("axis1", "velocity"))
+    out[("effort",)] = Column(("joint",), ("axis1", "force"))
+
+
+def _clock(out: Assignments) -> None:
+    out[("clock", "sec")] = ClockPart(("sim",), 0)
+    out[("clock", "nanosec")] = ClockPart(("sim",), 1)
+
+
+#: Whole hand-written converters, by their ``to_ros``.
+_WHOLE: dict[Callable[[Any], Any], Callable[[Assignments], None]] = {
+    clock_to_ros: _clock,
+    joint_state_to_ros: _joint_state,
+}
+
+
+def assignments_of(fill: Fill, ros: Path = (), gz: Path = ()) -> Assignments:
+    """Where each ROS field written by ``fill.to_ros`` comes from (later entries win, as
+    they do when the Python code runs).
+
+    Raises:
+        NotExpressibleError: a step of the Fill is not one a program can express.
+    """
+    out: Assignments = {}
+    _assign(fill, ros, gz, out)
+    return out
+
+
+def _assign(fill: Fill, ros: Path, gz: Path, out: Assignments) -> None:
+    leaf = _LEAVES.get(fill.to_ros)
+    if leaf is not None:
+        leaf(ros, gz, out)
+    elif isinstance(fill.shape, Table):
+        for ros_path, gz_path, how in fill.shape.parts:
+            _entry((*ros, *_split(ros_path)), (*gz, *_split(gz_path)), how, out)
+    elif isinstance(fill.shape, Each):
+        out[ros] = Sequence(gz, assignments_of(fill.shape.fill), fill.shape.new_ros)
+    else:
+        msg = f"a Fill of hand-written functions ({fill.to_ros.__qualname__})"
+        raise NotExpressibleError(msg)
+
+
+def _entry(ros: Path, gz: Path, how: Fill | Value | None, out: Assignments) -> None:
+    if how is None:
+        out[ros] = Copy(gz)
+    elif isinstance(how, Fill):
+        _assign(how, ros, gz, out)
+    elif how.to_ros is None:
+        return
+    elif how.to_ros in _VALUES:
+        out[ros] = Copy(gz, wrap=_VALUES[how.to_ros])
+    else:
+        msg = f"a Value of {how.to_ros.__qualname__}"
+        raise NotExpressibleError(msg)
+
+
+# ---- the schema ------------------------------------------------------------------------------
+
+
+class _Schema:
+    """The Gazebo message types a payload may hold, numbered from the root (index 0)."""
+
+    def __init__(self, root: Any) -> None:
+        self.index: dict[str, int] = {}
+        self.messages: list[Any] = []
+        self.of(root)
+
+    def of(self, descriptor: Any) -> int:
+        name = descriptor.full_name
+        if name not in self.index:
+            self.index[name] = len(self.messages)
+            self.messages.append(descriptor)
+            for field in descriptor.fields:
+                if field.message_type is not None:
+                    self.of(field.message_type)
+        return self.index[name]
+
+    def words(self) -> list[int]:
+        count = len(self.messages)
+        head = [count]
+        body: list[int] = []
+        for descriptor in self.messages:
+            head.append(1 + count + len(body))
+            fields = list(descriptor.fields)
+            if len(fields) > _MAX_FIELDS:
+                msg = f"{descriptor.full_name} has more than {_MAX_FIELDS} fields"
+                raise NotExpressibleError(msg)
+            body.append(len(fields))
+            for field in fields:
+                if field.type == _PB_GROUP:
+                    msg = f"group field {descriptor.full_name}.{field.name}"
+                    raise NotExpressibleError(msg)
+                sub = self.index[field.message_type.full_name] if field.message_type else -1
+                body += [field.number, field.type, int(field.is_repeated), sub]
+        return head + body
+
+
+# ---- ops -------------------------------------------------------------------------------------
+
+
+def _text(data: bytes) -> list[int]:
+    """A byte string as words: its length, then the bytes four to a word."""
+    padded = data + bytes(-len(data) % 4)
+    return [len(data), *array("i", padded)]
+
+
+def _bits(code: str, value: Any) -> tuple[int, int]:
+    raw = struct.pack(f"<{code}", value).ljust(8, b"\0")
+    lo, hi = struct.unpack("<ii", raw)
+    return lo, hi
+
+
+def _walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path`` (all but the last name), and the
+    descriptor of the field the last name names."""
+    steps = []
+    for name in path[:-1]:
+        field = _field(descriptor, name)
+        if field.message_type is None or field.is_repeated:
+            msg = f"{descriptor.full_name}.{name} is not a singular submessage"
+            raise NotExpressibleError(msg)
+        steps.append(field.number)
+        descriptor = field.message_type
+    return steps, _field(descriptor, path[-1])
+
+
+def _descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path``, and the message it reaches."""
+    if not path:
+        return [], descriptor
+    steps, field = _walk(descriptor, path)
+    if field.message_type is None or field.is_repeated:
+        msg = f"{descriptor.full_name}.{'.'.join(path)} is not a singular submessage"
+        raise NotExpressibleError(msg)
+    return [*steps, field.number], field.message_type
+
+
+def _field(descriptor: Any, name: str) -> Any:
+    field = descriptor.fields_by_name.get(name)
+    if field is None:
+        msg = f"{descriptor.full_name} has no field {name!r}"
+        raise NotExpressibleError(msg)
+    return field
+
+
+def _scalar_field(field: Any) -> None:
+    if field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP):
+        msg = f"{field.full_name} is not a plain scalar"
+        raise NotExpressibleError(msg)
+
+
+def _kind(slot: Any) -> tuple[int, str]:
+    basic = cdr.basic_of(slot)
+    if basic not in ROS_KINDS:
+        msg = f"ROS type {basic or type(slot).__name__} is not written natively"
+        raise NotExpressibleError(msg)
+    return ROS_KINDS[basic]
+
+
+class _Emitter:
+    def __init__(self, schema: _Schema) -> None:
+        self.schema = schema
+
+    def message(
+        self, msg_class: type[Any], prefix: Path, given: Mapping[Path, Source], default: Any,
+        gz: Any,
+    ) -> list[int]:  # fmt: skip
+        fields = cdr.fields_of(msg_class)
+        if not fields:
+            return [OP_CONST, ROS_KINDS["uint8"][0], 0, 0]
+        ops: list[int] = []
+        for name, slot in fields:
+            path = (*prefix, name)
+            value = getattr(default, name)
+            source = given.get(path)
+            if source is not None:
+                ops += self.source(slot, source, value, gz)
+            elif type(slot).__name__ == "NamespacedType":
+                nested = {key: src for key, src in given.items() if key[: len(path)] == path}
+                ops += self.message(cdr.nested_class(slot), path, nested, value, gz)
+            else:
+                ops += self.constant(slot, value)
+        return ops
+
+    def source(self, slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
+        kind = type(slot).__name__
+        if isinstance(source, Copy) and kind in cdr.STRING_TYPES:
+            steps, field = _walk(gz, source.gz)
+            if field.type != _PB_STRING or field.is_repeated:
+                msg = f"{field.full_name} is not a string"
+                raise NotExpressibleError(msg)
+            return [OP_STR, len(steps), *steps, field.number]
+        if isinstance(source, Copy):
+            steps, field = _walk(gz, source.gz)
+            _scalar_field(field)
+            ros_kind, code = _kind(slot)
+            if code in "fd" and field.cpp_type not in (5, 6):  # CPPTYPE_DOUBLE, CPPTYPE_FLOAT
+                msg = f"{field.full_name} is not a floating-point number"
+                raise NotExpressibleError(msg)
+            conv = CONV_WRAP if source.wrap else CONV_EXACT
+            return [OP_NUM, len(steps), *steps, field.number, field.type, ros_kind, conv]
+        if isinstance(source, HeaderText) and kind in cdr.STRING_TYPES:
+            steps, _header_type = _descend(gz, source.gz)
+            return [
+                OP_HEADER_STR, len(steps), *steps, int(source.last),
+                *_text(source.key.encode()), *_text(_plain(default)),
+            ]  # fmt: skip
+        if isinstance(source, FixedList) and kind == "Array":
+            steps, field = _walk(gz, source.gz)
+            if not field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
+                msg = f"{field.full_name} is not a repeated number"
+                raise NotExpressibleError(msg)
+            ros_kind, _code = _kind(slot.value_type)
+            return [OP_FIXED_LIST, len(steps), *steps, field.number, field.type, ros_kind,
+                    slot.size]  # fmt: skip
+        if isinstance(source, Sequence) and kind in cdr.SEQUENCE_TYPES:
+            steps, field = _walk(gz, source.gz)
+            element_class = cdr.nested_class(slot.value_type)
+            if field.message_type is None or not field.is_repeated:
+                msg = f"{field.full_name} is not a repeated message"
+                raise NotExpressibleError(msg)
+            body = self.message(
+                element_class, (), source.element, source.new_ros(), field.message_type
+            )
+            body.append(OP_END)
+            return [OP_SEQ_MSG, len(steps), *steps, field.number, len(body), *body]
+        if isinstance(source, Column) and kind in cdr.SEQUENCE_TYPES:
+            steps, field = _walk(gz, source.gz)
+            if field.message_type is None or not field.is_repeated:
+                msg = f"{field.full_name} is not a repeated message"
+                raise NotExpressibleError(msg)
+            sub_steps, sub = _walk(field.message_type, source.field)
+            head = [len(steps), *steps, field.number, len(sub_steps), *sub_steps, sub.number]
+            if type(slot.value_type).__name__ in cdr.STRING_TYPES and sub.type == _PB_STRING:
+                return [OP_COLUMN_STR, *head]
+            _scalar_field(sub)
+            ros_kind, _code = _kind(slot.value_type)
+            return [OP_COLUMN, *head, sub.type, ros_kind]
+        if isinstance(source, ClockPart) and cdr.basic_of(slot) is not None:
+            steps, _time_type = _descend(gz, source.gz)
+            return [OP_CLOCK, len(steps), *steps, source.part]
+        msg = f"{type(source).__name__} into a ROS {kind}"
+        raise NotExpressibleError(msg)
+
+    def constant(self, slot: Any, value: Any) -> list[int]:
+        """The ops that write ``value``, a ROS field's default."""
+        kind = type(slot).__name__
+        if cdr.basic_of(slot) is not None:
+            ros_kind, code = _kind(slot)
+            return [OP_CONST, ros_kind, *_bits(code, value)]
+        if kind in cdr.STRING_TYPES:
+            return [OP_CONST_STR, *_text(_plain(value))]
+        if kind == "Array" and cdr.basic_of(slot.value_type) is not None:
+            _ros_kind, code = _kind(slot.value_type)
+            data = struct.pack(f"<{slot.size}{code}", *value)
+            return [OP_CONST_BLOCK, struct.calcsize(code), *_text(data)]
+        if kind in cdr.SEQUENCE_TYPES and len(value) == 0:
+            return [OP_CONST, ROS_KINDS["uint32"][0], 0, 0]
+        msg = f"a default {kind} the program cannot write"
+        raise NotExpressibleError(msg)
+
+
+def _plain(text: str) -> bytes:
+    data = text.encode()
+    if b"\0" in data:
+        msg = "a default string with a NUL"
+        raise NotExpressibleError(msg)
+    return data
+
+
+@dataclass(frozen=True)
+class Compiled:
+    """The words of one pair's program: the schema of its Gazebo type, then the ops."""
+
+    schema: bytes
+    ops: bytes
+
+
+def compile_to_ros(pair: Pair) -> Compiled:
+    """The program converting ``pair``'s Gazebo messages to its ROS messages' CDR.
+
+    Raises:
+        NotExpressibleError: the pair stays on the Python path (the reason says why).
+    """
+    if pair.bulk is not None:
+        msg = "a bulk pair (it has its own path)"
+        raise NotExpressibleError(msg)
+    declared = declaration_of(pair.to_ros)
+    given: Assignments = {}
+    if declared is not None:
+        fill, new_ros = declared
+        _assign(fill, (), (), given)
+        default = new_ros()
+    elif pair.to_ros in _WHOLE:
+        _WHOLE[pair.to_ros](given)
+        default = pair.ros_class()
+    else:
+        msg = f"a hand-written converter ({pair.to_ros.__qualname__})"
+        raise NotExpressibleError(msg)
+    root = message_class(pair.gz_type).DESCRIPTOR
+    schema = _Schema(root)
+    ops = _Emitter(schema).message(pair.ros_class, (), given, default, root)
+    ops.append(OP_END)
+    return Compiled(array("i", schema.words()).tobytes(), array("i", ops).tobytes())
+
+
+def expressible(pairs: Iterable[Pair]) -> dict[tuple[str, str], str]:
+    """Per (ROS type, Gazebo type): "" where a program compiles, else why not."""
+    found = {}
+    for pair in pairs:
+        try:
+            compile_to_ros(pair)
+            found[(pair.ros_type, pair.gz_type)] = ""
+        except NotExpressibleError as err:
+            found[(pair.ros_type, pair.gz_type)] = str(err)
+    return found
