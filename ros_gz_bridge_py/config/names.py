@@ -65,3 +65,13 @@ def ros_name_for_gz(gz_topic: str) -> str:
             tokens.append(f"_{token}" if token[0].isdigit() else token)
     name = "/".join(tokens)
     return f"/{name}" if name and gz_topic.startswith("/") else name
+
+
+def renamed(given: str, resolved: str) -> bool:
+    """True when ROS resolution changed ``given`` into ``resolved`` beyond the leading ``/`` a
+    relative name gets in the root namespace (a namespace, ``~`` or a remapping did).
+
+    >>> renamed("scan", "/scan"), renamed("scan", "/robot1/scan")
+    (False, True)
+    """
+    return resolved not in (given, f"/{given}")

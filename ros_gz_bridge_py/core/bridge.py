@@ -218,7 +218,8 @@ class Bridge:
         try:
             for kind in kinds:
                 channel = kind(self._ctx, spec, layouts, lazy)
-                self._logger.info(f"Creating {channel.describe()} (Lazy {int(lazy)})")
+                for line in channel.creation_lines():
+                    self._logger.info(line)
                 handle.channels.append(channel)
                 self._guard_loops(channel, handle.channels)
                 channel.start()
@@ -259,7 +260,8 @@ class Bridge:
                 f"[{spec.ros_type}]: {err}"
             )
             raise ConfigError(msg, spec.source or None) from err
-        self._logger.info(f"Creating {service.describe()}")
+        for line in service.creation_lines():
+            self._logger.info(line)
         return BridgeHandle(spec, service=service)
 
 

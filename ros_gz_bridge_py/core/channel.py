@@ -39,6 +39,7 @@ from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.config.names import renamed
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.diagnosis import Finding, Flow
 from ros_gz_bridge_py.core.loop_guard import OwnPublications
@@ -161,6 +162,8 @@ class Channel(abc.ABC):
     """
 
     direction: Direction
+    #: The direction as the C++ bridge's log lines name it: ``GZ->ROS`` or ``ROS->GZ``.
+    label: str
 
     def __init__(
         self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
@@ -253,8 +256,28 @@ class Channel(abc.ABC):
             f"({count} so far, {self.stats.errors} errors in all){hint}"
         )
 
+    def describe(self) -> str:
+        """``GZ->ROS [<from> (<type>) -> <to> (<type>)]`` with the resolved ROS name: what the
+        channel's own log lines start with."""
+        return f"{self.label} {self._names(self.ros_topic)}"
+
+    def creation_lines(self) -> list[str]:
+        """What the bridge logs on creating the channel: the C++ bridge's line word for word
+        (the names as configured, docs/behaviour.md §5), then, when ROS resolution changed
+        the ROS name, a line of ours saying into what."""
+        lazy = int(self.lazy)
+        lines = [f"Creating {self.label} Bridge: {self._names(self.spec.ros_topic)} (Lazy {lazy})"]
+        if renamed(self.spec.ros_topic, self.ros_topic):
+            lines.append(
+                f"{self.describe()}: the ROS name {self.spec.ros_topic} resolves to "
+                f"{self.ros_topic}"
+            )
+        return lines
+
     @abc.abstractmethod
-    def describe(self) -> str: ...
+    def _names(self, ros_topic: str) -> str:
+        """``[<from> (<type>) -> <to> (<type>)]`` in the channel's direction, the ROS side
+        named ``ros_topic``."""
 
     @property
     @abc.abstractmethod

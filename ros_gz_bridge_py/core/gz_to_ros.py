@@ -41,6 +41,7 @@ class GzToRosChannel(Channel):
     """
 
     direction = Direction.GZ_TO_ROS
+    label = "GZ->ROS"
 
     def __init__(
         self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
@@ -57,11 +58,9 @@ class GzToRosChannel(Channel):
         self._subscription: Subscription | None = None
         self._finish = self._make_finisher()
 
-    def describe(self) -> str:
-        return (
-            f"GZ->ROS [{self.spec.gz_topic} ({self.spec.gz_type}) -> "
-            f"{self.ros_topic} ({self.spec.ros_type})]"
-        )
+    def _names(self, ros_topic: str) -> str:
+        spec = self.spec
+        return f"[{spec.gz_topic} ({spec.gz_type}) -> {ros_topic} ({spec.ros_type})]"
 
     @property
     def dropped(self) -> int:

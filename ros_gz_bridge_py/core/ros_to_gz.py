@@ -37,6 +37,7 @@ class RosToGzChannel(Channel):
     """
 
     direction = Direction.ROS_TO_GZ
+    label = "ROS->GZ"
 
     def __init__(
         self, ctx: ChannelContext, spec: TopicBridgeSpec, layouts: dict[str, Pair], lazy: bool
@@ -66,11 +67,9 @@ class RosToGzChannel(Channel):
             self._close_input()
             self._open_input()
 
-    def describe(self) -> str:
-        return (
-            f"ROS->GZ [{self.ros_topic} ({self.spec.ros_type}) -> "
-            f"{self.spec.gz_topic} ({self.spec.gz_type})]"
-        )
+    def _names(self, ros_topic: str) -> str:
+        spec = self.spec
+        return f"[{ros_topic} ({spec.ros_type}) -> {spec.gz_topic} ({spec.gz_type})]"
 
     def _open_output(self) -> None:
         self._gz_publisher = self.ctx.gz_node.advertise(self.spec.gz_topic, self.spec.gz_type)

@@ -19,6 +19,7 @@ from typing import Any
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from ros_gz_bridge_py.config import ServiceBridgeSpec
+from ros_gz_bridge_py.config.names import renamed
 from ros_gz_bridge_py.converters.registry import ServicePair
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.msgs import message_class
@@ -96,13 +97,33 @@ class ServiceBridge:
             ),
             callback_group=host.reentrant,
         )
-        self.service_name: str = self._service.srv_name
+        #: The name ROS resolved ``spec.service`` to (rclpy's ``srv_name`` is the given one).
+        self.service_name: str = host.node.resolve_service_name(spec.service)
 
     def describe(self) -> str:
+        """``ROS->GZ service [<name> (<ROS type> -> <request>/<reply>)]`` with the resolved
+        name and the Gazebo types in use: what the service's own log lines start with."""
         return (
             f"ROS->GZ service [{self.service_name} ({self.spec.ros_type} -> "
             f"{self.gz_req_type}/{self.gz_rep_type})]"
         )
+
+    def creation_lines(self) -> list[str]:
+        """What the bridge logs on creating the service: the C++ bridge's line word for word
+        (the name and types as configured, a left-out type empty; docs/behaviour.md §5),
+        then, when the ROS name resolved to another or a Gazebo type was left out, a line of
+        ours saying what is used."""
+        spec = self.spec
+        given = f"{spec.gz_req_type or ''}/{spec.gz_rep_type or ''}"
+        lines = [f"Creating ROS->GZ service bridge [{spec.service} ({spec.ros_type} -> {given})]"]
+        notes = []
+        if renamed(spec.service, self.service_name):
+            notes.append(f"the ROS name {spec.service} resolves to {self.service_name}")
+        if not (spec.gz_req_type and spec.gz_rep_type):
+            notes.append("the Gazebo types left out are the service type's")
+        if notes:
+            lines.append(f"{self.describe()}: {'; '.join(notes)}")
+        return lines
 
     async def _on_request(self, request: Any, _response: Any) -> Any:
         """One call, answered once: never raises (an exception would leave it unanswered)."""

@@ -55,8 +55,12 @@ def test_a_namespaced_command_line_bridge_and_image_bridge_publish_under_it(
         image_bridge_command(f"{camera}/image", ros_args=["-r", "__ns:=/robot2", *namespaced])
     )
     started += [cli, images]
-    wait_for_line(cli, rf"Creating GZ->ROS \[/robot1/{chatter} ", timeout=30)
-    wait_for_line(images, rf"Creating GZ->ROS \[/robot2/{camera}/image ", timeout=30)
+    # The C++ creation line names the ROS topic as given; our next line says what it resolved to.
+    wait_for_line(
+        cli, rf"Creating GZ->ROS Bridge: \[/robot1/{chatter} .* -> {chatter} ", timeout=30
+    )
+    wait_for_line(cli, rf"the ROS name {chatter} resolves to /robot1/{chatter}$", timeout=30)
+    wait_for_line(images, rf"Creating GZ->ROS Bridge: \[/robot2/{camera}/image ", timeout=30)
     for topic in (f"/robot1/{chatter}", f"/robot2/{camera}/image"):
         wait_until(
             lambda: probe.count_publishers(topic) == 1,  # noqa: B023 - called in this iteration
