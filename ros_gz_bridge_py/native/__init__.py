@@ -9,19 +9,20 @@ Python path, which stays the reference. :func:`extension` says which, and why no
 from __future__ import annotations
 
 import functools
+import importlib
 from types import ModuleType
 
 
 @functools.cache
 def _load() -> tuple[ModuleType | None, str]:
     try:
-        import ros_gz_bridge_py.native._native as _native  # noqa: PLC0415 - optional
+        native = importlib.import_module("ros_gz_bridge_py.native._native")
     except ImportError as err:
         return None, (
             f"the native extension is not built ({err}); reinstall with a C compiler and "
             "Python headers (pip install .) to build it"
         )
-    return _native, ""
+    return native, ""
 
 
 def extension() -> ModuleType | None:
