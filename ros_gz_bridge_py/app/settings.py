@@ -50,6 +50,8 @@ BULK_NICE_ENV = "ROS_GZ_BRIDGE_BULK_NICE"
 LIGHT_READ_ENV = "ROS_GZ_BRIDGE_LIGHT_READ"
 #: A switch: off makes Gazebo->ROS channels publish rclpy's message objects through rclpy.
 CDR_WRITE_ENV = "ROS_GZ_BRIDGE_CDR_WRITE"
+#: A switch: off keeps every channel on the Python path (no native data plane).
+NATIVE_ENV = "ROS_GZ_BRIDGE_NATIVE"
 #: A switch: off leaves Fast DDS's event threads at normal scheduling (not SCHED_BATCH).
 DDS_EVENT_BATCH_ENV = "ROS_GZ_BRIDGE_DDS_EVENT_BATCH"
 
@@ -61,6 +63,7 @@ MESSAGE_PATH_SWITCHES = (
     "bulk_nice",
     "light_read",
     "cdr_write",
+    "native",
 )
 
 
@@ -82,6 +85,8 @@ class Switches:
     light_read: bool = True
     #: False with ``ROS_GZ_BRIDGE_CDR_WRITE=off``.
     cdr_write: bool = True
+    #: False with ``ROS_GZ_BRIDGE_NATIVE=off``.
+    native: bool = True
     #: False with ``ROS_GZ_BRIDGE_DDS_EVENT_BATCH=off``.
     dds_event_batch: bool = True
     #: What was wrong with a value, one sentence each: the executables log them once their
@@ -128,6 +133,7 @@ def read_switches(env: Mapping[str, str] | None = None) -> Switches:
         bulk_nice=bulk_nice,
         light_read=not switched_off(LIGHT_READ_ENV, env),
         cdr_write=not switched_off(CDR_WRITE_ENV, env),
+        native=not switched_off(NATIVE_ENV, env),
         dds_event_batch=not switched_off(DDS_EVENT_BATCH_ENV, env),
         warnings=(nice_warning,) if nice_warning else (),
     )

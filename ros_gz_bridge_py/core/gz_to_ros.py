@@ -3,7 +3,10 @@
 Each message is decoded, converted and published on the channel's own delivery thread (see
 :mod:`~ros_gz_bridge_py.core.channel`), in the layout of the spelling it arrived with; images
 and point clouds take the bulk path unless ``BridgeOptions.bulk_path`` is off; other messages
-are serialized by the compiled CDR writer unless ``BridgeOptions.cdr_write`` is off.
+are serialized by the compiled CDR writer unless ``BridgeOptions.cdr_write`` is off. Pairs a
+native program expresses run their per-message loop natively where the extension is built
+(``BridgeOptions.native``, docs/native.md): the channel's Python path then takes only what the
+native loop hands back.
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext
 from ros_gz_bridge_py.errors import UndecodableError
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.native.channel import native_programs
+from ros_gz_bridge_py.native.pump import ChannelPump
 from ros_gz_bridge_py.ros.qos import PUBLISHER_OVERRIDES, gz_to_ros_publisher_qos
 from ros_gz_bridge_py.ros.serialized_publisher import SerializedPublisher, object_publisher
 from ros_gz_bridge_py.transport import MessageInfo, Subscription
@@ -57,6 +62,18 @@ class GzToRosChannel(Channel):
         self._publish: Callable[[Any], None] = _closed_publish
         self._subscription: Subscription | None = None
         self._finish = self._make_finisher()
+        #: The native programs of the wire spellings, where this channel takes the native path.
+        self._programs = (
+            native_programs(layouts, ctx.options, ctx.gz_node)
+            if self._finish is None and self.bulk is None
+            else {}
+        )
+        self._pump: ChannelPump | None = None
+
+    @property
+    def native(self) -> bool:
+        """Whether the channel's messages take the native path (docs/native.md)."""
+        return bool(self._programs)
 
     def _names(self, ros_topic: str) -> str:
         spec = self.spec
@@ -104,10 +121,36 @@ class GzToRosChannel(Channel):
             )
         else:
             publisher = self._publisher
-        self._publish = self.ctx.own_publications(self.ros_topic).wrap(publisher)
+        own = self.ctx.own_publications(self.ros_topic)
+        if self._programs:
+            self._pump = ChannelPump(
+                topic=self.ctx.gz_node.fqn(self.spec.gz_topic),
+                publisher=self._publisher,
+                programs=self._programs,
+                capacity=max(self._qos.depth, MIN_DELIVERY_QUEUE),
+                max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
+                refused=self._convert_and_publish,
+                counted=self._counted,
+                partition=self.ctx.gz_node.partition,
+                name=self.spec.gz_topic,
+            )
+            own.add_numbered(self._pump)
+            self._publish = self._pump.wrap(publisher.publish)
+        else:
+            self._publish = own.wrap(publisher)
+
+    def _counted(self, received: int, rate_limited: int, published: int) -> None:
+        """What the native loop did since it last said (on the reader thread)."""
+        stats = self.stats
+        stats.received += received
+        stats.rate_limited += rate_limited
+        stats.published += published
 
     def _close_output(self) -> None:
         self._publish = _closed_publish
+        if self._pump is not None:
+            self.ctx.own_publications(self.ros_topic).remove_numbered(self._pump)
+            self._pump = None
         if self._publisher is not None:
             self.ctx.ros_node.destroy_publisher(self._publisher)
             self._publisher = None
@@ -126,6 +169,7 @@ class GzToRosChannel(Channel):
             if bulk
             else None,
             on_reject=self._rejected,
+            native=self._pump,
         )
 
     def _close_input(self) -> None:
@@ -140,8 +184,12 @@ class GzToRosChannel(Channel):
         )
 
     def _on_gz_message(self, payload: Any, info: MessageInfo) -> None:
-        if self.limited():
-            return
+        if not self.limited():
+            self._convert_and_publish(payload, info)
+
+    def _convert_and_publish(self, payload: Any, info: MessageInfo) -> None:
+        """The Python path of one admitted message: decode, convert, publish, or count why
+        not."""
         pair, gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))
         try:
             gz_msg = gz_class.FromString(payload)

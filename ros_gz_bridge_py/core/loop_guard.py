@@ -18,12 +18,19 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, Protocol
 
 #: How many recent publications per ROS topic are remembered (covers bursts and slow executors).
 HISTORY = 1024
 #: The end of the window of a publish call that has not returned yet.
 _STILL_PUBLISHING = 2**63
+
+
+class NumberedPublisher(Protocol):
+    """A publisher that numbers and times its publications itself (a native channel's pump,
+    ``native/pump.py``, whose C loop publishes without Python)."""
+
+    def is_own(self, sequence: int, stamp: int) -> bool: ...
 
 
 class OwnPublications:
@@ -34,6 +41,17 @@ class OwnPublications:
         # (publisher id, sequence number) -> (start ns, end ns) of the publish call.
         self._windows: OrderedDict[tuple[int, int], tuple[int, int]] = OrderedDict()
         self._sequences: dict[int, int] = {}
+        self._numbered: list[NumberedPublisher] = []
+
+    def add_numbered(self, publisher: NumberedPublisher) -> None:
+        """Also ask ``publisher`` whether a sample is ours (until :meth:`remove_numbered`)."""
+        with self._lock:
+            self._numbered.append(publisher)
+
+    def remove_numbered(self, publisher: NumberedPublisher) -> None:
+        with self._lock:
+            if publisher in self._numbered:
+                self._numbered.remove(publisher)
 
     def wrap(self, publisher: Any) -> Callable[[Any], None]:
         """A publish function for ``publisher`` that records each publication's window.
@@ -79,4 +97,5 @@ class OwnPublications:
                 window = self._windows.get((key, sequence))
                 if window is not None and window[0] <= stamp <= window[1]:
                     return True
-        return False
+            numbered = list(self._numbered)
+        return any(publisher.is_own(sequence, stamp) for publisher in numbered)

@@ -38,6 +38,9 @@ class BridgeOptions:
     #: Gazebo->ROS channels of small messages serialize with ``cdr_writer`` and publish the
     #: bytes with the GIL released (False: rclpy's publish of the message object).
     cdr_write: bool = True
+    #: Gazebo->ROS channels of pairs a native program expresses run their per-message loop in
+    #: the native extension where it is built (docs/native.md; False: the Python path).
+    native: bool = True
     #: The simulator's Gazebo line when the user names it (``gz_version``, ``GZ_VERSION``);
     #: only ``garden`` changes anything: its ``gz.msgs.*`` have Fortress layouts and names.
     gz_version: str = ""

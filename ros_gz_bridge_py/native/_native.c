@@ -1,10 +1,11 @@
 /* The Python face of the native data plane (docs/native.md).
  *
  * Program: one pair's transcoder, loaded from the words program.py compiles.
- */
+ * Pump: the per-message loop of one Gazebo -> ROS channel (pump.c). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
+#include "pump.h"
 #include "transcode.h"
 
 typedef struct {
@@ -84,6 +85,12 @@ static PyTypeObject ProgramType = {
     .tp_methods = program_methods,
 };
 
+struct rgb_program *native_program_of(PyObject *object) {
+    if (!PyObject_TypeCheck(object, &ProgramType)) return NULL;
+    ProgramObject *program = (ProgramObject *)object;
+    return program->words == NULL ? NULL : &program->program;
+}
+
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, .m_name = "_native",
     .m_doc = "The native data plane of ros_gz_bridge_py (docs/native.md).", .m_size = -1,
@@ -94,7 +101,7 @@ PyMODINIT_FUNC PyInit__native(void) {
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) return NULL;
     Py_INCREF(&ProgramType);
-    if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0) {
+    if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0 || pump_register(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -8,7 +8,7 @@ from __future__ import annotations
 import enum
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from ros_gz_bridge_py.msgs.names import Spelling
 
@@ -151,6 +151,35 @@ class TransportStats:
 Callback = Callable[[Any, MessageInfo], None]
 #: Told about each message a subscription could not use: ``on_reject(reason, detail)``.
 RejectCallback = Callable[[Rejection, str], None]
+
+
+class NativeLoop(Protocol):
+    """A per-message loop that reads a subscription's ZeroMQ socket outside Python
+    (``native/pump.py``); the ZeroMQ reader runs it instead of reading, and judges only what it
+    hands back (``zmq/reader.py``). Other backends do not use it."""
+
+    def forget(self) -> None:
+        """A new subscription starts: no (sender, type) is known."""
+
+    def learn(self, sender: bytes, msg_type: bytes, *, take: bool) -> None:
+        """Messages of (sender, type) are the loop's from now on (``take``), or skipped."""
+
+    def run(self, sock: int, wake_fd: int, monitor: int, timeout_ms: int) -> tuple[int, list[Any]]:
+        """Runs until the wake-up fd or the monitor socket is readable (events 1, 2) or the
+        time is up; returns the events and the frames of messages it has no route for."""
+        ...
+
+    @property
+    def received(self) -> int:
+        """Messages it took from the socket."""
+        ...
+
+    @property
+    def dropped(self) -> int:
+        """Messages it dropped, oldest first."""
+        ...
+
+
 #: Service handler: ``handler(request bytes) -> (success, response bytes)``.
 ServiceHandler = Callable[[bytes], tuple[bool, bytes]]
 #: Async service callback: ``(True/False, reply)`` on a reply, ``(None, b"")`` on timeout.

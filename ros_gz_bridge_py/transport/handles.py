@@ -10,7 +10,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Protocol
 
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, canonical_type
-from ros_gz_bridge_py.transport.api import MessageInfo, RejectCallback, Rejection
+from ros_gz_bridge_py.transport.api import MessageInfo, NativeLoop, RejectCallback, Rejection
 from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue, Payload, payload_size
 from ros_gz_bridge_py.transport.wire_types import WireTypeCache
 
@@ -112,6 +112,8 @@ class Subscription:
         self.ignore_local = ignore_local
         self.on_reject = on_reject
         self.delivery: Delivery | None = None
+        #: The loop that reads the subscription's socket natively, where the backend uses it.
+        self.native: NativeLoop | None = None
         self._node = node
         self._deliver = deliver
         # (publisher id, canonical type) -> the spelling taken from that publisher.

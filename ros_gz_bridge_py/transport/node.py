@@ -28,6 +28,7 @@ from ros_gz_bridge_py.transport.api import (
     Callback,
     GraphEndpoint,
     MessageInfo,
+    NativeLoop,
     RejectCallback,
     ReplyCallback,
     ServiceCall,
@@ -69,6 +70,8 @@ class GzNode(abc.ABC):
     call_class: ClassVar[type[ServiceCall]] = ServiceCall
     #: The backend's subscription handle (a subclass where it keeps more per subscription).
     subscription_class: ClassVar[type[Subscription]] = Subscription
+    #: Whether a queued subscription's ``native`` loop reads its messages (ZeroMQ only).
+    runs_native_loops: ClassVar[bool] = False
 
     def __init__(
         self,
@@ -177,6 +180,7 @@ class GzNode(abc.ABC):
         copy: bool = True,
         on_delivery_start: Callable[[], None] | None = None,
         on_reject: RejectCallback | None = None,
+        native: NativeLoop | None = None,
     ) -> Subscription:
         """Receive raw payloads of ``msg_type`` (either spelling; GENERIC_TYPE = any).
 
@@ -187,6 +191,8 @@ class GzNode(abc.ABC):
         ``memoryview``) instead of copying it into ``bytes``. ``on_reject(reason, detail)`` is
         told of each message of the topic the transport could not use (a malformed frame,
         another type, over ``settings.max_message_size``), on the receiving thread.
+        ``native``: a loop that takes over reading a queued subscription's messages where the
+        backend can hand it its socket (ZeroMQ); other backends deliver through ``callback``.
 
         Raises:
             ValueError: a queue of no messages, or ``on_delivery_start`` without a queue.
@@ -198,8 +204,9 @@ class GzNode(abc.ABC):
             raise ValueError(msg)
         deliver = raw_deliverer(self.count, callback, copy=copy)
         return self._add_subscription(
-            topic, msg_type, deliver, ignore_local, queue_size, on_delivery_start, on_reject
-        )
+            topic, msg_type, deliver, ignore_local, queue_size, on_delivery_start, on_reject,
+            native,
+        )  # fmt: skip
 
     def subscribe_typed(
         self,
@@ -229,12 +236,14 @@ class GzNode(abc.ABC):
         queue_size: int | None,
         on_start: Callable[[], None] | None,
         on_reject: RejectCallback | None,
+        native: NativeLoop | None = None,
     ) -> Subscription:
         self._check_open()
         sub = self.subscription_class(
             self, topic, self.fqn(topic), msg_type, deliver, ignore_local=ignore_local
         )
         sub.on_reject = on_reject
+        sub.native = native
         if queue_size is not None:
             sub.delivery = self._open_delivery(sub, queue_size, on_start)
         with self._subscriptions_lock:

@@ -61,7 +61,7 @@ class DataIntake:
         reader = SubscriptionReader(
             self._context, fqn=sub.fqn, partition=node.partition, accepts=sub.accepts_from,
             takes=sub.accepts, deliver=sub.run, reject=sub.reject, size=size,
-            settings=node.settings, count=node.count, on_start=on_start,
+            settings=node.settings, count=node.count, on_start=on_start, native=sub.native,
         )  # fmt: skip
         self.readers.append(reader)
         return reader

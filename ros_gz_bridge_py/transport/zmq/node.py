@@ -89,6 +89,7 @@ class ZmqGzNode(GzNode):
 
     subscription_class = ZmqSubscription
     call_class = PendingCall
+    runs_native_loops = True
 
     def __init__(
         self,

@@ -38,7 +38,7 @@ from typing import Any
 import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
-from ros_gz_bridge_py.transport.api import MessageInfo, Rejection
+from ros_gz_bridge_py.transport.api import MessageInfo, NativeLoop, Rejection
 from ros_gz_bridge_py.transport.delivery import (
     MAX_QUEUED_BYTES,
     Delivery,
@@ -68,6 +68,8 @@ IDLE_POLL = 0.25
 READ_BATCH = 256
 #: ``zmq.POLLIN`` as a plain int: ``&`` with the enum runs Python code (enum.Flag.__and__).
 _POLLIN = int(zmq.POLLIN)
+#: What a native loop's run returns for: the wake-up socket, the connection monitor.
+_WAKE, _MONITOR = 1, 2
 #: What a message's (topic, sender, type) frames make of it: what the callback is told, a
 #: rejection (reason, detail), or None (another topic's).
 Verdict = MessageInfo | tuple[Rejection, str] | None
@@ -91,9 +93,12 @@ class SubscriptionReader:
         count: Callable[..., None],
         on_start: Callable[[], None] | None = None,
         max_bytes: int = MAX_QUEUED_BYTES,
+        native: NativeLoop | None = None,
     ) -> None:
         self.fqn = fqn
-        self.received = 0
+        self._received = 0
+        self._native = native
+        self._native_dropped = 0
         self._partition = partition
         self._name = (decompose(fqn) or ("", fqn))[1]
         self._topic_frame = fqn.encode()
@@ -134,9 +139,14 @@ class SubscriptionReader:
         self._post(lambda: self._connections.disconnect(address))
 
     @property
+    def received(self) -> int:
+        """Messages of the topic accepted so far (by the native loop too)."""
+        return self._received + (self._native.received if self._native is not None else 0)
+
+    @property
     def dropped(self) -> int:
-        """Messages dropped so far, oldest first."""
-        return self._pending.dropped
+        """Messages dropped so far, oldest first (by the native loop too)."""
+        return self._pending.dropped + self._native_dropped
 
     def offer(self, payload: Payload, info: MessageInfo) -> int:
         """An intra-process message (from any thread): queued like a received one; returns how
@@ -171,13 +181,18 @@ class SubscriptionReader:
         try:
             if self._on_start is not None:
                 self._on_start()
-            poller = zmq.Poller()
-            poller.register(self._sock, zmq.POLLIN)
-            poller.register(self._wake_r.fileno(), zmq.POLLIN)
-            poller.register(self._connections.monitor, zmq.POLLIN)
+            if self._native is not None:
+                self._native.forget()
+                poll = self._native_poll(self._native)
+            else:
+                poller = zmq.Poller()
+                poller.register(self._sock, zmq.POLLIN)
+                poller.register(self._wake_r.fileno(), zmq.POLLIN)
+                poller.register(self._connections.monitor, zmq.POLLIN)
+                poll = lambda timeout: dict(poller.poll(timeout))  # noqa: E731
             while not self._closed:
                 try:
-                    self._turn(dict(poller.poll(self._poll_timeout())))
+                    self._turn(poll(self._poll_timeout()))
                 except zmq.ContextTerminated:  # the node went away without closing us
                     return
                 except Exception:  # the reader must survive anything, as the I/O thread does
@@ -188,6 +203,41 @@ class SubscriptionReader:
             self._sock.close(linger=0)
             self._wake_r.close()
             self._wake_w.close()
+
+    def _native_poll(self, native: NativeLoop) -> Callable[[int], dict[Any, int]]:
+        """A poll that lets ``native`` read and deliver the socket's messages while it waits:
+        it returns what else is ready (the wake-up socket, the monitor), after judging the
+        messages the loop handed back (those of a sender and type it was not told about)."""
+        sock = self._sock.underlying
+        monitor = self._connections.monitor
+        address = monitor.underlying
+
+        def poll(timeout: int) -> dict[Any, int]:
+            events, unrouted = native.run(sock, self._wake_fd, address, timeout)
+            for frames in unrouted:
+                self._judge_for(native, frames)
+            dropped = native.dropped - self._native_dropped
+            if dropped:
+                self._native_dropped += dropped
+                self._count("messages_dropped", dropped)
+            ready = {self._wake_fd: _POLLIN} if events & _WAKE else {}
+            if events & _MONITOR:
+                ready[monitor] = _POLLIN
+            return ready
+
+        return poll
+
+    def _judge_for(self, native: NativeLoop, frames: list[Frame]) -> None:
+        """A message the native loop had no route for: judged here (the Python reference),
+        the route told to the loop, and the message itself delivered through Python."""
+        verdict = self._verdict(frames)
+        if len(frames) == DATA_FRAMES and (verdict is None or isinstance(verdict, MessageInfo)):
+            native.learn(bytes(frames[1]), bytes(frames[3]), take=verdict is not None)
+        if isinstance(verdict, MessageInfo):
+            self._received += 1
+            self._keep((frames[2], verdict))
+        elif verdict is not None:
+            self._reject(*verdict)
 
     def _poll_timeout(self) -> int:
         """Milliseconds to wait: none with messages pending, else until the connections
@@ -247,7 +297,7 @@ class SubscriptionReader:
             frames = receive_message(sock)
             verdict = self._verdict(frames)
             if isinstance(verdict, MessageInfo):
-                self.received += 1
+                self._received += 1
                 self._trimmer.received(len(frames[2]))
                 self._keep((frames[2], verdict))
             elif verdict is not None:

@@ -1,0 +1,61 @@
+"""Which channels take the native path, and with which programs (docs/native.md §1).
+
+A Gazebo -> ROS channel takes it when the extension is built and may be used (the bridge's
+``native`` option, ``ROS_GZ_BRIDGE_NATIVE``), its backend lets a native loop read (ZeroMQ),
+it publishes serialized messages through rcl (the ``cdr_write`` and ``rcl_serialized_publish``
+options), and a program compiles for at least one spelling of its Gazebo type. Programs are
+compiled once per pair and shared: they are read-only once loaded.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+from typing import Any
+
+from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.native import extension, unavailable_reason
+from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
+from ros_gz_bridge_py.native.pump import foreign_functions, why_no_functions
+
+_LOG = logging.getLogger("ros_gz_bridge_py.native")
+
+
+def native_programs(layouts: dict[str, Pair], options: Any, gz_node: Any) -> dict[str, Any]:
+    """The program of each wire spelling a channel of ``layouts`` runs natively; empty when
+    the channel takes the Python path."""
+    if not (options.native and options.cdr_write and options.rcl_serialized_publish):
+        return {}
+    if not gz_node.runs_native_loops or not native_path_available():
+        return {}
+    programs = {}
+    for wire_type, pair in layouts.items():
+        program = program_of(pair)
+        if program is not None:
+            programs[wire_type] = program
+    return programs
+
+
+@functools.cache
+def native_path_available() -> bool:
+    """Whether the extension and the functions it calls are there; logged once where not."""
+    if extension() is None:
+        _LOG.warning("Every channel takes the Python path: %s", unavailable_reason())
+        return False
+    if foreign_functions() is None:
+        _LOG.warning("Every channel takes the Python path: %s", why_no_functions())
+        return False
+    return True
+
+
+@functools.cache
+def program_of(pair: Pair) -> Any | None:
+    """The loaded program of ``pair`` (compiled once), or None where it stays on Python."""
+    native = extension()
+    if native is None:
+        return None
+    try:
+        compiled = compile_to_ros(pair)
+    except NotExpressibleError:
+        return None
+    return native.Program(compiled.schema, compiled.ops)

@@ -1,0 +1,643 @@
+/* The per-message loop of a native Gazebo -> ROS channel (docs/native.md §5).
+ *
+ * Run by the channel's reader thread with the GIL released: it polls the topic's SUB socket,
+ * reads each message's four frames, keeps the newest `capacity` payloads (dropping the oldest,
+ * before any work is spent on them), applies max_rate, transcodes each payload with the
+ * program of its wire type and publishes it through rcl on the channel's publisher. No Python
+ * runs per message. What it does not decide is handed back to Python, which stays the
+ * reference: frames of a (sender, type) it has not been told about (Python judges them and
+ * tells it with `learn`), and payloads its program does not take (Python converts them, or
+ * says why not). It returns when the reader's wake-up socket or the connection monitor is
+ * readable, or the timeout ends, so that Python does its share of the work.
+ *
+ * libzmq and rcl are the libraries pyzmq and rclpy already loaded: Python passes the addresses
+ * of their functions (pump.py). */
+#define PY_SSIZE_T_CLEAN
+#include "pump.h"
+
+#include <pthread.h>
+#include <stdint.h>
+#include <string.h>
+#include <time.h>
+
+/* ---- the foreign functions ------------------------------------------------------------------ */
+
+/* zmq_msg_t: 64 bytes, aligned as a pointer (zmq.h). */
+typedef union {
+    unsigned char bytes[64];
+    void *align;
+} zmq_msg;
+
+typedef struct {
+    void *socket;
+    int fd;
+    short events;
+    short revents;
+} zmq_pollitem;
+
+typedef struct {
+    uint8_t *buffer;
+    size_t buffer_length;
+    size_t buffer_capacity;
+    void *allocator[5];
+} rcl_serialized;
+
+enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_EVENTS_ = 15 };
+
+struct foreign {
+    int (*poll)(zmq_pollitem *items, int count, long timeout);
+    int (*msg_init)(zmq_msg *msg);
+    int (*msg_recv)(zmq_msg *msg, void *socket, int flags);
+    int (*msg_close)(zmq_msg *msg);
+    void *(*msg_data)(zmq_msg *msg);
+    size_t (*msg_size)(const zmq_msg *msg);
+    int (*msg_more)(const zmq_msg *msg);
+    int (*getsockopt)(void *socket, int option, void *value, size_t *length);
+    int (*publish)(const void *publisher, const rcl_serialized *message, void *allocation);
+    void (*reset_error)(void);
+};
+
+/* ---- the pump --------------------------------------------------------------------------------- */
+
+#define MAX_FRAMES 16
+#define READ_BATCH 256
+#define SLICE_NS 1000000LL
+#define HISTORY 1024
+
+/* What a (sender, type) pair of frames gets: a program, or nothing (another spelling taken). */
+struct route {
+    uint8_t *sender, *type;
+    size_t sender_len, type_len;
+    int program; /* index into programs, or -1: skip without a word */
+};
+
+struct queued {
+    zmq_msg payload;
+    int route;
+};
+
+/* A message handed to Python: its frames (unrouted), or its payload (refused). */
+struct handed {
+    int kind; /* 0 unrouted frames, 1 payload of route `route` refused with `status` */
+    int route, status, nframes;
+    PyObject *frames[MAX_FRAMES]; /* made when the GIL is back */
+    uint8_t *data[MAX_FRAMES];
+    size_t size[MAX_FRAMES];
+};
+
+struct window {
+    uint64_t sequence;
+    int64_t start, end;
+};
+
+typedef struct {
+    PyObject_HEAD
+    struct foreign f;
+    void *publisher;
+    uint8_t *topic;
+    size_t topic_len;
+    PyObject *program_objects; /* list, keeps the programs alive */
+    struct rgb_program **programs;
+    uint8_t **program_types;
+    size_t *program_type_lens;
+    int nprograms;
+    struct route *routes;
+    int nroutes;
+    struct queued *ring;
+    size_t capacity, head, count;
+    struct handed *handover;
+    size_t nhanded, handed_cap;
+    struct rgb_out out;
+    int64_t period_ns, next_ns; /* max_rate: next admission time (period 0: no limit) */
+    unsigned long long received, rate_limited, published, dropped, skipped;
+    pthread_mutex_t lock; /* the windows and the sequence (read by is_own from any thread) */
+    uint64_t sequence;
+    struct window windows[HISTORY];
+    int running;
+} PumpObject;
+
+static int64_t now_ns(clockid_t clock) {
+    struct timespec t;
+    clock_gettime(clock, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+/* ---- publication windows (the loop guard, core/loop_guard.py) ----------------------------- */
+
+static uint64_t begin_publication(PumpObject *self) {
+    pthread_mutex_lock(&self->lock);
+    uint64_t sequence = ++self->sequence;
+    struct window *w = &self->windows[sequence % HISTORY];
+    w->sequence = sequence;
+    w->start = now_ns(CLOCK_REALTIME);
+    w->end = INT64_MAX;
+    pthread_mutex_unlock(&self->lock);
+    return sequence;
+}
+
+static void end_publication(PumpObject *self, uint64_t sequence, int ok) {
+    pthread_mutex_lock(&self->lock);
+    struct window *w = &self->windows[sequence % HISTORY];
+    if (!ok) {
+        w->sequence = 0;
+        if (self->sequence == sequence) self->sequence--;
+    } else if (w->sequence == sequence) {
+        w->end = now_ns(CLOCK_REALTIME);
+    }
+    pthread_mutex_unlock(&self->lock);
+}
+
+/* ---- the loop (no GIL) ---------------------------------------------------------------------- */
+
+static int find_route(PumpObject *self, const uint8_t *sender, size_t sender_len,
+                      const uint8_t *type, size_t type_len) {
+    for (int i = 0; i < self->nroutes; i++) {
+        struct route *r = &self->routes[i];
+        if (r->sender_len == sender_len && r->type_len == type_len &&
+            !memcmp(r->sender, sender, sender_len) && !memcmp(r->type, type, type_len))
+            return i;
+    }
+    return -1;
+}
+
+static struct handed *hand(PumpObject *self) {
+    if (self->nhanded == self->handed_cap) {
+        size_t cap = self->handed_cap ? self->handed_cap * 2 : 16;
+        struct handed *grown = realloc(self->handover, cap * sizeof *grown);
+        if (grown == NULL) return NULL;
+        self->handover = grown;
+        self->handed_cap = cap;
+    }
+    struct handed *h = &self->handover[self->nhanded++];
+    memset(h, 0, sizeof *h);
+    return h;
+}
+
+/* Copies `n` bytes for Python (NULL only when memory runs out). */
+static uint8_t *copy_bytes(const void *p, size_t n) {
+    uint8_t *copy = malloc(n ? n : 1);
+    if (copy != NULL && n) memcpy(copy, p, n);
+    return copy;
+}
+
+static void keep(PumpObject *self, zmq_msg *payload, int route) {
+    if (self->count == self->capacity) { /* drop the oldest, before any work on it */
+        struct queued *oldest = &self->ring[self->head];
+        self->f.msg_close(&oldest->payload);
+        self->head = (self->head + 1) % self->capacity;
+        self->count--;
+        self->dropped++;
+    }
+    struct queued *slot = &self->ring[(self->head + self->count) % self->capacity];
+    memcpy(&slot->payload, payload, sizeof *payload);
+    slot->route = route;
+    self->count++;
+}
+
+/* Reads one message; 0 when none was waiting. */
+static int read_message(PumpObject *self, void *sock) {
+    int events = 0;
+    size_t size = sizeof events;
+    if (self->f.getsockopt(sock, ZMQ_EVENTS_, &events, &size) != 0 || !(events & ZMQ_POLLIN_))
+        return 0;
+    zmq_msg frames[MAX_FRAMES];
+    int n = 0, more = 1, extra = 0;
+    while (more) {
+        zmq_msg scratch, *frame = n < MAX_FRAMES ? &frames[n] : &scratch;
+        self->f.msg_init(frame);
+        if (self->f.msg_recv(frame, sock, n ? 0 : ZMQ_DONTWAIT_) < 0) {
+            self->f.msg_close(frame);
+            if (n == 0) return 0;
+            break;
+        }
+        more = self->f.msg_more(frame);
+        if (frame == &scratch) {
+            self->f.msg_close(&scratch); /* beyond the frames kept: Python sees too many */
+            extra = 1;
+        } else {
+            n++;
+        }
+    }
+    int route = -1;
+    if (n == 4 && !extra && self->f.msg_size(&frames[0]) == self->topic_len &&
+        !memcmp(self->f.msg_data(&frames[0]), self->topic, self->topic_len)) {
+        route = find_route(self, self->f.msg_data(&frames[1]), self->f.msg_size(&frames[1]),
+                           self->f.msg_data(&frames[3]), self->f.msg_size(&frames[3]));
+    }
+    if (route >= 0 && self->routes[route].program >= 0) {
+        keep(self, &frames[2], route);
+        self->f.msg_close(&frames[0]);
+        self->f.msg_close(&frames[1]);
+        self->f.msg_close(&frames[3]);
+        return 1;
+    }
+    if (route >= 0) { /* a spelling already taken from this publisher: not ours */
+        self->skipped++;
+    } else {
+        struct handed *h = hand(self);
+        if (h != NULL) {
+            h->kind = 0;
+            h->nframes = n;
+            for (int i = 0; i < n; i++) {
+                h->size[i] = self->f.msg_size(&frames[i]);
+                h->data[i] = copy_bytes(self->f.msg_data(&frames[i]), h->size[i]);
+                if (h->data[i] == NULL) h->size[i] = 0;
+            }
+        }
+    }
+    for (int i = 0; i < n; i++) self->f.msg_close(&frames[i]);
+    return 1;
+}
+
+static int admit(PumpObject *self) {
+    if (self->period_ns <= 0) return 1;
+    int64_t now = now_ns(CLOCK_MONOTONIC);
+    if (self->next_ns != INT64_MIN && now < self->next_ns) return 0;
+    /* on the schedule, or a fresh start after a pause (core/rate_limit.py) */
+    int on_time = self->next_ns != INT64_MIN && now - self->next_ns < self->period_ns;
+    self->next_ns = on_time ? self->next_ns + self->period_ns : now + self->period_ns;
+    return 1;
+}
+
+static void deliver(PumpObject *self, struct queued *q) {
+    self->received++;
+    if (!admit(self)) {
+        self->rate_limited++;
+        return;
+    }
+    int program = self->routes[q->route].program;
+    const uint8_t *data = self->f.msg_data(&q->payload);
+    size_t size = self->f.msg_size(&q->payload);
+    enum rgb_status status = rgb_to_cdr(self->programs[program], data, size, &self->out);
+    if (status == RGB_OK) {
+        rcl_serialized message = {self->out.data, self->out.len, self->out.cap, {0}};
+        uint64_t sequence = begin_publication(self);
+        int ret = self->f.publish(self->publisher, &message, NULL);
+        end_publication(self, sequence, ret == 0);
+        if (ret == 0) {
+            self->published++;
+            return;
+        }
+        self->f.reset_error();
+        status = RGB_FALLBACK; /* Python publishes it, or says why it cannot */
+    }
+    struct handed *h = hand(self);
+    if (h == NULL) return;
+    h->kind = 1;
+    h->route = q->route;
+    h->status = (int)status;
+    h->nframes = 1;
+    h->size[0] = size;
+    h->data[0] = copy_bytes(data, size);
+    if (h->data[0] == NULL) h->size[0] = 0;
+}
+
+enum { EVENT_WAKE = 1, EVENT_MONITOR = 2, EVENT_HANDED = 4 };
+
+static int pump_loop(PumpObject *self, void *sock, int wake_fd, void *monitor, long timeout_ms) {
+    int64_t deadline = now_ns(CLOCK_MONOTONIC) + (int64_t)timeout_ms * 1000000LL;
+    for (;;) {
+        for (int i = 0; i < READ_BATCH && read_message(self, sock); i++) {
+        }
+        int64_t slice_end = now_ns(CLOCK_MONOTONIC) + SLICE_NS;
+        while (self->count) {
+            struct queued *q = &self->ring[self->head];
+            self->head = (self->head + 1) % self->capacity;
+            self->count--;
+            deliver(self, q);
+            self->f.msg_close(&q->payload);
+            if (now_ns(CLOCK_MONOTONIC) >= slice_end) break;
+        }
+        if (self->nhanded) return EVENT_HANDED;
+        if (self->count) continue;
+        int64_t left = deadline - now_ns(CLOCK_MONOTONIC);
+        if (left <= 0) return 0;
+        zmq_pollitem items[3] = {
+            {sock, 0, ZMQ_POLLIN_, 0},
+            {NULL, wake_fd, ZMQ_POLLIN_, 0},
+            {monitor, 0, ZMQ_POLLIN_, 0},
+        };
+        int ready = self->f.poll(items, monitor ? 3 : 2, (long)((left + 999999) / 1000000));
+        if (ready < 0) return 0; /* EINTR or a closed context: Python looks */
+        int events = (items[1].revents ? EVENT_WAKE : 0) |
+                     (monitor && items[2].revents ? EVENT_MONITOR : 0);
+        if (events) return events;
+    }
+}
+
+/* ---- Python methods -------------------------------------------------------------------------- */
+
+static void clear_handover(PumpObject *self) {
+    for (size_t i = 0; i < self->nhanded; i++)
+        for (int k = 0; k < self->handover[i].nframes; k++) free(self->handover[i].data[k]);
+    self->nhanded = 0;
+}
+
+static void clear_routes(PumpObject *self) {
+    for (int i = 0; i < self->nroutes; i++) {
+        free(self->routes[i].sender);
+        free(self->routes[i].type);
+    }
+    free(self->routes);
+    self->routes = NULL;
+    self->nroutes = 0;
+}
+
+static void clear_ring(PumpObject *self) {
+    while (self->count) {
+        self->f.msg_close(&self->ring[self->head].payload);
+        self->head = (self->head + 1) % self->capacity;
+        self->count--;
+    }
+}
+
+static void pump_dealloc(PumpObject *self) {
+    if (self->ring != NULL) clear_ring(self);
+    free(self->ring);
+    clear_handover(self);
+    free(self->handover);
+    clear_routes(self);
+    for (int i = 0; i < self->nprograms; i++) free(self->program_types[i]);
+    free(self->program_types);
+    free(self->program_type_lens);
+    free(self->programs);
+    free(self->topic);
+    Py_XDECREF(self->program_objects);
+    rgb_out_free(&self->out);
+    pthread_mutex_destroy(&self->lock);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static PyObject *pump_new(PyTypeObject *type, PyObject *args, PyObject *kwds) {
+    PumpObject *self = (PumpObject *)type->tp_alloc(type, 0);
+    if (self != NULL) pthread_mutex_init(&self->lock, NULL);
+    (void)args;
+    (void)kwds;
+    return (PyObject *)self;
+}
+
+/* Pump(topic, functions, publisher, programs, capacity, max_rate)
+ * functions: 10 addresses (zmq_poll, zmq_msg_init, zmq_msg_recv, zmq_msg_close, zmq_msg_data,
+ * zmq_msg_size, zmq_msg_more, zmq_getsockopt, rcl_publish_serialized_message,
+ * rcutils_reset_error); programs: {wire type (bytes): Program}. */
+static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
+    static char *keywords[] = {"topic", "functions", "publisher", "programs", "capacity",
+                               "max_rate", NULL};
+    Py_buffer topic;
+    PyObject *functions, *programs;
+    unsigned long long publisher;
+    Py_ssize_t capacity;
+    double max_rate;
+    if (self->topic != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "a Pump is initialised once");
+        return -1;
+    }
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*OKO!nd", keywords, &topic, &functions,
+                                     &publisher, &PyDict_Type, &programs, &capacity, &max_rate))
+        return -1;
+    int result = -1;
+    void *addresses[10];
+    PyObject *sequence = PySequence_Fast(functions, "functions must be a sequence");
+    if (sequence == NULL) goto done;
+    if (PySequence_Fast_GET_SIZE(sequence) != 10) {
+        PyErr_SetString(PyExc_ValueError, "functions: 10 addresses expected");
+        Py_DECREF(sequence);
+        goto done;
+    }
+    for (int i = 0; i < 10; i++) {
+        addresses[i] = PyLong_AsVoidPtr(PySequence_Fast_GET_ITEM(sequence, i));
+        if (addresses[i] == NULL) {
+            if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "a null function address");
+            Py_DECREF(sequence);
+            goto done;
+        }
+    }
+    Py_DECREF(sequence);
+    if (publisher == 0 || capacity < 1 || capacity > (1 << 24) || !(max_rate >= 0)) {
+        PyErr_SetString(PyExc_ValueError, "publisher, capacity or max_rate out of range");
+        goto done;
+    }
+    memcpy(&self->f.poll, &addresses[0], sizeof(void *));
+    memcpy(&self->f.msg_init, &addresses[1], sizeof(void *));
+    memcpy(&self->f.msg_recv, &addresses[2], sizeof(void *));
+    memcpy(&self->f.msg_close, &addresses[3], sizeof(void *));
+    memcpy(&self->f.msg_data, &addresses[4], sizeof(void *));
+    memcpy(&self->f.msg_size, &addresses[5], sizeof(void *));
+    memcpy(&self->f.msg_more, &addresses[6], sizeof(void *));
+    memcpy(&self->f.getsockopt, &addresses[7], sizeof(void *));
+    memcpy(&self->f.publish, &addresses[8], sizeof(void *));
+    memcpy(&self->f.reset_error, &addresses[9], sizeof(void *));
+    self->publisher = (void *)(uintptr_t)publisher;
+    Py_ssize_t n = PyDict_Size(programs);
+    self->programs = calloc((size_t)n + 1, sizeof *self->programs);
+    self->program_types = calloc((size_t)n + 1, sizeof *self->program_types);
+    self->program_type_lens = calloc((size_t)n + 1, sizeof *self->program_type_lens);
+    self->ring = calloc((size_t)capacity, sizeof *self->ring);
+    self->topic = copy_bytes(topic.buf, (size_t)topic.len);
+    if (!self->programs || !self->program_types || !self->program_type_lens || !self->ring ||
+        !self->topic) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    self->topic_len = (size_t)topic.len;
+    self->capacity = (size_t)capacity;
+    self->program_objects = PyList_New(0);
+    if (self->program_objects == NULL) goto done;
+    PyObject *key, *value;
+    Py_ssize_t pos = 0;
+    while (PyDict_Next(programs, &pos, &key, &value)) {
+        struct rgb_program *program = native_program_of(value);
+        if (!PyBytes_Check(key) || program == NULL) {
+            PyErr_SetString(PyExc_TypeError, "programs: {bytes: Program}");
+            goto done;
+        }
+        if (PyList_Append(self->program_objects, value) < 0) goto done;
+        int i = self->nprograms++;
+        self->programs[i] = program;
+        self->program_type_lens[i] = (size_t)PyBytes_GET_SIZE(key);
+        self->program_types[i] = copy_bytes(PyBytes_AS_STRING(key), self->program_type_lens[i]);
+        if (self->program_types[i] == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
+    }
+    self->period_ns = max_rate > 0 ? (int64_t)(1e9 / max_rate) : 0;
+    self->next_ns = INT64_MIN;
+    result = 0;
+done:
+    PyBuffer_Release(&topic);
+    return result;
+}
+
+/* learn(sender, msg_type, take): what messages of (sender, type) get from now on. */
+static PyObject *pump_learn(PumpObject *self, PyObject *args) {
+    Py_buffer sender, type;
+    int take;
+    if (!PyArg_ParseTuple(args, "y*y*p", &sender, &type, &take)) return NULL;
+    PyObject *result = NULL;
+    int program = -1;
+    for (int i = 0; take && i < self->nprograms; i++)
+        if (self->program_type_lens[i] == (size_t)type.len &&
+            !memcmp(self->program_types[i], type.buf, (size_t)type.len))
+            program = i;
+    if (take && program < 0) { /* taken, but no program: stays with Python */
+        result = Py_NewRef(Py_False);
+        goto done;
+    }
+    if (find_route(self, sender.buf, (size_t)sender.len, type.buf, (size_t)type.len) < 0) {
+        if (self->nroutes >= 1024) { /* as Python's verdict cache; queued ones name routes */
+            self->dropped += self->count;
+            clear_ring(self);
+            clear_routes(self);
+        }
+        struct route *grown = realloc(self->routes, (size_t)(self->nroutes + 1) * sizeof *grown);
+        if (grown == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        self->routes = grown;
+        struct route *r = &self->routes[self->nroutes];
+        r->sender = copy_bytes(sender.buf, (size_t)sender.len);
+        r->type = copy_bytes(type.buf, (size_t)type.len);
+        if (r->sender == NULL || r->type == NULL) {
+            free(r->sender);
+            free(r->type);
+            PyErr_NoMemory();
+            goto done;
+        }
+        r->sender_len = (size_t)sender.len;
+        r->type_len = (size_t)type.len;
+        r->program = program;
+        self->nroutes++;
+    }
+    result = Py_NewRef(Py_True);
+done:
+    PyBuffer_Release(&sender);
+    PyBuffer_Release(&type);
+    return result;
+}
+
+static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
+    (void)unused;
+    if (self->running) {
+        PyErr_SetString(PyExc_RuntimeError, "forget while the pump runs");
+        return NULL;
+    }
+    clear_routes(self);
+    clear_ring(self);
+    Py_RETURN_NONE;
+}
+
+/* run(sock, wake_fd, monitor, timeout_ms) -> (events, handed)
+ * handed: [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused. */
+static PyObject *pump_run(PumpObject *self, PyObject *args) {
+    unsigned long long sock, monitor;
+    int wake_fd;
+    long timeout_ms;
+    if (!PyArg_ParseTuple(args, "KiKl", &sock, &wake_fd, &monitor, &timeout_ms)) return NULL;
+    if (sock == 0 || self->running) {
+        PyErr_SetString(PyExc_ValueError, "no socket, or the pump already runs");
+        return NULL;
+    }
+    self->running = 1;
+    int events;
+    Py_BEGIN_ALLOW_THREADS;
+    events = pump_loop(self, (void *)(uintptr_t)sock, wake_fd, (void *)(uintptr_t)monitor,
+                       timeout_ms < 0 ? 0 : timeout_ms);
+    Py_END_ALLOW_THREADS;
+    self->running = 0;
+    PyObject *handed = PyList_New(0);
+    for (size_t i = 0; handed != NULL && i < self->nhanded; i++) {
+        struct handed *h = &self->handover[i];
+        PyObject *item;
+        if (h->kind == 0) {
+            PyObject *frames = PyList_New(0);
+            for (int k = 0; frames != NULL && k < h->nframes; k++) {
+                PyObject *frame = PyBytes_FromStringAndSize((char *)h->data[k], (Py_ssize_t)h->size[k]);
+                if (frame == NULL || PyList_Append(frames, frame) < 0) Py_CLEAR(frames);
+                Py_XDECREF(frame);
+            }
+            item = frames == NULL ? NULL : Py_BuildValue("(iN)", 0, frames);
+        } else {
+            struct route *r = &self->routes[h->route];
+            item = Py_BuildValue("(iy#y#y#i)", 1, (char *)r->sender, (Py_ssize_t)r->sender_len,
+                                 (char *)r->type, (Py_ssize_t)r->type_len, (char *)h->data[0],
+                                 (Py_ssize_t)h->size[0], h->status);
+        }
+        if (item == NULL || PyList_Append(handed, item) < 0) Py_CLEAR(handed);
+        Py_XDECREF(item);
+    }
+    clear_handover(self);
+    if (handed == NULL) return NULL;
+    return Py_BuildValue("(iN)", events, handed);
+}
+
+static PyObject *pump_counts(PumpObject *self, PyObject *unused) {
+    (void)unused;
+    return Py_BuildValue("(KKKKK)", self->received, self->rate_limited, self->published,
+                         self->dropped, self->skipped);
+}
+
+static PyObject *pump_begin_publication(PumpObject *self, PyObject *unused) {
+    (void)unused;
+    return PyLong_FromUnsignedLongLong(begin_publication(self));
+}
+
+static PyObject *pump_end_publication(PumpObject *self, PyObject *args) {
+    unsigned long long sequence;
+    int ok;
+    if (!PyArg_ParseTuple(args, "Kp", &sequence, &ok)) return NULL;
+    end_publication(self, sequence, ok);
+    Py_RETURN_NONE;
+}
+
+static PyObject *pump_is_own(PumpObject *self, PyObject *args) {
+    unsigned long long sequence;
+    long long stamp;
+    if (!PyArg_ParseTuple(args, "KL", &sequence, &stamp)) return NULL;
+    int own;
+    pthread_mutex_lock(&self->lock);
+    struct window *w = &self->windows[sequence % HISTORY];
+    own = sequence != 0 && w->sequence == sequence && w->start <= stamp && stamp <= w->end;
+    pthread_mutex_unlock(&self->lock);
+    return PyBool_FromLong(own);
+}
+
+static PyMethodDef pump_methods[] = {
+    {"learn", (PyCFunction)pump_learn, METH_VARARGS,
+     "learn(sender, msg_type, take) -> bool: route messages of (sender, type) natively (take) "
+     "or skip them; False where no program takes msg_type"},
+    {"forget", (PyCFunction)pump_forget, METH_NOARGS, "forget routes and queued messages"},
+    {"run", (PyCFunction)pump_run, METH_VARARGS,
+     "run(sock, wake_fd, monitor, timeout_ms) -> (events, handed), the GIL released"},
+    {"counts", (PyCFunction)pump_counts, METH_NOARGS,
+     "(received, rate_limited, published, dropped, skipped) so far"},
+    {"begin_publication", (PyCFunction)pump_begin_publication, METH_NOARGS,
+     "a publication made from Python on the same publisher: its sequence number"},
+    {"end_publication", (PyCFunction)pump_end_publication, METH_VARARGS,
+     "end_publication(sequence, ok)"},
+    {"is_own", (PyCFunction)pump_is_own, METH_VARARGS,
+     "is_own(sequence, source_timestamp_ns) -> bool: a sample this publisher wrote"},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyTypeObject PumpType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.Pump",
+    .tp_basicsize = sizeof(PumpObject),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "The per-message loop of one Gazebo -> ROS channel (docs/native.md §5).",
+    .tp_new = pump_new,
+    .tp_init = (initproc)pump_init,
+    .tp_dealloc = (destructor)pump_dealloc,
+    .tp_methods = pump_methods,
+};
+
+int pump_register(PyObject *module) {
+    if (PyType_Ready(&PumpType) < 0) return -1;
+    Py_INCREF(&PumpType);
+    if (PyModule_AddObject(module, "Pump", (PyObject *)&PumpType) < 0) {
+        Py_DECREF(&PumpType);
+        return -1;
+    }
+    return 0;
+}

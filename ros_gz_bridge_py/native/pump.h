@@ -1,0 +1,15 @@
+/* The per-message loop of a native Gazebo -> ROS channel (pump.c, docs/native.md §5). */
+#ifndef RGB_PUMP_H
+#define RGB_PUMP_H
+
+#include <Python.h>
+
+#include "transcode.h"
+
+/* Adds the Pump type to the module; -1 on error. */
+int pump_register(PyObject *module);
+
+/* The loaded program of a Program object, or NULL when `object` is not one. */
+struct rgb_program *native_program_of(PyObject *object);
+
+#endif

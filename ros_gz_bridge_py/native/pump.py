@@ -1,0 +1,201 @@
+"""A native Gazebo -> ROS channel's pump, as its reader thread and its channel use it.
+
+:class:`ChannelPump` holds the C ``Pump`` (pump.c) of one channel: made when the channel's
+ROS publisher exists, with one program per spelling of the channel's Gazebo type, and kept for
+the publisher's life (its publication sequence numbers are the loop guard's, whichever path
+published). The ZeroMQ reader calls :meth:`ChannelPump.run` instead of polling and reading
+itself (``transport/zmq/reader.py``); what the C loop hands back is done here in Python: the
+payloads no program took go through the channel's Python path (``refused``), which converts
+them or says why not, with the Python path's own error reasons.
+
+libzmq and rcl are not linked: their functions are taken from the libraries pyzmq and rclpy
+already loaded (docs/native.md §5).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import logging
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import zmq
+
+from ros_gz_bridge_py.native import extension
+from ros_gz_bridge_py.transport import MessageInfo
+
+_LOG = logging.getLogger("ros_gz_bridge_py.native")
+_ZMQ_FUNCTIONS = (
+    "zmq_poll",
+    "zmq_msg_init",
+    "zmq_msg_recv",
+    "zmq_msg_close",
+    "zmq_msg_data",
+    "zmq_msg_size",
+    "zmq_msg_more",
+    "zmq_getsockopt",
+)
+#: Handed back by the C loop: frames it has no route for, or a payload no program took.
+_UNROUTED, _REFUSED = 0, 1
+
+
+def _libzmq_path() -> str | None:
+    """The libzmq pyzmq loaded (its wheel bundles one), from this process's mappings."""
+    try:
+        maps = Path("/proc/self/maps").read_text()
+    except OSError:
+        return None
+    for line in maps.splitlines():
+        path = line.rpartition(" ")[2]
+        if "/libzmq" in path and ".so" in path:
+            return path
+    return None
+
+
+@functools.cache
+def foreign_functions() -> tuple[int, ...] | None:
+    """The addresses of the libzmq and rcl functions the pump calls, or None (then no channel
+    takes the native path; :func:`why_no_functions` says why)."""
+    return _resolve()[0]
+
+
+def why_no_functions() -> str:
+    return _resolve()[1]
+
+
+@functools.cache
+def _resolve() -> tuple[tuple[int, ...] | None, str]:
+    zmq.Context.instance()  # pyzmq loads libzmq with its backend
+    path = _libzmq_path()
+    if path is None:
+        return None, "pyzmq's libzmq is not among the loaded libraries"
+    try:
+        libzmq = ctypes.CDLL(path)
+        rcl = ctypes.CDLL("librcl.so")
+        rcutils = ctypes.CDLL("librcutils.so")
+        functions = [getattr(libzmq, name) for name in _ZMQ_FUNCTIONS]
+        functions += [rcl.rcl_publish_serialized_message, rcutils.rcutils_reset_error]
+    except (OSError, AttributeError) as err:
+        return None, f"libzmq or rcl cannot be used from C ({err})"
+    addresses = tuple(ctypes.cast(function, ctypes.c_void_p).value or 0 for function in functions)
+    return (addresses, "") if all(addresses) else (None, "a function has no address")
+
+
+class ChannelPump:
+    """One channel's C pump (see the module docstring).
+
+    ``programs``: the compiled program of each wire spelling the channel takes.
+    ``refused(payload, info)``: the channel's Python path for one admitted payload.
+    """
+
+    def __init__(
+        self,
+        *,
+        topic: str,
+        publisher: Any,
+        programs: Mapping[str, Any],
+        capacity: int,
+        max_rate: float,
+        refused: Callable[[bytes, MessageInfo], None],
+        counted: Callable[[int, int, int], None],
+        partition: str,
+        name: str,
+    ) -> None:
+        native = extension()
+        functions = foreign_functions()
+        if native is None or functions is None:
+            msg = "no native extension or foreign functions"
+            raise RuntimeError(msg)
+        self._handle = publisher.handle
+        self._pump = native.Pump(
+            topic.encode(),
+            functions,
+            publisher.handle.pointer,
+            {name.encode(): program for name, program in programs.items()},
+            capacity,
+            max_rate,
+        )
+        self._refused = refused
+        self._counted = counted
+        self._partition = partition
+        self._name = name
+        self._infos: dict[tuple[bytes, bytes], MessageInfo] = {}
+        self._seen = (0, 0, 0, 0, 0)
+
+    # --- the reader thread ----------------------------------------------------------------
+
+    def forget(self) -> None:
+        """A new subscription: no route is known yet (a closed one's queue is dropped)."""
+        self._pump.forget()
+
+    def learn(self, sender: bytes, msg_type: bytes, *, take: bool) -> None:
+        """Messages of (``sender``, ``msg_type``) go natively from now on (``take``; where a
+        program takes the type), or are skipped (another spelling of a type taken)."""
+        self._pump.learn(sender, msg_type, take)
+
+    def run(self, sock: int, wake_fd: int, monitor: int, timeout_ms: int) -> tuple[int, list[Any]]:
+        """Pump messages with the GIL released until the wake-up socket or the monitor is
+        readable or ``timeout_ms`` ends; returns the events and the frames with no route (for
+        the reader to judge). Refused payloads are converted here, in Python."""
+        with self._handle:
+            events, handed = self._pump.run(sock, wake_fd, monitor, timeout_ms)
+        received, rate_limited, published, _dropped = self.take_counts()
+        if received:
+            self._counted(received, rate_limited, published)
+        unrouted = []
+        for item in handed:
+            if item[0] == _UNROUTED:
+                unrouted.append(item[1])
+            else:
+                _kind, sender, msg_type, payload, _status = item
+                self._refused(payload, self._info(sender, msg_type))
+        return events, unrouted
+
+    def _info(self, sender: bytes, msg_type: bytes) -> MessageInfo:
+        info = self._infos.get((sender, msg_type))
+        if info is None:
+            info = MessageInfo(
+                self._name, msg_type.decode(), self._partition, sender.decode(),
+                intra_process=False,
+            )  # fmt: skip
+            self._infos[(sender, msg_type)] = info
+        return info
+
+    def take_counts(self) -> tuple[int, int, int, int]:
+        """(received, rate_limited, published, dropped) since the last call."""
+        now = self._pump.counts()
+        before, self._seen = self._seen, now
+        return (now[0] - before[0], now[1] - before[1], now[2] - before[2], now[3] - before[3])
+
+    @property
+    def received(self) -> int:
+        """Payloads taken from the socket so far."""
+        return int(self._pump.counts()[0])
+
+    @property
+    def dropped(self) -> int:
+        """Payloads dropped so far, oldest first, before any work on them."""
+        return int(self._pump.counts()[3])
+
+    # --- the loop guard -------------------------------------------------------------------
+
+    def wrap(self, publish: Callable[[Any], None]) -> Callable[[Any], None]:
+        """``publish`` (the channel's Python path on the same publisher) numbered in the same
+        sequence as the pump's own publications."""
+        pump = self._pump
+
+        def publish_and_record(msg: Any) -> None:
+            sequence = pump.begin_publication()
+            try:
+                publish(msg)
+            except BaseException:
+                pump.end_publication(sequence, False)
+                raise
+            pump.end_publication(sequence, True)
+
+        return publish_and_record
+
+    def is_own(self, sequence: int, stamp: int) -> bool:
+        return bool(self._pump.is_own(sequence, stamp))
