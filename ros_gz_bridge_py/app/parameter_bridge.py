@@ -337,8 +337,8 @@ def discover_yaml(
     explicit = [spec for source in sources for spec in source.specs]
     patterns = [pattern for source in sources for pattern in source.patterns]
     rules = discovery_rules(node, params, enabled=True)
-    node.get_logger().info(f"Listening to Gazebo discovery for {seconds:g} s ...")
     with create_gz_node(params.shared.gz_node_options()) as gz_node:
+        node.get_logger().info(f"Listening to Gazebo discovery for {seconds:g} s ...")
         discover.listen(seconds / 2)
         gz_node.ask_subscribers()  # gz-transport 13+ list their subscriptions with types
         discover.listen(seconds / 2)
