@@ -10,7 +10,8 @@ values go both ways. ``--discover`` prints a YAML that, fed back, bridges the sa
 Issue 23 item 5: a Fortress ``cmd_vel`` subscriber (no type on the wire) beside a ROS publisher
 gets the ROS publisher's values, under ``auto_bridge`` and through a ``--discover`` file; a
 typed subscriber (a Zenoh peer: its tokens carry the type) beside a ROS publisher of another
-type is bridged with the Gazebo type and the mismatch is explained; a
+type is bridged with the Gazebo type and the mismatch is explained; ``--check`` with
+``auto_bridge`` checks the inferred entry and names its rule; a
 Fortress subscriber that subscribed before the bridge is invisible until a publisher of its
 type is announced on its topic.
 """
@@ -329,3 +330,27 @@ def test_a_fortress_subscriber_older_than_the_bridge_shows_only_when_its_type_is
         publisher = gz_node.advertise(topic, "gz.msgs.Twist")  # both spellings announced
         wait_until(lambda: subscribers() == ["ignition.msgs.Twist"], WAIT, "it takes ours")
         publisher.close()
+
+
+def test_check_with_auto_bridge_checks_the_inferred_entry_and_names_its_rule(
+    probe: RosSide, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    stem = unique_name("cinfer")
+    cmd_vel = f"{stem}/model/robot1/cmd_vel"
+    check = start_process(
+        [str(PARAMETER_BRIDGE), "--check", "6", "--ros-args",
+         "-p", "auto_bridge:=true", "-p", f"auto_bridge_allow:=[^{stem}/]"]
+    )  # fmt: skip
+    started.append(check)
+    wait_for_line(check, r"^Listening for 6 s", timeout=30)
+    started.append(start_peer("echo", cmd_vel, "ignition.msgs.Twist", "60"))
+    twist_publisher(probe, cmd_vel, 1.0)
+    assert check.wait(30) == 0, check.output()
+    title = (
+        f"ROS {cmd_vel} (geometry_msgs/msg/Twist) -> Gazebo {cmd_vel} (ignition.msgs.Twist) "
+        "(auto_bridge, discovered: inferred from the ROS publisher's type)"
+    )
+    report = check.output().split(title, 1)[1]
+    assert "Gazebo: subscriber (ignition.msgs.Twist, takes ours)" in report
+    assert "ok: messages can flow" in report
