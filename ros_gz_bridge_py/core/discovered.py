@@ -199,10 +199,13 @@ def ros_publishers(
     """The distinct types of the ROS publishers of each of ``names`` (resolved in
     ``ros_node``'s namespace) that no node of ``own_nodes`` (name, namespace) owns; names
     without such publishers left out."""
+    wanted = list(names)
+    if not wanted:
+        return {}  # no graph query: the scan runs every SCAN_PERIOD
     own = set(own_nodes)
     existing = {name for name, _ in ros_node.get_topic_names_and_types()}
     found = {}
-    for name in names:
+    for name in wanted:
         resolved = ros_node.resolve_topic_name(name)
         if resolved not in existing:
             continue
