@@ -4,13 +4,16 @@ It takes the same arguments, ``--ros-args`` and configuration as a normal run, b
 listens to Gazebo discovery (every partition) and the ROS graph for a few seconds, and prints
 per entry what each side shows and the fix for every cause that keeps it from working
 (``diagnosis.py``). ROS->Gazebo entries are announced to Gazebo (nothing is published), so that
-Gazebo subscribers show whether they take the type. Exit status 1 when an entry cannot work.
+Gazebo subscribers show whether they take the type. With ``auto_bridge`` or entries that
+discovery completes, what discovered bridging would bridge (planned half-way through) is
+checked too, each entry with the rule that chose its types. Exit status 1 when an entry cannot
+work.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, TextIO
 
@@ -52,18 +55,21 @@ class EntryReport:
 
 
 def run_check(
-    sides: Sides, specs: Sequence[BridgeSpec], seconds: float, *, out: TextIO, spin_once: Any
+    sides: Sides,
+    specs: Sequence[BridgeSpec],
+    seconds: float,
+    *,
+    out: TextIO,
+    spin_once: Any,
+    discovered: Callable[[], Sequence[TopicBridgeSpec]] = list,
 ) -> int:
     """Listen for ``seconds`` (spinning the ROS node with ``spin_once``), then print one
-    report per entry to ``out``; 1 if any cannot work."""
+    report per entry to ``out``; 1 if any cannot work. ``discovered``: the entries discovered
+    bridging would add, asked for half-way through and checked with the others."""
     gz_node = sides.gz_node
+    specs = list(specs)
     probes: dict[int, Publisher] = {}
-    for index, spec in enumerate(specs):
-        if isinstance(spec, TopicBridgeSpec) and spec.direction is not Direction.GZ_TO_ROS:
-            try:
-                probes[index] = gz_node.advertise(spec.gz_topic, spec.gz_type)
-            except Exception as err:  # a bad name: reported with the entry below
-                print(f"cannot announce {spec.gz_topic}: {err}", file=out)
+    _announce(gz_node, specs, probes, out)
     print(
         f"Listening for {seconds:g} s: Gazebo ({gz_node.listening()}) and the ROS graph ...",
         file=out,
@@ -76,6 +82,8 @@ def run_check(
         if not asked and time.monotonic() > deadline - seconds / 2:
             gz_node.ask_subscribers()
             asked = True
+            specs += discovered()
+            _announce(gz_node, specs, probes, out)
     reports: list[EntryReport] = []
     for index, spec in enumerate(specs):
         if isinstance(spec, ServiceBridgeSpec):
@@ -95,6 +103,22 @@ def run_check(
     return 1 if failing else 0
 
 
+def _announce(
+    gz_node: GzNode, specs: Sequence[BridgeSpec], probes: dict[int, Publisher], out: TextIO
+) -> None:
+    """Announce to Gazebo the ROS->Gazebo entries not yet in ``probes``."""
+    for index, spec in enumerate(specs):
+        if (
+            isinstance(spec, TopicBridgeSpec)
+            and spec.direction is not Direction.GZ_TO_ROS
+            and index not in probes
+        ):
+            try:
+                probes[index] = gz_node.advertise(spec.gz_topic, spec.gz_type)
+            except Exception as err:  # a bad name: reported with the entry below
+                print(f"cannot announce {spec.gz_topic}: {err}", file=out)
+
+
 def _print_report(report: EntryReport, out: TextIO) -> None:
     print(report.title, file=out)
     for line in report.seen:
@@ -111,6 +135,8 @@ def _topic_reports(
     ros_node, gz_node, registry = sides.ros_node, sides.gz_node, sides.registry
     own = {(ros_node.get_name(), ros_node.get_namespace())}
     where = f" ({spec.source})" if spec.source else ""
+    if spec.discovered_by:
+        where = f" ({spec.source}, discovered: {spec.discovered_by})"
     try:
         registry.layouts(spec.ros_type, spec.gz_type)
     except UnsupportedTypeError as err:
@@ -141,6 +167,7 @@ def _topic_reports(
             listening=gz_node.listening(),
             gz_subscriber_registered=probe is not None and bool(probe.wire_types()),
             gz_topics=gz_node.topic_list(),
+            discovered_by=spec.discovered_by,
         )
         arrow = (
             f"Gazebo {name} ({spec.gz_type}) -> ROS {ros_topic} ({spec.ros_type})"

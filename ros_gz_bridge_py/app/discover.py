@@ -5,6 +5,8 @@ It listens to Gazebo discovery for a few seconds, plans as ``auto_bridge`` would
 discovery completes, explicit entries left out) and prints a YAML file on standard output, one
 entry per topic, for the user to edit and commit. Logs go to standard error, so
 ``parameter_bridge --discover > bridge.yaml`` writes a file ``config_file`` takes as it is.
+Entries whose types were inferred from a ROS publisher (the Gazebo subscribers told none) carry
+a comment that says so: the Gazebo side was not seen to take that type.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from collections.abc import Sequence
 from typing import TextIO
 
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.core.discovery_plan import BY_ROS_PUBLISHER
 from ros_gz_bridge_py.msgs.names import canonical_type
 
 #: Seconds ``--discover`` listens by default: every peer re-announces within a second, and
@@ -75,19 +78,33 @@ def write_yaml(specs: Sequence[TopicBridgeSpec], header: Sequence[str], out: Tex
                 print(f"  {key}: {value}", file=out)
 
 
-def header_lines(seconds: float, listening: str, count: int) -> list[str]:
-    """What the file is and how its names and types are written."""
-    return [
+def header_lines(
+    seconds: float, listening: str, count: int, specs: Sequence[TopicBridgeSpec] = ()
+) -> list[str]:
+    """What the file is and how its names and types are written (``specs``: its entries)."""
+    lines = [
         f"Written by parameter_bridge --discover {seconds:g}: {count} Gazebo topics seen by",
         f"{listening}.",
         "Gazebo types are written gz.msgs.X; they also match ignition.msgs.X (Fortress) peers.",
         "Relative ROS names resolve in the bridge's namespace (/ unless -r __ns:=... is given).",
         "Use: parameter_bridge --ros-args -p config_file:=<this file>",
     ]
+    inferred = sum(1 for spec in specs if spec.discovered_by == BY_ROS_PUBLISHER)
+    if inferred:
+        lines.append(
+            f"{inferred} entries (marked 'inferred') take their types from the ROS publisher: "
+            "their Gazebo subscribers tell no type."
+        )
+    return lines
 
 
 def _hints(spec: TopicBridgeSpec) -> list[str]:
     hints = []
+    if spec.discovered_by == BY_ROS_PUBLISHER:
+        hints.append(
+            f"# inferred: {spec.gz_topic}'s Gazebo subscribers tell no type (gz-transport 11/12); "
+            f"the types are the ROS publisher's ({spec.ros_type}) and its default Gazebo type"
+        )
     name = spec.ros_topic.strip("/")
     if name in _HINTS_BY_NAME:
         hints.append(_HINTS_BY_NAME[name])

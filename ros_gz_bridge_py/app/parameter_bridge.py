@@ -53,14 +53,20 @@ from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.config.patterns import TopicPattern
 from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.core.bridge import Bridge
-from ros_gz_bridge_py.core.discovered import DiscoveredBridges
-from ros_gz_bridge_py.core.discovery_plan import plan, sightings
+from ros_gz_bridge_py.core.discovered import DiscoveredBridges, ros_publishers
+from ros_gz_bridge_py.core.discovery_plan import (
+    Plan,
+    Sighting,
+    plan,
+    ros_names_to_read,
+    sightings,
+)
 from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
-from ros_gz_bridge_py.transport import create_gz_node
+from ros_gz_bridge_py.transport import GzNode, create_gz_node
 
 NODE_NAME = "ros_gz_bridge"
 #: ``parameter_bridge --check [SECONDS]``: report on the entries instead of bridging them.
@@ -289,16 +295,30 @@ def check(
     specs = [spec for source in sources for spec in source.specs]
     errors = sum(len(source.errors) for source in sources)
     patterns = [pattern for source in sources for pattern in source.patterns]
-    for pattern in patterns:
-        print(f"{pattern.gz_topic} ({pattern.source}): completed by discovery when the bridge runs")
-    if not specs and not errors:
-        print("parameter_bridge --check: no entries to check (give topics or config_file)")
-        return USAGE_EXIT if not patterns else 0
+    rules = discovery_rules(node, params, enabled=params.auto_bridge)
+    if not specs and not errors and not patterns and not rules.enabled:
+        print(
+            "parameter_bridge --check: no entries to check (give topics, config_file or "
+            "-p auto_bridge:=true)"
+        )
+        return USAGE_EXIT
     executor = make_executor(events=switches.events_executor)
     executor.add_node(node)
     with create_gz_node(params.shared.gz_node_options()) as gz_node:
+
+        def discovered() -> list[TopicBridgeSpec]:
+            if not patterns and not rules.enabled:
+                return []
+            _, wanted = discovered_plan(node, gz_node, specs, patterns, rules)
+            for topic, why in wanted.skipped.items():
+                print(f"Discovered {topic}: not bridged: {why}")
+            return list(wanted.specs.values())
+
         sides = Sides(node, gz_node, default_registry())
-        status = run_check(sides, specs, seconds, out=sys.stdout, spin_once=executor.spin_once)
+        status = run_check(
+            sides, specs, seconds, out=sys.stdout, spin_once=executor.spin_once,
+            discovered=discovered,
+        )  # fmt: skip
     if errors:
         print(f"{errors} configuration entries could not be read (see the errors above)")
     return 1 if errors else status
@@ -317,27 +337,45 @@ def discover_yaml(
     explicit = [spec for source in sources for spec in source.specs]
     patterns = [pattern for source in sources for pattern in source.patterns]
     rules = discovery_rules(node, params, enabled=True)
-    node.get_logger().info(f"Listening to Gazebo discovery for {seconds:g} s ...")
     with create_gz_node(params.shared.gz_node_options()) as gz_node:
+        node.get_logger().info(f"Listening to Gazebo discovery for {seconds:g} s ...")
         discover.listen(seconds / 2)
         gz_node.ask_subscribers()  # gz-transport 13+ list their subscriptions with types
         discover.listen(seconds / 2)
-        found = sightings(gz_node.graph(), gz_node.partition)
-        explicit_names = frozenset(
-            gazebo_name(gz_node, spec.gz_topic)[1]
-            for spec in explicit
-            if isinstance(spec, TopicBridgeSpec)
-        )
-        wanted = plan(
-            found, patterns=patterns, rules=rules, registry=default_registry(),
-            explicit=explicit_names,
-        )  # fmt: skip
+        found, wanted = discovered_plan(node, gz_node, explicit, patterns, rules)
         listening = gz_node.listening()
     for topic, why in wanted.skipped.items():
         node.get_logger().info(f"Not bridging Gazebo {topic}: {why}")
-    header = discover.header_lines(seconds, listening, len(found))
-    discover.write_yaml(list(wanted.specs.values()), header, sys.stdout)
+    for topic, note in wanted.notes.items():
+        node.get_logger().warning(f"Gazebo {topic}: {note}")
+    specs = list(wanted.specs.values())
+    discover.write_yaml(
+        specs, discover.header_lines(seconds, listening, len(found), specs), sys.stdout
+    )
     return 1 if any(source.errors for source in sources) else 0
+
+
+def discovered_plan(
+    node: Node,
+    gz_node: GzNode,
+    explicit: Sequence[BridgeSpec],
+    patterns: Sequence[TopicPattern],
+    rules: AutoBridgeRules,
+) -> tuple[dict[str, Sighting], Plan]:
+    """What discovered bridging would bridge now, beside the ``explicit`` entries (the
+    sightings of the partition, and the plan)."""
+    found = sightings(gz_node.graph(), gz_node.partition, gz_node.peer_spelling)
+    explicit_names = frozenset(
+        gazebo_name(gz_node, spec.gz_topic)[1]
+        for spec in explicit
+        if isinstance(spec, TopicBridgeSpec)
+    )
+    ros = ros_publishers(node, ros_names_to_read(found), {(node.get_name(), node.get_namespace())})
+    wanted = plan(
+        found, patterns=patterns, rules=rules, registry=default_registry(),
+        explicit=explicit_names, ros_publishers=ros,
+    )  # fmt: skip
+    return found, wanted
 
 
 def build_bridge(

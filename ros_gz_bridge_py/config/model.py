@@ -69,6 +69,8 @@ class TopicBridgeSpec:
     max_rate: float | None = None
     #: Where it came from, e.g. ``"argument 2"`` or ``"bridge.yaml entry 3 (line 12)"``.
     source: str = ""
+    #: The rule of discovered bridging that chose its types ("" for a configured entry).
+    discovered_by: str = ""
 
 
 @dataclass(frozen=True)

@@ -74,7 +74,7 @@ class TopicPattern:
     @classmethod
     def from_spec(cls, spec: TopicBridgeSpec, direction: Direction | None) -> TopicPattern:
         """The pattern of an entry read as ``spec`` (its direction None when not given)."""
-        values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(spec)}
+        values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(cls)}
         return cls(**{**values, "direction": direction})
 
     def completed(
@@ -82,7 +82,7 @@ class TopicPattern:
     ) -> TopicBridgeSpec:
         """The entry this pattern makes of one discovered topic (``types``: ROS, Gazebo): its
         own settings, the rest completed."""
-        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(TopicBridgeSpec)}
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         ros_type, gz_type = types
         return TopicBridgeSpec(**{
             **values, "ros_topic": ros_topic, "gz_topic": gz_topic,

@@ -110,6 +110,11 @@ class Bridge:
             self._explain_timer = ros_node.create_timer(EXPLAIN_PERIOD, self.explain, clock=steady)
 
     @property
+    def own_nodes(self) -> frozenset[tuple[str, str]]:
+        """(name, namespace) of the bridge's ROS nodes: its endpoints are not the graph's."""
+        return self._ctx.own_nodes
+
+    @property
     def handles(self) -> list[BridgeHandle]:
         with self._lock:
             return list(self._handles)

@@ -100,6 +100,8 @@ class Situation:
     since_message: float | None = None
     #: The channel's usual time between messages, when known.
     interval: float | None = None
+    #: The rule of discovered bridging that chose the types ("" for a configured entry).
+    discovered_by: str = ""
 
 
 def flow(situation: Situation) -> Flow:
@@ -208,8 +210,15 @@ def _type_finding(situation: Situation, hints: TypeHints, endpoint: GraphEndpoin
     return Finding(
         f"gz-type:{endpoint.role}:{seen}",
         f"the Gazebo {endpoint.role} of {situation.gz_topic} ({_where(endpoint)}) {verb} "
-        f"{seen}, but the bridge is configured with {situation.gz_type}; {fix}",
+        f"{seen}, but {_chosen(situation, situation.gz_type)}; {fix}",
     )
+
+
+def _chosen(situation: Situation, type_name: str) -> str:
+    """How the bridge came to use ``type_name``: its configuration, or a rule of discovery."""
+    if situation.discovered_by:
+        return f"the bridge took {type_name} from discovery ({situation.discovered_by})"
+    return f"the bridge is configured with {type_name}"
 
 
 def _declined_finding(situation: Situation, endpoint: GraphEndpoint) -> Finding:
@@ -278,7 +287,9 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
     for endpoint in situation.ros_endpoints:
         if endpoint.msg_type != situation.ros_type:
             others = hints.gz_types_for(endpoint.msg_type)
-            if hints.pairs(endpoint.msg_type, situation.gz_type):
+            if situation.discovered_by:
+                fix = _discovered_fix(situation, endpoint.msg_type, hints)
+            elif hints.pairs(endpoint.msg_type, situation.gz_type):
                 fix = f"set the ROS type (ros_type_name) to {endpoint.msg_type}"
             elif others:
                 fix = (
@@ -291,8 +302,8 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
                 Finding(
                     f"ros-type:{endpoint.node}:{endpoint.msg_type}",
                     f"the ROS {role} {endpoint.node} of {situation.ros_topic} uses "
-                    f"{endpoint.msg_type}, but the bridge is configured with "
-                    f"{situation.ros_type}; {fix}",
+                    f"{endpoint.msg_type}, but {_chosen(situation, situation.ros_type)}; "
+                    f"{fix}",
                 )
             )
         elif endpoint.qos_problem:
@@ -305,3 +316,17 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
                 )
             )
     return found
+
+
+def _discovered_fix(situation: Situation, ros_type: str, hints: TypeHints) -> str:
+    """The fix for a ROS endpoint of another type than a discovered bridge took."""
+    if hints.pairs(ros_type, situation.gz_type):
+        return (
+            f"{ros_type} also pairs with {situation.gz_type}: write an entry with "
+            f"ros_type_name {ros_type} (entries win over discovery)"
+        )
+    return (
+        f"{ros_type} does not pair with {situation.gz_type}, which the Gazebo side takes: use "
+        f"{situation.ros_type} in ROS, or write an entry with the types (entries win over "
+        "discovery)"
+    )

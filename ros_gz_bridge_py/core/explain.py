@@ -228,6 +228,7 @@ class Explainer:
             input_open=channel.state is ChannelState.ACTIVE,
             since_message=None if seen.changed is None else now - seen.changed,
             interval=seen.interval,
+            discovered_by=spec.discovered_by,
         )
 
     def _ask_subscribers(self, now: float) -> None:

@@ -416,6 +416,11 @@ class GzNode(abc.ABC):
         bridging reads it; filter by ``partition``). A subscriber whose type its protocol
         does not tell (gz-transport 11/12) has ``msg_type`` ``""``."""
 
+    def peer_spelling(self, process_uuid: str) -> Spelling | None:
+        """How peer ``process_uuid``'s Gazebo line spells message types, when discovery tells
+        it (docs/protocol.md §9.2)."""
+        return self.subscriber_book.spelling(process_uuid)
+
     @abc.abstractmethod
     def peer_processes(self) -> int:
         """How many other Gazebo Transport processes this node hears."""

@@ -142,6 +142,10 @@ class SubscriberBook:
     def subscribers(self, fqn: str) -> tuple[RemoteSubscriber, ...]:
         return self._subscribers.get(fqn, ())
 
+    def spelling(self, process_uuid: str) -> Spelling | None:
+        """The spelling of peer ``process_uuid``: known, else the default (may be None)."""
+        return self._spellings.get(process_uuid, self._default)
+
     def wire_types(self, fqn: str, names: tuple[str, ...]) -> frozenset[str]:
         """What a publisher of ``names`` on ``fqn`` sends now (see :func:`wire_types`)."""
         spellings = self._spellings

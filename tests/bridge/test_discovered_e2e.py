@@ -6,6 +6,14 @@ appear in ROS under valid names, carry their values, and go when their process e
 topic never appears; a Fortress subscriber, whose type the protocol does not tell, is skipped
 and said once. Zenoh: our ``ZenohGzNode`` process publishes and has a typed subscriber, so
 values go both ways. ``--discover`` prints a YAML that, fed back, bridges the same topics.
+
+Issue 23 item 5: a Fortress ``cmd_vel`` subscriber (no type on the wire) beside a ROS publisher
+gets the ROS publisher's values, under ``auto_bridge`` and through a ``--discover`` file; a
+typed subscriber (a Zenoh peer: its tokens carry the type) beside a ROS publisher of another
+type is bridged with the Gazebo type and the mismatch is explained; ``--check`` with
+``auto_bridge`` checks the inferred entry and names its rule; a
+Fortress subscriber that subscribed before the bridge is invisible until a publisher of its
+type is announced on its topic.
 """
 
 from __future__ import annotations
@@ -13,6 +21,7 @@ from __future__ import annotations
 import json
 import re
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -20,6 +29,8 @@ from geometry_msgs.msg import Pose, Twist
 from nav_msgs.msg import Odometry
 from std_msgs.msg import String
 
+from ros_gz_bridge_py.transport import create_gz_node
+from ros_gz_bridge_py.transport.api import SUBSCRIBER
 from tests.bridge.behaviour_harness import (
     PARAMETER_BRIDGE,
     WAIT,
@@ -184,3 +195,162 @@ def test_discover_prints_a_yaml_that_bridges_the_same_topics(
     odoms, _ = probe.subscribe(Odometry, odom_ros)
     assert odoms.wait_for_count(1, WAIT)[0][0].pose.pose.position.x == 1.5
     assert "Following Gazebo discovery" not in bridge.output()
+
+
+def twist_publisher(ros: RosSide, topic: str, x: float) -> Callable[[int], None]:
+    """A ROS Twist publisher on ``topic``; the returned function publishes linear.x = ``x``."""
+    publisher = ros.run(lambda: ros.node.create_publisher(Twist, topic, 10))
+    twist = Twist()
+    twist.linear.x = x
+    return lambda _: ros.run(lambda: publisher.publish(twist))
+
+
+def echoed(peer: PeerProcess, pattern: str) -> Callable[[], bool]:
+    return lambda: re.search(pattern, peer.output()) is not None
+
+
+def test_auto_bridge_types_a_fortress_subscriber_from_the_ros_publisher(
+    probe: RosSide, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    stem = unique_name("infer")
+    cmd_vel = f"{stem}/model/robot1/cmd_vel"
+    bridge = start_process(
+        bridge_command(ros_args=["-p", "auto_bridge:=true", "-p", f"auto_bridge_allow:=[^{stem}/]"])
+    )
+    started.append(bridge)
+    wait_for_line(bridge, r"Following Gazebo discovery: auto_bridge", timeout=30)
+    diff_drive = start_peer("echo", cmd_vel, "ignition.msgs.Twist", "60")  # as DiffDrive does
+    started.append(diff_drive)
+    wait_for_line(bridge, rf"Not bridging Gazebo {cmd_vel}: .*no ROS node publishes on")
+    publish = twist_publisher(probe, cmd_vel, 0.75)
+    wait_for_line(
+        bridge,
+        rf"Bridging ROS {cmd_vel[1:]} \(geometry_msgs/msg/Twist\) -> Gazebo {cmd_vel} "
+        r"\(ignition\.msgs\.Twist\): .*inferred from the ROS publisher's type",
+    )
+    publish_until(publish, echoed(diff_drive, r"MSG ignition\.msgs\.Twist .*x: 0\.75"), "echoed")
+    assert "Removing the discovered bridge" not in bridge.output()
+
+
+def test_discover_writes_the_inferred_entry_and_the_file_carries_the_values(
+    probe: RosSide, started: list[PeerProcess], tmp_path: Path
+) -> None:
+    require_peer()
+    stem = unique_name("dinfer")
+    cmd_vel = f"{stem}/model/robot1/cmd_vel"
+    discover = start_process(
+        [str(PARAMETER_BRIDGE), "--discover", "6", "--ros-args",
+         "-p", f"auto_bridge_allow:=[^{stem}/]"]
+    )  # fmt: skip
+    started.append(discover)
+    # A Fortress subscriber is heard only when it subscribes: after --discover listens.
+    wait_for_line(discover, r"Listening to Gazebo discovery", timeout=30)
+    diff_drive = start_peer("echo", cmd_vel, "ignition.msgs.Twist", "90")
+    started.append(diff_drive)
+    publish = twist_publisher(probe, cmd_vel, -1.25)
+    assert discover.wait(30) == 0, discover.output()
+    text = "\n".join(line for line in discover.output().splitlines() if not line.startswith("["))
+    entry = text.split(f"# inferred: {cmd_vel}'s Gazebo subscribers tell no type", 1)[1]
+    assert f'gz_topic_name: "{cmd_vel}"' in entry
+    assert 'ros_type_name: "geometry_msgs/msg/Twist"' in entry
+    assert 'gz_type_name: "gz.msgs.Twist"' in entry
+    assert "direction: ROS_TO_GZ" in entry
+    assert "1 entries (marked 'inferred') take their types from the ROS publisher" in text
+    config = tmp_path / "discovered.yaml"
+    config.write_text(text + "\n")
+    # The Fortress subscriber predates this bridge: the entry's announcement makes it register.
+    bridge = start_process(bridge_command(ros_args=["-p", f"config_file:={config}"]))
+    started.append(bridge)
+    wait_for_line(bridge, r"Creating ROS->GZ \[", timeout=30)
+    publish_until(publish, echoed(diff_drive, r"MSG ignition\.msgs\.Twist .*x: -1\.25"), "echoed")
+
+
+def test_a_typed_gazebo_subscriber_wins_over_a_ros_publisher_of_another_type(
+    probe: RosSide, started: list[PeerProcess]
+) -> None:
+    stem = unique_name("typed")
+    cmd_vel = f"{stem}/cmd_vel"
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    bridge = start_process(
+        bridge_command(
+            ros_args=["-p", "auto_bridge:=true", "-p", f"auto_bridge_allow:=[^{stem}/]"]
+        ),
+        zenoh_env("peer", [endpoint], []),
+    )
+    started.append(bridge)
+    wait_for_line(bridge, r"Following Gazebo discovery: auto_bridge", timeout=30)
+    text_publisher = probe.run(lambda: probe.node.create_publisher(String, cmd_vel, 10))
+    # A subscriber that tells its type: Zenoh tokens always do. (Our ZeroMQ node's heartbeats
+    # look like gz-transport 11/12's, so the bridge does not ask it for its subscriptions.)
+    spec = {"echo": [[cmd_vel, "gz.msgs.Twist"]], "seconds": 60}
+    gazebo = start_process(
+        [sys.executable, str(GAZEBO_SIDE), json.dumps(spec)], zenoh_env("peer", [], [endpoint])
+    )
+    started.append(gazebo)
+    wait_for_line(gazebo, r"^READY", timeout=30)
+    wait_for_line(
+        bridge,
+        rf"Gazebo {cmd_vel}: the ROS publishers of {cmd_vel[1:]} use std_msgs/msg/String, which "
+        r"does not pair with gz\.msgs\.Twist, the type its Gazebo subscribers take: the bridge "
+        r"follows the Gazebo type \(geometry_msgs/msg/Twist <-> gz\.msgs\.Twist\)",
+        timeout=30,
+    )
+    wait_for_line(
+        bridge,
+        r"uses std_msgs/msg/String, but the bridge took geometry_msgs/msg/Twist from discovery "
+        r"\(typed Gazebo subscriber\); std_msgs/msg/String does not pair with gz\.msgs\.Twist",
+        timeout=30,
+    )
+    probe.destroy(text_publisher)
+    publish = twist_publisher(probe, cmd_vel, 2.5)
+    publish_until(publish, echoed(gazebo, r"MSG gz\.msgs\.Twist linear \{ x: 2\.5 \}"), "echoed")
+
+
+def test_a_fortress_subscriber_older_than_the_bridge_shows_only_when_its_type_is_announced(
+    started: list[PeerProcess],
+) -> None:
+    require_peer()
+    topic = f"{unique_name('old')}/cmd_vel"
+    peer = start_peer("echo", topic, "ignition.msgs.Twist", "60")
+    started.append(peer)
+    wait_for_line(peer, r"^READY", timeout=30)
+    with create_gz_node() as gz_node:  # a bridge that starts after the subscription
+
+        def subscribers() -> list[str]:
+            return [e.msg_type for e in gz_node.observe(topic) if e.role == SUBSCRIBER]
+
+        # a publisher started later is heard; the older subscription is never re-announced
+        witness = f"{topic}_witness"
+        started.append(
+            start_peer("pub", witness, "ignition.msgs.Twist", "10", "0", "", "--wait", "0")
+        )
+        wait_until(lambda: bool(gz_node.topic_info(witness)), WAIT, "the witness publisher")
+        assert subscribers() == []
+        publisher = gz_node.advertise(topic, "gz.msgs.Twist")  # both spellings announced
+        wait_until(lambda: subscribers() == ["ignition.msgs.Twist"], WAIT, "it takes ours")
+        publisher.close()
+
+
+def test_check_with_auto_bridge_checks_the_inferred_entry_and_names_its_rule(
+    probe: RosSide, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    stem = unique_name("cinfer")
+    cmd_vel = f"{stem}/model/robot1/cmd_vel"
+    check = start_process(
+        [str(PARAMETER_BRIDGE), "--check", "6", "--ros-args",
+         "-p", "auto_bridge:=true", "-p", f"auto_bridge_allow:=[^{stem}/]"]
+    )  # fmt: skip
+    started.append(check)
+    wait_for_line(check, r"^Listening for 6 s", timeout=30)
+    started.append(start_peer("echo", cmd_vel, "ignition.msgs.Twist", "60"))
+    twist_publisher(probe, cmd_vel, 1.0)
+    assert check.wait(30) == 0, check.output()
+    title = (
+        f"ROS {cmd_vel} (geometry_msgs/msg/Twist) -> Gazebo {cmd_vel} (ignition.msgs.Twist) "
+        "(auto_bridge, discovered: inferred from the ROS publisher's type)"
+    )
+    report = check.output().split(title, 1)[1]
+    assert "Gazebo: subscriber (ignition.msgs.Twist, takes ours)" in report
+    assert "ok: messages can flow" in report

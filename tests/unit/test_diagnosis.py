@@ -127,3 +127,30 @@ def test_ros_endpoints_of_another_type_or_qos_are_named_even_while_flowing() -> 
     assert "uses geometry_msgs/msg/PoseStamped, but the bridge is configured with " in found[0].text
     assert "ERROR: Best effort publisher" in found[1].text
     assert flow(flowing) is Flow.FLOWING
+
+
+def test_a_discovered_bridge_names_the_rule_that_chose_its_types() -> None:
+    discovered = situation(
+        Direction.ROS_TO_GZ,
+        ros_topic="/cmd_vel",
+        ros_type="geometry_msgs/msg/Twist",
+        gz_topic="/cmd_vel",
+        gz_type="gz.msgs.Twist",
+        gz_subscriber_registered=True,
+        ros_endpoints=[
+            RosEndpoint("/teleop", "std_msgs/msg/String"),
+            RosEndpoint("/planner", "geometry_msgs/msg/TwistStamped"),
+        ],
+        discovered_by="typed Gazebo subscriber",
+    )
+    found = findings(discovered, HINTS)
+    assert keys(found) == [
+        "ros-type:/teleop:std_msgs/msg/String",
+        "ros-type:/planner:geometry_msgs/msg/TwistStamped",
+    ]
+    assert (
+        "uses std_msgs/msg/String, but the bridge took geometry_msgs/msg/Twist from discovery "
+        "(typed Gazebo subscriber); std_msgs/msg/String does not pair with gz.msgs.Twist, "
+        "which the Gazebo side takes: use geometry_msgs/msg/Twist in ROS"
+    ) in found[0].text
+    assert "TwistStamped also pairs with gz.msgs.Twist: write an entry with" in found[1].text

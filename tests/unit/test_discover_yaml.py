@@ -10,6 +10,7 @@ import pytest
 from ros_gz_bridge_py.app.discover import header_lines, write_yaml
 from ros_gz_bridge_py.app.parameter_bridge import DISCOVER_OPTION, split_seconds_option
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec, UsageError, parse_yaml
+from ros_gz_bridge_py.core.discovery_plan import AUTO_SOURCE, BY_ROS_PUBLISHER
 
 SPECS = [
     TopicBridgeSpec(
@@ -41,6 +42,28 @@ def test_the_yaml_reads_back_as_the_same_bridges_with_hints() -> None:
     assert "# /clock: rclcpp's time source subscribes best effort" in text
     assert "# a sensor stream: max_rate: <Hz>" in text
     assert text.startswith("# Written by parameter_bridge --discover 3: 3 Gazebo topics")
+
+
+def test_entries_inferred_from_the_ros_publisher_say_so() -> None:
+    inferred = TopicBridgeSpec(
+        "model/robot1/cmd_vel", "/model/robot1/cmd_vel", "geometry_msgs/msg/Twist",
+        "ignition.msgs.Twist", Direction.ROS_TO_GZ, lazy=True, source=AUTO_SOURCE,
+        discovered_by=BY_ROS_PUBLISHER,
+    )  # fmt: skip
+    specs = [SPECS[0], inferred]
+    out = io.StringIO()
+    write_yaml(specs, header_lines(3.0, "ZeroMQ discovery on ...", 2, specs), out)
+    text = out.getvalue()
+    assert "# 1 entries (marked 'inferred') take their types from the ROS publisher" in text
+    comment = "# inferred: /model/robot1/cmd_vel's Gazebo subscribers tell no type"
+    assert text.count("# inferred:") == 1
+    after = text.split(comment, 1)[1]
+    assert after.split("\n")[1] == '- ros_topic_name: "model/robot1/cmd_vel"'
+    read = parse_yaml(text, "discovered.yaml").specs[1]
+    assert isinstance(read, TopicBridgeSpec)
+    assert (read.ros_type, read.gz_type, read.direction) == (
+        "geometry_msgs/msg/Twist", "gz.msgs.Twist", Direction.ROS_TO_GZ
+    )  # fmt: skip
 
 
 def test_nothing_discovered_is_an_empty_list() -> None:
