@@ -27,8 +27,8 @@ from benchmarks import (
     images,
     memory,
     small_messages,
-    starvation,
     startup,
+    starvation,
     sustained,
     transport,
 )
