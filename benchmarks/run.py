@@ -22,10 +22,12 @@ from benchmarks import (
     conversion,
     costs,
     discovery,
+    first_call,
     headline,
     images,
     memory,
     small_messages,
+    startup,
     starvation,
     sustained,
     transport,
@@ -55,6 +57,8 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
         "discovery": lambda: discovery.main(
             ["--idle", "5" if quick else "10"] + (["--counts", "10", "100"] if quick else [])
         ),
+        "startup": lambda: startup.main(["--rounds", "3" if quick else "5"]),
+        "first_call": lambda: first_call.main(["--runs", "5" if quick else "10"]),
         "memory": lambda: memory.main(
             ["--flood-seconds", "15" if quick else "60", "--slow-seconds", "8" if quick else "15"]
         ),

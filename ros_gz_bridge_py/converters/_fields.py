@@ -19,8 +19,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros.constructors import constructor
@@ -130,7 +128,10 @@ def repeated(read: Callable[[Any], Any]) -> Fill:
 
 def numbers(typecode: str) -> Fill:
     """:func:`repeated` for a ROS ``array(typecode)``; numpy reads the gz repeated field as one
-    buffer (~300x faster than iterating it)."""
+    buffer (~300x faster than iterating it). numpy is imported by the modules that declare
+    such a list, not by every converter module."""
+    import numpy as np  # noqa: PLC0415
+
     return repeated(lambda values: array(typecode, np.asarray(values, dtype=typecode).tobytes()))
 
 

@@ -8,6 +8,13 @@ package (see :func:`modules_of`; those that declare neither are helpers and add 
 then every module registered under the entry-point group ``ros_gz_bridge_py.converters``, and
 indexes their pairs by (ROS type, Gazebo type).
 
+The process-wide registry (:func:`default_registry`) imports them on demand: a module of
+this package is named after the ROS package of every type it pairs (a test checks it), so a
+lookup of one pair first imports that package's module only; a lookup it does not answer, and
+every listing, imports the rest (plugins too) and gives what importing everything at once
+gives. A bridge of a few topics thus imports the converters, ROS message packages and numpy
+it uses, not all of them.
+
 Gazebo type names are accepted as ``gz.msgs.X`` or ``ignition.msgs.X``. An exact registration
 wins (``ignition.msgs.IMU`` has its own, Fortress wire layout); otherwise the name is
 normalised to ``gz.msgs.X``. The default Gazebo type for a ROS type is the first pair declared
@@ -24,9 +31,9 @@ import functools
 import importlib
 import itertools
 import pkgutil
+import threading
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
-from importlib.metadata import entry_points
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
@@ -104,16 +111,76 @@ class ServicePair:
     origin: str = field(default="", compare=False)
 
 
+#: A converter module's name and the call that imports it.
+ModuleSource = tuple[str, Callable[[], ModuleType]]
+
+
 @dataclass
 class Registry:
-    """All known pairs, indexed for lookup. Registering a duplicate pair raises."""
+    """All known pairs, indexed for lookup. Registering a duplicate pair raises.
 
-    pairs: list[Pair] = field(default_factory=list)
-    services: list[ServicePair] = field(default_factory=list)
-    #: Modules that could not be imported (e.g. an interface package not built): name -> reason.
-    unavailable: dict[str, str] = field(default_factory=dict)
-    _by_key: dict[tuple[str, str], Pair] = field(default_factory=dict, repr=False)
-    _services_by_type: dict[str, ServicePair] = field(default_factory=dict, repr=False)
+    A registry made by :func:`lazy_registry` holds the modules it has not imported yet:
+    :meth:`find` and :meth:`get_service` import the module of the type's ROS package first,
+    and everything else imports them all (:meth:`complete`).
+    """
+
+    _pairs: list[Pair] = field(default_factory=list, init=False)
+    _services: list[ServicePair] = field(default_factory=list, init=False)
+    _unavailable: dict[str, str] = field(default_factory=dict, init=False)
+    _by_key: dict[tuple[str, str], Pair] = field(default_factory=dict, init=False, repr=False)
+    _services_by_type: dict[str, ServicePair] = field(default_factory=dict, init=False, repr=False)
+    #: While some modules are not imported (a lazy registry): every module in reading order.
+    _sources: Callable[[], Iterable[ModuleSource]] | None = field(
+        default=None, init=False, repr=False
+    )
+    #: The modules a lookup may import alone, by ROS package, until it does.
+    _by_package: dict[str, Callable[[], ModuleType]] = field(
+        default_factory=dict, init=False, repr=False
+    )
+    _lock: threading.Lock = field(
+        default_factory=threading.Lock, init=False, repr=False, compare=False
+    )
+
+    @property
+    def pairs(self) -> list[Pair]:
+        self.complete()
+        return self._pairs
+
+    @property
+    def services(self) -> list[ServicePair]:
+        self.complete()
+        return self._services
+
+    @property
+    def unavailable(self) -> dict[str, str]:
+        """Modules that could not be imported (e.g. an interface package not built): name ->
+        reason."""
+        self.complete()
+        return self._unavailable
+
+    def complete(self) -> None:
+        """Import every module not imported yet; the pairs are then listed in reading order
+        (modules by name, then plugins), as if all had been imported at once."""
+        with self._lock:
+            if self._sources is None:
+                return
+            full = Registry()
+            for name, load in self._sources():  # those imported already are read again
+                full.read(name, load)
+            # Each index is replaced whole: a lookup meanwhile sees the old or the new one.
+            self._by_key = {(pair.ros_type, pair.gz_type): pair for pair in full.pairs}
+            self._services_by_type = {service.ros_type: service for service in full.services}
+            self._pairs, self._services = full.pairs, full.services
+            self._unavailable = full.unavailable
+            self._by_package = {}
+            self._sources = None
+
+    def _import_package(self, ros_type: str) -> None:
+        """Import the module of ``ros_type``'s ROS package, if it is one not imported yet."""
+        with self._lock:
+            load = self._by_package.pop(ros_type.partition("/")[0], None)
+            if load is not None:
+                self.read(ros_type.partition("/")[0], load)
 
     def add(self, pair: Pair) -> None:
         key = (pair.ros_type, pair.gz_type)
@@ -121,14 +188,36 @@ class Registry:
             msg = f"pair {pair.ros_type} <-> {pair.gz_type} registered twice ({pair.origin})"
             raise BridgeError(msg)
         self._by_key[key] = pair
-        self.pairs.append(pair)
+        self._pairs.append(pair)
 
     def add_service(self, pair: ServicePair) -> None:
         if pair.ros_type in self._services_by_type:
             msg = f"service {pair.ros_type} registered twice ({pair.origin})"
             raise BridgeError(msg)
         self._services_by_type[pair.ros_type] = pair
-        self.services.append(pair)
+        self._services.append(pair)
+
+    @classmethod
+    def lazy(
+        cls, sources: Callable[[], Iterable[ModuleSource]], alone: Iterable[ModuleSource]
+    ) -> Registry:
+        """A registry of every module ``sources`` gives, in its order, that imports a module of
+        ``alone`` (named after a ROS package) by itself when a lookup of that package needs it.
+        """
+        registry = cls()
+        registry._sources = sources
+        registry._by_package = dict(alone)
+        return registry
+
+    def read(self, name: str, load: Callable[[], ModuleType]) -> None:
+        """Import a module and add its pairs; one that fails to import is recorded in
+        :attr:`unavailable`."""
+        try:
+            module = load()
+        except ImportError as err:
+            self._unavailable[name] = str(err)
+            return
+        self.add_module(module, name)
 
     def add_module(self, module: ModuleType, origin: str) -> None:
         for pair in getattr(module, "PAIRS", ()):
@@ -138,6 +227,14 @@ class Registry:
 
     def find(self, ros_type: str, gz_type: str) -> Pair | None:
         """The pair for exactly these names, accepting both Gazebo prefixes."""
+        self._import_package(ros_type)
+        pair = self._lookup(ros_type, gz_type)
+        if pair is None and self._sources is not None:
+            self.complete()
+            pair = self._lookup(ros_type, gz_type)
+        return pair
+
+    def _lookup(self, ros_type: str, gz_type: str) -> Pair | None:
         pair = self._by_key.get((ros_type, gz_type))
         if pair is None:
             pair = self._by_key.get((ros_type, canonical_type(gz_type)))
@@ -167,7 +264,11 @@ class Registry:
         return layouts
 
     def get_service(self, ros_type: str) -> ServicePair:
+        self._import_package(ros_type)
         service = self._services_by_type.get(ros_type)
+        if service is None and self._sources is not None:
+            self.complete()
+            service = self._services_by_type.get(ros_type)
         if service is not None:
             return service
         known = ", ".join(sorted(self._services_by_type)) or "none"
@@ -175,6 +276,7 @@ class Registry:
         raise UnsupportedTypeError(msg)
 
     def gz_types_for(self, ros_type: str) -> list[str]:
+        """The Gazebo types paired with ``ros_type``, its default first."""
         return [p.gz_type for p in self.pairs if p.ros_type == ros_type]
 
     def ros_types_for(self, gz_type: str) -> list[str]:
@@ -217,7 +319,7 @@ def _with_origin(item: Any, origin: str) -> Any:
     return item if item.origin else dataclasses.replace(item, origin=origin)
 
 
-def modules_of(package: str) -> list[tuple[str, Callable[[], ModuleType]]]:
+def modules_of(package: str) -> list[ModuleSource]:
     """The public modules of ``package``, by name, each with the call that imports it.
 
     Which of them are converter modules is known once imported: those that declare ``PAIRS``
@@ -233,14 +335,14 @@ def modules_of(package: str) -> list[tuple[str, Callable[[], ModuleType]]]:
     ]
 
 
-def _plugin_modules() -> Iterator[tuple[str, Callable[[], ModuleType]]]:
+def _plugin_modules() -> Iterator[ModuleSource]:
+    from importlib.metadata import entry_points  # noqa: PLC0415 - read only when completing
+
     for ep in entry_points(group=ENTRY_POINT_GROUP):
         yield ep.name, ep.load
 
 
-def build_registry(
-    modules: Iterable[tuple[str, Callable[[], ModuleType]]] | None = None,
-) -> Registry:
+def build_registry(modules: Iterable[ModuleSource] | None = None) -> Registry:
     """Import ``modules`` (by default this package's, then the plugins) and index their pairs.
 
     A module that fails to import (its ROS interface package is not installed) is recorded in
@@ -250,21 +352,27 @@ def build_registry(
         modules = itertools.chain(modules_of(_PACKAGE), _plugin_modules())
     registry = Registry()
     for name, load in modules:
-        try:
-            module = load()
-        except ImportError as err:
-            registry.unavailable[name] = str(err)
-            continue
-        registry.add_module(module, name)
+        registry.read(name, load)
     return registry
+
+
+def lazy_registry(modules: Iterable[ModuleSource] | None = None) -> Registry:
+    """A registry of ``modules`` (by default this package's, then the plugins) that imports
+    each when a lookup needs it (see :class:`Registry`); it answers as :func:`build_registry`.
+    """
+    if modules is None:
+        local = modules_of(_PACKAGE)
+        return Registry.lazy(lambda: itertools.chain(local, _plugin_modules()), local)
+    given = list(modules)
+    return Registry.lazy(lambda: given, given)
 
 
 _DEFAULT: Registry | None = None
 
 
 def default_registry() -> Registry:
-    """The process-wide registry, built on first use."""
+    """The process-wide registry (:func:`lazy_registry`), made on first use."""
     global _DEFAULT  # noqa: PLW0603 - a lazily built process-wide cache
     if _DEFAULT is None:
-        _DEFAULT = build_registry()
+        _DEFAULT = lazy_registry()
     return _DEFAULT

@@ -32,8 +32,6 @@ from array import array
 from collections.abc import Callable
 from typing import Any
 
-import numpy as np
-
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
 #: Serializes one message to CDR bytes (with the encapsulation header).
@@ -74,7 +72,8 @@ def numeric_block(values: Any, code: str, count: int | None) -> bytes:
         raise ValueError(msg)
     if isinstance(values, (bytes, bytearray)) and code in "Bc":
         return bytes(values)
-    if isinstance(values, np.ndarray):
+    np = sys.modules.get("numpy")  # an ndarray exists only once numpy is imported
+    if np is not None and isinstance(values, np.ndarray):
         if values.dtype != np.dtype(code) and values.dtype.kind != np.dtype(code).kind:
             msg = f"numpy array of {values.dtype} where {np.dtype(code)} is declared"
             raise ValueError(msg)

@@ -18,11 +18,10 @@ whose defaults are not all values it knows how to copy (or whose result would no
 
 from __future__ import annotations
 
+import sys
 from array import array
 from collections.abc import Callable
 from typing import Any
-
-import numpy as np
 
 #: Default values stored as they are (immutable).
 _IMMUTABLE = (bool, int, float, str, bytes, type(None))
@@ -73,7 +72,8 @@ def _copy_expression(value: Any, name: str, namespace: dict[str, Any]) -> str:
     """Python making a fresh copy of the default ``value`` (held in ``namespace[name]``)."""
     if isinstance(value, _IMMUTABLE):
         return name
-    if isinstance(value, np.ndarray):
+    np = sys.modules.get("numpy")  # an ndarray exists only once numpy is imported
+    if np is not None and isinstance(value, np.ndarray):
         return f"{name}.copy()"
     if is_message_class(type(value)):
         namespace[name] = constructor(type(value))

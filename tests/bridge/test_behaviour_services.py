@@ -290,3 +290,31 @@ def test_a_storm_with_gazebo_is_served_in_full(
     assert sorted(answers) == list(range(STORM)), f"unanswered: {STORM - len(answers)}"
     assert all(len(got) == 1 for got in answers.values()), answers
     assert {ok for ((_, ok),) in answers.values()} == {True}
+
+
+def test_a_first_call_made_the_moment_the_service_is_discoverable_is_answered(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    """A fresh bridge, a client already waiting: its one call, made as soon as the service is
+    ready, reaches the Fortress service once and is answered (issue 23: a first request or reply
+    lost would be answered only after Fast DDS resends it, or not at all)."""
+    service = unique_name("svc_first_call")
+    peer = start_replier(started, service, WORLD_CONTROL)
+    client = ros_side.run(lambda: ros_side.node.create_client(ControlWorld, service))
+    entry = f"{service}@ros_gz_interfaces/srv/ControlWorld@{WORLD_CONTROL}@{BOOLEAN}"
+    started.append(start_bridge(entry))
+    try:
+        deadline = time.monotonic() + WAIT
+        while not client.service_is_ready():
+            assert time.monotonic() < deadline, f"service {service} never appeared"
+            time.sleep(0.001)
+        future = ros_side.run(lambda: client.call_async(control_request()))
+        while not future.done():
+            assert time.monotonic() < deadline + WAIT, f"no response from {service}"
+            time.sleep(0.01)
+    finally:
+        ros_side.destroy(client)
+    assert future.result().success
+    requests = [line for line in peer.output().splitlines() if line.startswith("REQUEST")]
+    assert len(requests) == 1  # sent to Gazebo once: no retry
+    assert "multi_step: 7" in requests[0]

@@ -53,3 +53,9 @@ def test_bridge_types_lists_the_plugin_pair(capsys: pytest.CaptureFixture[str]) 
 
 def test_without_the_plugin_the_pair_is_absent() -> None:
     assert registry.build_registry().find("std_msgs/msg/UInt8MultiArray", "gz.msgs.Bytes") is None
+
+
+@pytest.mark.usefixtures("installed_plugin")
+def test_a_lazy_registry_finds_the_plugin_pair_of_a_package_it_has_a_module_for() -> None:
+    pair = registry.lazy_registry().get("std_msgs/msg/UInt8MultiArray", "gz.msgs.Bytes")
+    assert pair.origin == "ros_gz_bytes_plugin"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import sys
 from collections import defaultdict
 from collections.abc import Iterator
@@ -141,3 +142,44 @@ def test_a_missing_interface_package_is_recorded_and_the_rest_keeps_working(
     assert found.ros_types_for("gz.msgs.NavSat") == ["sensor_msgs/msg/NavSatFix"]
     with pytest.raises(UnsupportedTypeError, match="converters for gps_msgs could not load"):
         found.get("gps_msgs/msg/GPSFix", "gz.msgs.NavSat")
+
+
+def test_every_pair_is_in_the_module_of_its_ros_package() -> None:
+    """What lets a lookup import only the module of the type's package (``lazy_registry``)."""
+    found = build_registry(modules_of(CONVERTERS))
+    declared = [(p.ros_type, p.origin) for p in found.pairs]
+    declared += [(s.ros_type, s.origin) for s in found.services]
+    for ros_type, origin in declared:
+        assert ros_type.partition("/")[0] == origin, ros_type
+
+
+def test_a_lookup_imports_only_its_package_module(fake_package: str) -> None:
+    folder = Path(importlib.import_module(fake_package).__path__[0])
+    (folder / "c_msgs.py").write_text("PAIRS = ()\n")
+    lazy = registry.lazy_registry(modules_of(fake_package))
+    assert lazy.find("b_msgs/msg/Bool", "gz.msgs.Boolean") is not None
+    assert f"{fake_package}.c_msgs" not in sys.modules
+    assert lazy.find("b_msgs/msg/Bool", "gz.msgs.Nothing") is None  # a miss reads them all
+    assert list(lazy.unavailable) == ["a_msgs"]
+
+
+def test_a_lazy_registry_answers_as_one_that_imported_everything() -> None:
+    full = build_registry(modules_of(CONVERTERS))
+    lazy = registry.lazy_registry(modules_of(CONVERTERS))
+    for pair in full.pairs:
+        assert lazy.find(pair.ros_type, pair.gz_type) == pair
+    for service in full.services:
+        assert lazy.get_service(service.ros_type) == service
+    assert lazy.pairs == full.pairs
+    assert lazy.services == full.services
+    for pair in full.pairs:
+        assert lazy.ros_types_for(pair.gz_type) == full.ros_types_for(pair.gz_type)
+        assert lazy.gz_types_for(pair.ros_type) == full.gz_types_for(pair.ros_type)
+
+
+def test_listing_a_lazy_registry_keeps_the_reading_order() -> None:
+    """Pairs imported by a lookup first are still listed where their module's name puts them."""
+    lazy = registry.lazy_registry(modules_of(CONVERTERS))
+    lazy.get("vision_msgs/msg/Detection2D", "gz.msgs.AnnotatedAxisAligned2DBox")
+    origins = [p.origin for p in lazy.pairs]
+    assert list(dict.fromkeys(origins)) == sorted(set(origins))

@@ -1,0 +1,169 @@
+"""Start-up (issue 23): from the bridge process's start to its first and last ``Creating`` line.
+
+Usage: ``.venv/bin/python -m benchmarks.startup [--counts 1 8 66] [--rounds 5] [--hz 50]``.
+
+Per count N: ``parameter_bridge`` with N inline entries ``/t<i>@std_msgs/msg/String@
+gz.msgs.StringMsg`` (both directions, as in the issue), started ``--rounds`` times without
+traffic, then as often while the C++ peer on Ignition Transport 11 (``tests/peer``, mode pub,
+one process per topic) already publishes on every one of those Gazebo topics at ``--hz``. The
+times come from the bridge's own log (``{time}`` of rcutils, wall clock) minus the wall clock
+just before the process was started: imports, rclpy init, node, settings, Gazebo discovery
+start and the channels. Beside them, the floor of any rclpy process: a script that imports
+rclpy, makes a node and one String publisher and logs one line, timed the same way. The
+bridge's modules are byte-compiled first (this environment sets PYTHONDONTWRITEBYTECODE, and an
+installed package has its bytecode).
+"""
+
+from __future__ import annotations
+
+import argparse
+import compileall
+import os
+import re
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from benchmarks.harness import BIN, ROOT, bench_env, topic_name
+from benchmarks.report import write_section
+from tests.gzpeer import start_peer, stop_processes, wait_for_line
+
+#: What the issue measured for the C++ bridge (three inline entries, last ``Creating`` line).
+QUOTED_CPP_S = 0.15
+#: The bridge's log lines with rcutils' wall-clock time first.
+LOG_FORMAT = "{time} {message}"
+CREATING = re.compile(r"^(\d+\.\d+) Creating ")
+#: The environment that makes a bridge print its ``Creating`` lines in that format.
+LOG_ENV = {
+    "RCUTILS_LOGGING_SEVERITY_THRESHOLD": "INFO",
+    "RCUTILS_CONSOLE_OUTPUT_FORMAT": LOG_FORMAT,
+}
+#: A process that only does what every rclpy node must before it publishes.
+FLOOR_SCRIPT = (
+    "import rclpy\n"
+    "from rclpy.node import Node\n"
+    "from std_msgs.msg import String\n"
+    "rclpy.init()\n"
+    "node = Node('startup_floor')\n"
+    "node.create_publisher(String, '/startup_floor', 10)\n"
+    "node.get_logger().info('Creating a publisher')\n"
+)
+TIMEOUT = 60.0
+
+
+@dataclass(frozen=True)
+class Row:
+    label: str
+    first_s: tuple[float, ...]
+    last_s: tuple[float, ...]
+
+
+def creating_times(command: Sequence[str], count: int) -> tuple[float, float]:
+    """Seconds from the start of ``command`` to its first and its ``count``-th ``Creating``
+    line; the process is then stopped."""
+    env = bench_env() | LOG_ENV
+    started = time.time()
+    proc = subprocess.Popen(
+        list(command), env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
+    assert proc.stdout is not None
+    stamps: list[float] = []
+    deadline = time.monotonic() + TIMEOUT
+    try:
+        for line in proc.stdout:
+            if match := CREATING.match(line):
+                stamps.append(float(match.group(1)) - started)
+                if len(stamps) == count:
+                    return stamps[0], stamps[-1]
+            if time.monotonic() > deadline:
+                break
+        msg = f"{len(stamps)} of {count} Creating lines from {command[0]}"
+        raise RuntimeError(msg)
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def bridge_rounds(count: int, rounds: int, hz: float | None) -> Row:
+    """``rounds`` start-ups of a bridge of ``count`` entries; with ``hz``, while the C++ peer
+    publishes on each of its Gazebo topics."""
+    topics = [topic_name(f"startup{count}_{i}") for i in range(count)]
+    command = [str(BIN / "parameter_bridge")]
+    command += [f"{topic}@std_msgs/msg/String@gz.msgs.StringMsg" for topic in topics]
+    try:
+        if hz is not None:
+            publish = ["ignition.msgs.StringMsg", str(hz), "0", 'data: "flowing"', "--wait", "0"]
+            peers = [start_peer("pub", topic, *publish, env=bench_env()) for topic in topics]
+            for peer in peers:
+                wait_for_line(peer, "^READY", timeout=30)
+            time.sleep(1.0)  # flowing before the bridge starts
+        times = [creating_times(command, 2 * count) for _ in range(rounds)]
+    finally:
+        stop_processes()
+    label = f"{count} {'entry' if count == 1 else 'entries'}"
+    label += f", {count} Gazebo publishers at {hz:g} Hz" if hz is not None else ", no traffic"
+    return Row(label, tuple(t[0] for t in times), tuple(t[1] for t in times))
+
+
+def floor_rounds(rounds: int) -> Row:
+    times = [creating_times([sys.executable, "-c", FLOOR_SCRIPT], 1) for _ in range(rounds)]
+    return Row("rclpy floor: a node and one publisher", tuple(t[0] for t in times), ())
+
+
+def _cell(values: tuple[float, ...]) -> str:
+    if not values:
+        return "-"
+    return f"{statistics.median(values):.3f} ({min(values):.3f}-{max(values):.3f})"
+
+
+def report(rows: Sequence[Row], args: argparse.Namespace, load: float) -> str:
+    lines = [
+        "## Start-up (issue 23)",
+        "",
+        f"Command: `.venv/bin/python -m benchmarks.startup --counts "
+        f"{' '.join(map(str, args.counts))} --rounds {args.rounds} --hz {args.hz:g}`",
+        "",
+        "Seconds from the start of the `parameter_bridge` process to its first and its last "
+        "`Creating` line (median of the rounds, range in brackets). N inline entries "
+        "`/t<i>@std_msgs/msg/String@gz.msgs.StringMsg`, both directions, so 2N lines. "
+        "*With traffic*: the C++ peer on Ignition Transport 11 (one `pub` process per topic) "
+        "publishes on every Gazebo topic from 1 s before the bridge starts. The rclpy floor is "
+        "a script that only imports rclpy, makes a node and one publisher and logs: what any "
+        f"rclpy process spends first. The C++ bridge: {QUOTED_CPP_S:g} s to its last line with 3 "
+        "entries (quoted from issue 23, measured elsewhere). Bytecode compiled beforehand. "
+        f"1-minute load average before the run: {load:.2f} (the machine, 2 cores, is shared).",
+        "",
+        "| bridge | first `Creating` s | last `Creating` s |",
+        "|---|---|---|",
+    ]
+    lines += [f"| {row.label} | {_cell(row.first_s)} | {_cell(row.last_s)} |" for row in rows]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--counts", type=int, nargs="+", default=[1, 8, 66])
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--hz", type=float, default=50.0)
+    args = parser.parse_args(argv)
+    compileall.compile_dir(ROOT / "ros_gz_bridge_py", quiet=1)
+    load = os.getloadavg()[0]
+    rows = [floor_rounds(args.rounds)]
+    for hz in (None, args.hz):
+        for count in args.counts:
+            print(f"== {count} entries, hz {hz}", file=sys.stderr, flush=True)
+            rows.append(bridge_rounds(count, args.rounds, hz))
+            print(rows[-1], file=sys.stderr, flush=True)
+    write_section("startup", report(rows, args, load))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
