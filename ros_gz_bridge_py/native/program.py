@@ -14,6 +14,7 @@ the program cannot write) makes the pair :class:`NotExpressible`: it stays on th
 from __future__ import annotations
 
 import struct
+import sys
 from array import array
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
@@ -23,8 +24,6 @@ from ros_gz_bridge_py.converters._fields import Each, Fill, Table, Value, declar
 from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time, to_int32, to_uint32
 from ros_gz_bridge_py.converters.geometry_msgs import fill_ros_covariance
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.converters.rosgraph_msgs import clock_to_ros
-from ros_gz_bridge_py.converters.sensor_msgs import joint_state_to_ros
 from ros_gz_bridge_py.converters.std_msgs import (
     CHILD_FRAME_ID_KEY,
     FRAME_ID_KEY,
@@ -171,11 +170,21 @@ def _clock(out: Assignments) -> None:
     out[("clock", "nanosec")] = ClockPart(("sim",), 1)
 
 
-#: Whole hand-written converters, by their ``to_ros``.
-_WHOLE: dict[Callable[[Any], Any], Callable[[Assignments], None]] = {
-    clock_to_ros: _clock,
-    joint_state_to_ros: _joint_state,
+#: Whole hand-written converters, by the module and name of their ``to_ros`` (named, not
+#: imported: the registry imports a converter module only when a pair of it is used).
+_WHOLE: dict[tuple[str, str], Callable[[Assignments], None]] = {
+    ("ros_gz_bridge_py.converters.rosgraph_msgs", "clock_to_ros"): _clock,
+    ("ros_gz_bridge_py.converters.sensor_msgs", "joint_state_to_ros"): _joint_state,
 }
+
+
+def _whole(to_ros: Callable[[Any], Any]) -> Callable[[Assignments], None] | None:
+    """The assignments of a whole hand-written converter, if ``to_ros`` is one of them."""
+    key = (getattr(to_ros, "__module__", ""), getattr(to_ros, "__qualname__", ""))
+    module = sys.modules.get(key[0])
+    if key not in _WHOLE or getattr(module, key[1], None) is not to_ros:
+        return None
+    return _WHOLE[key]
 
 
 def assignments_of(fill: Fill, ros: Path = (), gz: Path = ()) -> Assignments:
@@ -455,8 +464,8 @@ def compile_to_ros(pair: Pair) -> Compiled:
         fill, new_ros = declared
         _assign(fill, (), (), given)
         default = new_ros()
-    elif pair.to_ros in _WHOLE:
-        _WHOLE[pair.to_ros](given)
+    elif (whole := _whole(pair.to_ros)) is not None:
+        whole(given)
         default = pair.ros_class()
     else:
         msg = f"a hand-written converter ({pair.to_ros.__qualname__})"
