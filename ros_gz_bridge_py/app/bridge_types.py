@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from typing import TextIO
 
 from ros_gz_bridge_py.converters.registry import Registry, build_registry
+from ros_gz_bridge_py.native.program import expressible
 
 USAGE = """\
 usage: bridge_types [OPTION [TYPE]]
@@ -51,9 +52,17 @@ def _print_pairs(registry: Registry, out: TextIO) -> None:
 
 
 def _as_json(registry: Registry) -> str:
+    why_python = expressible(registry.pairs)
     document = {
         "pairs": [
-            {"ros_type": p.ros_type, "gz_type": p.gz_type, "origin": p.origin}
+            {
+                "ros_type": p.ros_type,
+                "gz_type": p.gz_type,
+                "origin": p.origin,
+                # Gazebo -> ROS through a native program (docs/native.md), or why not.
+                "native": not why_python[(p.ros_type, p.gz_type)],
+                "python_because": why_python[(p.ros_type, p.gz_type)],
+            }
             for p in registry.pairs
         ],
         "services": [

@@ -92,6 +92,13 @@ class ChannelStatus:
     errors_by_reason: tuple[tuple[str, int], ...] = ()
     #: Of ``errors``, those the converter refused (the rest the transport did).
     conversion_errors: int = 0
+    #: Whether the channel's messages take the native data plane (docs/native.md).
+    native: bool = False
+
+    @property
+    def path(self) -> str:
+        """``native`` or ``python``: how the channel's messages travel."""
+        return "native" if self.native else "python"
 
     def error_summary(self) -> str:
         """``"3 undecodable payload, 1 wrong type"`` ("" without errors)."""
@@ -146,6 +153,7 @@ class ChannelStatus:
             "last_error": self.last_error,
             "flow": self.flow,
             "why": self.why,
+            "path": self.path,
         }
 
 
@@ -216,6 +224,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
             sorted(dict(stats.errors_by_reason).items(), key=lambda item: (-item[1], item[0]))
         ),
         conversion_errors=stats.conversion_errors,
+        native=isinstance(channel, GzToRosChannel) and channel.native,
     )
 
 
@@ -266,6 +275,7 @@ _COLUMNS = (
     ("LIMITED", lambda s: str(s.rate_limited)),
     ("RATE/s", lambda s: f"{s.rate:.1f}"),
     ("FLOW", lambda s: s.flow),
+    ("PATH", lambda s: s.path),
 )
 
 

@@ -141,8 +141,11 @@ static int read_field(struct view v, size_t *pos, struct field *f) {
     }
     case WIRE_LEN: {
         uint64_t length;
+        size_t at = *pos;
         status = read_varint(v, pos, &length);
         if (status) return status;
+        /* The runtime (upb) refuses a length of more than 5 bytes, as it does a tag. */
+        if (*pos - at > 5) return RGB_FALLBACK;
         if (length > v.n - *pos) return RGB_UNDECODABLE;
         f->payload.p = v.p + *pos;
         f->payload.n = (size_t)length;

@@ -13,6 +13,7 @@ direction must not cross.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -90,17 +91,19 @@ def _ros_arrived(checker: RosChecker, line: str, entry: ConfigEntry) -> bool:
     return any(not mismatches(expected, msg) for msg in checker.messages(entry.ros_topic))
 
 
-def start_config_run(name: str, line: str) -> ConfigRun:
+def start_config_run(name: str, line: str, *, native: bool = True) -> ConfigRun:
     """The bridge with Gazebo publishers, echoes and a ROS checker, after the Gazebo->ROS phase.
 
     ROS publishers of the ROS->Gazebo entries start later, in their own test, so a bridge that
-    fails on them cannot take the Gazebo->ROS results down with it.
+    fails on them cannot take the Gazebo->ROS results down with it. ``native`` False runs the
+    bridge with ``ROS_GZ_BRIDGE_NATIVE=off`` (the Python path; docs/native.md §1).
     """
     path = CONFIG_DIR / name
     entries = read_entries(path)
     group = ProcessGroup()
     try:
-        bridge = group.bridge("--ros-args", "-p", f"config_file:={path}")
+        env = None if native else {**os.environ, "ROS_GZ_BRIDGE_NATIVE": "off"}
+        bridge = group.bridge("--ros-args", "-p", f"config_file:={path}", env=env)
         echoes: dict[str, GzEcho] = {}
         reverse: list[tuple[str, str, dict[str, Any]]] = []
         # Harmonic names go on the wire with --wire-type; Fortress peers need none.
@@ -166,11 +169,13 @@ class ConfigE2E:
 
     CONFIG = ""
     LINE = HARMONIC
+    #: The native data plane where the extension is built (False: the Python path).
+    NATIVE = True
 
     @pytest.fixture(scope="class")
     @classmethod
     def run(cls) -> Iterator[ConfigRun]:
-        started = start_config_run(cls.CONFIG, cls.LINE)
+        started = start_config_run(cls.CONFIG, cls.LINE, native=cls.NATIVE)
         yield started
         started.group.stop()
 
@@ -227,6 +232,20 @@ class TestTurtlebot3WaffleOnFortress(ConfigE2E):
 
     CONFIG = "turtlebot3_waffle_bridge.yaml"
     LINE = FORTRESS
+
+
+class TestTurtlebot3WaffleOnFortressPythonPath(ConfigE2E):
+    """The same on the Python path (``ROS_GZ_BRIDGE_NATIVE=off``), the reference of the
+    native one."""
+
+    CONFIG = "turtlebot3_waffle_bridge.yaml"
+    LINE = FORTRESS
+    NATIVE = False
+
+
+class TestTurtlebot3WafflePythonPath(ConfigE2E):
+    CONFIG = "turtlebot3_waffle_bridge.yaml"
+    NATIVE = False
 
 
 class TestDiffCar(ConfigE2E):

@@ -92,6 +92,12 @@ def test_json_document(capsys: pytest.CaptureFixture[str]) -> None:
         "ros_type": "std_msgs/msg/Bool",
         "gz_type": "gz.msgs.Boolean",
         "origin": "std_msgs",
+        "native": True,
+        "python_because": "",
     } in (document["pairs"])
+    by_types = {(pair["ros_type"], pair["gz_type"]): pair for pair in document["pairs"]}
+    image = by_types[("sensor_msgs/msg/Image", "gz.msgs.Image")]
+    assert image["native"] is False
+    assert image["python_because"] == "a bulk pair (it has its own path)"
     assert isinstance(document["services"], list)
     assert isinstance(document["unavailable"], dict)
