@@ -309,9 +309,9 @@ static int pump_loop(PumpObject *self, void *sock, int wake_fd, void *monitor, l
             if (now_ns(CLOCK_MONOTONIC) >= slice_end) break;
         }
         if (self->nhanded) return EVENT_HANDED;
-        if (self->count) continue;
         int64_t left = deadline - now_ns(CLOCK_MONOTONIC);
-        if (left <= 0) return 0;
+        if (left <= 0) return 0; /* also under a flood: Python's share is due */
+        if (self->count) continue;
         zmq_pollitem items[3] = {
             {sock, 0, ZMQ_POLLIN_, 0},
             {NULL, wake_fd, ZMQ_POLLIN_, 0},

@@ -262,7 +262,7 @@ def test_discover_writes_the_inferred_entry_and_the_file_carries_the_values(
     # The Fortress subscriber predates this bridge: the entry's announcement makes it register.
     bridge = start_process(bridge_command(ros_args=["-p", f"config_file:={config}"]))
     started.append(bridge)
-    wait_for_line(bridge, r"Creating ROS->GZ \[", timeout=30)
+    wait_for_line(bridge, r"Creating ROS->GZ Bridge: \[", timeout=30)
     publish_until(publish, echoed(diff_drive, r"MSG ignition\.msgs\.Twist .*x: -1\.25"), "echoed")
 
 
