@@ -12,6 +12,7 @@ from setuptools import Extension, setup
 
 NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/_native.c",
+    "ros_gz_bridge_py/native/encode.c",
     "ros_gz_bridge_py/native/pump.c",
     "ros_gz_bridge_py/native/transcode.c",
 ]
@@ -21,7 +22,11 @@ setup(
         Extension(
             "ros_gz_bridge_py.native._native",
             sources=NATIVE_SOURCES,
-            depends=["ros_gz_bridge_py/native/pump.h", "ros_gz_bridge_py/native/transcode.h"],
+            depends=[
+                "ros_gz_bridge_py/native/encode.h",
+                "ros_gz_bridge_py/native/pump.h",
+                "ros_gz_bridge_py/native/transcode.h",
+            ],
             extra_compile_args=["-O2", "-std=gnu11", "-Wall", "-Wextra", "-fvisibility=hidden"],
             libraries=["dl"],
             optional=True,

@@ -171,6 +171,7 @@ def converters(
         return ros
 
     _DECLARED[to_ros] = (fill, new_ros)
+    _DECLARED_TO_GZ[to_gz] = fill
     return to_gz, to_ros
 
 
@@ -178,10 +179,19 @@ def converters(
 _DECLARED: dict[Callable[[Any], Any], tuple[Fill, Callable[[], Any]]] = {}
 
 
+#: The Fill behind each ``to_gz`` that :func:`converters` made.
+_DECLARED_TO_GZ: dict[Callable[[Any], Any], Fill] = {}
+
+
 def declaration_of(to_ros: Callable[[Any], Any]) -> tuple[Fill, Callable[[], Any]] | None:
     """The Fill and the ROS message maker a ``to_ros`` converter was made of, if
     :func:`converters` made it."""
     return _DECLARED.get(to_ros)
+
+
+def gz_declaration_of(to_gz: Callable[[Any], Any]) -> Fill | None:
+    """The Fill a ``to_gz`` converter was made of, if :func:`converters` made it."""
+    return _DECLARED_TO_GZ.get(to_gz)
 
 
 def fill_pair(

@@ -19,6 +19,7 @@ from ros_gz_bridge_py.bulk.path import ros_cdr_to_gz
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import Channel, ChannelContext, ChannelState
+from ros_gz_bridge_py.native.channel import native_encoders
 from ros_gz_bridge_py.ros import light_reader
 from ros_gz_bridge_py.ros.qos import (
     SUBSCRIPTION_OVERRIDES,
@@ -53,6 +54,9 @@ class RosToGzChannel(Channel):
             and self.bulk is None
             and light_reader.reader_for(self.pair.ros_class) is not None
         )
+        #: Native encoders of the wire spellings, where the light read's CDR is encoded in C
+        #: (docs/native.md §6): no light tree, converter or protobuf objects per message.
+        self._encoders = native_encoders(layouts, ctx.options) if self._light else {}
         self._subscription: Any = None
         self._subscription_node: Any = None
         self._announced = False
@@ -130,6 +134,8 @@ class RosToGzChannel(Channel):
         try:
             if self.bulk is not None:
                 self._publish_serialized(publisher, ros_msg)
+            elif self._encoders and self._publish_encoded(publisher, ros_msg):
+                pass
             else:
                 msg = self._read(ros_msg) if self._light else ros_msg
                 if self._per_spelling:
@@ -146,6 +152,25 @@ class RosToGzChannel(Channel):
                 f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
                 "(showing msg only once per type)"
             )
+
+    def _publish_encoded(self, publisher: Publisher, cdr: bytes) -> bool:
+        """Encode natively and publish, in each spelling the layouts need; False (nothing
+        sent) where an encoder leaves the message to the Python path."""
+        if not self._per_spelling:
+            status, payload = self._encoders[publisher.msg_type].to_pb(cdr)
+            if status or payload is None:
+                return False
+            publisher.publish_raw(payload)
+            return True
+        payloads = {}
+        for wire_type in publisher.wire_types() | {publisher.msg_type}:
+            status, payload = self._encoders[wire_type].to_pb(cdr)
+            if status or payload is None:
+                return False
+            payloads[wire_type] = payload
+        for wire_type, payload in payloads.items():
+            publisher.publish_raw(payload, as_type=wire_type)
+        return True
 
     def _publish_per_spelling(self, publisher: Publisher, msg: Any) -> None:
         """Convert once per layout the subscribers need (and the configured one, for local

@@ -5,6 +5,7 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
+#include "encode.h"
 #include "pump.h"
 #include "transcode.h"
 
@@ -85,6 +86,92 @@ static PyTypeObject ProgramType = {
     .tp_methods = program_methods,
 };
 
+typedef struct {
+    PyObject_HEAD
+    struct rgb_encoder encoder;
+    int32_t *words; /* owned */
+} EncoderObject;
+
+static void encoder_dealloc(EncoderObject *self) {
+    PyMem_Free(self->words);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static int encoder_init(EncoderObject *self, PyObject *args, PyObject *kwds) {
+    static char *keywords[] = {"words", NULL};
+    Py_buffer words;
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*", keywords, &words)) return -1;
+    int result = -1;
+    if (words.len % 4) {
+        PyErr_SetString(PyExc_ValueError, "an encoder is int32 words");
+        goto done;
+    }
+    int32_t *copy = PyMem_Malloc((size_t)words.len + 4);
+    if (copy == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    memcpy(copy, words.buf, (size_t)words.len);
+    const char *why = "";
+    if (rgb_encoder_load(&self->encoder, copy, (size_t)words.len / 4, &why)) {
+        PyMem_Free(copy);
+        PyErr_Format(PyExc_ValueError, "not a native encoder: %s", why);
+        goto done;
+    }
+    PyMem_Free(self->words);
+    self->words = copy;
+    result = 0;
+done:
+    PyBuffer_Release(&words);
+    return result;
+}
+
+/* to_pb(cdr) -> (status, bytes or None); the output buffer is the call's own, so channels
+ * on several threads may share one encoder. */
+static PyObject *encoder_to_pb(EncoderObject *self, PyObject *arg) {
+    if (self->words == NULL) {
+        PyErr_SetString(PyExc_ValueError, "encoder not loaded");
+        return NULL;
+    }
+    Py_buffer cdr;
+    if (PyObject_GetBuffer(arg, &cdr, PyBUF_SIMPLE)) return NULL;
+    struct rgb_out out = {NULL, 0, 0};
+    enum rgb_status status = rgb_to_pb(&self->encoder, cdr.buf, (size_t)cdr.len, &out);
+    PyBuffer_Release(&cdr);
+    PyObject *result;
+    if (status != RGB_OK) {
+        result = Py_BuildValue("(iO)", (int)status, Py_None);
+    } else {
+        const char *data = out.len ? (const char *)out.data : ""; /* empty: no buffer */
+        result = Py_BuildValue("(iy#)", 0, data, (Py_ssize_t)out.len);
+    }
+    rgb_out_free(&out);
+    return result;
+}
+
+static PyMethodDef encoder_methods[] = {
+    {"to_pb", (PyCFunction)encoder_to_pb, METH_O,
+     "to_pb(cdr) -> (status, payload or None): 0 ok, 1 undecodable, 3 fallback"},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyTypeObject EncoderType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.Encoder",
+    .tp_basicsize = sizeof(EncoderObject),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "One pair's ROS -> Gazebo transcoder (docs/native.md §6).",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)encoder_init,
+    .tp_dealloc = (destructor)encoder_dealloc,
+    .tp_methods = encoder_methods,
+};
+
+struct rgb_encoder *native_encoder_of(PyObject *object) {
+    if (!PyObject_TypeCheck(object, &EncoderType)) return NULL;
+    EncoderObject *encoder = (EncoderObject *)object;
+    return encoder->words == NULL ? NULL : &encoder->encoder;
+}
+
 struct rgb_program *native_program_of(PyObject *object) {
     if (!PyObject_TypeCheck(object, &ProgramType)) return NULL;
     ProgramObject *program = (ProgramObject *)object;
@@ -97,11 +184,13 @@ static struct PyModuleDef module = {
 };
 
 PyMODINIT_FUNC PyInit__native(void) {
-    if (PyType_Ready(&ProgramType) < 0) return NULL;
+    if (PyType_Ready(&ProgramType) < 0 || PyType_Ready(&EncoderType) < 0) return NULL;
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) return NULL;
     Py_INCREF(&ProgramType);
-    if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0 || pump_register(m) < 0) {
+    Py_INCREF(&EncoderType);
+    if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0 ||
+        PyModule_AddObject(m, "Encoder", (PyObject *)&EncoderType) < 0 || pump_register(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

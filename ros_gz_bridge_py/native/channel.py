@@ -1,4 +1,4 @@
-"""Which channels take the native path, and with which programs (docs/native.md §1).
+"""Which channels take the native path, and with which programs (docs/native.md §1, §6).
 
 A Gazebo -> ROS channel takes it when the extension is built and may be used (the bridge's
 ``native`` option, ``ROS_GZ_BRIDGE_NATIVE``), its backend lets a native loop read (ZeroMQ),
@@ -15,6 +15,7 @@ from typing import Any
 
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.native import extension, unavailable_reason
+from ros_gz_bridge_py.native.encoder import compile_to_gz
 from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
 from ros_gz_bridge_py.native.pump import foreign_functions, why_no_functions
 
@@ -59,3 +60,27 @@ def program_of(pair: Pair) -> Any | None:
     except NotExpressibleError:
         return None
     return native.Program(compiled.schema, compiled.ops)
+
+
+def native_encoders(layouts: dict[str, Pair], options: Any) -> dict[str, Any]:
+    """The encoder of each wire spelling a ROS -> Gazebo channel of ``layouts`` runs natively
+    (docs/native.md §6); empty where the channel converts in Python."""
+    if not (options.native and options.light_read) or extension() is None:
+        return {}
+    encoders = {wire_type: encoder_of(pair) for wire_type, pair in layouts.items()}
+    if any(encoder is None for encoder in encoders.values()):
+        return {}
+    return encoders
+
+
+@functools.cache
+def encoder_of(pair: Pair) -> Any | None:
+    """The loaded ROS -> Gazebo encoder of ``pair`` (compiled once), or None."""
+    native = extension()
+    if native is None:
+        return None
+    try:
+        words = compile_to_gz(pair)
+    except NotExpressibleError:
+        return None
+    return native.Encoder(words)

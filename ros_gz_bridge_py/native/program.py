@@ -18,7 +18,7 @@ import sys
 from array import array
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from ros_gz_bridge_py.converters._fields import Each, Fill, Table, Value, declaration_of, same
 from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time, to_int32, to_uint32
@@ -178,13 +178,17 @@ _WHOLE: dict[tuple[str, str], Callable[[Assignments], None]] = {
 }
 
 
-def _whole(to_ros: Callable[[Any], Any]) -> Callable[[Assignments], None] | None:
-    """The assignments of a whole hand-written converter, if ``to_ros`` is one of them."""
-    key = (getattr(to_ros, "__module__", ""), getattr(to_ros, "__qualname__", ""))
+_T = TypeVar("_T")
+
+
+def named(function: Callable[..., Any], table: Mapping[tuple[str, str], _T]) -> _T | None:
+    """``table``'s entry for ``function``, keyed by its module and name (the function itself,
+    not another of the same name)."""
+    key = (getattr(function, "__module__", ""), getattr(function, "__qualname__", ""))
     module = sys.modules.get(key[0])
-    if key not in _WHOLE or getattr(module, key[1], None) is not to_ros:
+    if key not in table or getattr(module, key[1], None) is not function:
         return None
-    return _WHOLE[key]
+    return table[key]
 
 
 def assignments_of(fill: Fill, ros: Path = (), gz: Path = ()) -> Assignments:
@@ -464,7 +468,7 @@ def compile_to_ros(pair: Pair) -> Compiled:
         fill, new_ros = declared
         _assign(fill, (), (), given)
         default = new_ros()
-    elif (whole := _whole(pair.to_ros)) is not None:
+    elif (whole := named(pair.to_ros, _WHOLE)) is not None:
         whole(given)
         default = pair.ros_class()
     else:

@@ -4,10 +4,14 @@
 
 #include <Python.h>
 
+#include "encode.h"
 #include "transcode.h"
 
 /* Adds the Pump type to the module; -1 on error. */
 int pump_register(PyObject *module);
+
+/* The loaded encoder of an Encoder object, or NULL when `object` is not one. */
+struct rgb_encoder *native_encoder_of(PyObject *object);
 
 /* The loaded program of a Program object, or NULL when `object` is not one. */
 struct rgb_program *native_program_of(PyObject *object);

@@ -1,0 +1,395 @@
+"""Compile a pair's declaration into the words of a native ROS -> Gazebo encoder
+(docs/native.md §6).
+
+As for the Gazebo -> ROS programs (``program.py``), the words are read from the converters'
+declarations: the ``to_gz`` halves of the :func:`~ros_gz_bridge_py.converters._fields.fields`
+tables, a few hand-written leaves named in :data:`_LEAVES` beside what they do, the ROS type
+description (the CDR the read ops walk) and the protobuf descriptors (field numbers and types
+of the message the write ops write). The write ops write what the Python runtime would
+serialize after the Python converter ran: fields in number order, a submessage whenever a field
+of it was assigned (even to its default), a scalar only when it is not zero.
+"""
+
+from __future__ import annotations
+
+from array import array
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ros_gz_bridge_py.converters._fields import (
+    Each,
+    Fill,
+    Table,
+    Value,
+    gz_declaration_of,
+    same,
+)
+from ros_gz_bridge_py.converters.builtin_interfaces import (
+    fill_gz_present_time,
+    to_int32,
+    to_uint32,
+)
+from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_covariance
+from ros_gz_bridge_py.converters.registry import Pair
+from ros_gz_bridge_py.converters.std_msgs import (
+    CHILD_FRAME_ID_KEY,
+    FRAME_ID_KEY,
+    FRAMES,
+    HEADER,
+)
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.native.program import (
+    ROS_KINDS,
+    NotExpressibleError,
+    Path,
+    _split,
+    _text,
+    named,
+)
+from ros_gz_bridge_py.ros import cdr_types as cdr
+
+# Read ops, write ops (encode.c).
+R_END, R_NUM, R_STR, R_ARR, R_SEQ_NUM, R_SEQ_STR, R_SEQ_MSG = 0, 1, 2, 3, 4, 5, 6
+W_END, W_NUM, W_STR, W_STR_REP, W_CONST_STR, W_MSG, W_SEQ_MSG, W_PACKED, W_SEQ_STR = range(9)
+CONV_EXACT, CONV_WRAP = 0, 1
+_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP, _PB_BOOL = 9, 11, 12, 10, 8
+_PB_FLOATS = frozenset({1, 2})
+
+
+@dataclass
+class Copy:
+    """The gz field takes the ROS field at ``ros`` (``wrap``: C integer narrowing)."""
+
+    ros: Path
+    wrap: bool = False
+
+
+@dataclass
+class Text:
+    """A constant string (a header entry's key)."""
+
+    value: str
+
+
+@dataclass
+class Node:
+    """A gz submessage the converter writes into (so present on the wire): per field name, a
+    source, a Node, or a list of them for a repeated field."""
+
+    fields: dict[str, Any] = field(default_factory=dict)
+
+    def at(self, path: Path) -> Node:
+        """The Node at ``path`` below this one (made present)."""
+        node = self
+        for name in path:
+            child = node.fields.get(name)
+            if not isinstance(child, Node):
+                child = node.fields[name] = Node()
+            node = child
+        return node
+
+    def set(self, path: Path, source: Any) -> None:
+        self.at(path[:-1]).fields[path[-1]] = source
+
+    def append(self, path: Path, item: Any) -> None:
+        items = self.at(path[:-1]).fields.setdefault(path[-1], [])
+        if not isinstance(items, list):
+            msg = f"{'.'.join(path)} written as a single and a repeated field"
+            raise NotExpressibleError(msg)
+        items.append(item)
+
+
+@dataclass
+class Sequence:
+    """A repeated gz message, one element per item of the ROS sequence at ``ros``."""
+
+    ros: Path
+    element: Node
+
+
+@dataclass
+class Packed:
+    """A repeated gz number field from the ROS array or sequence at ``ros``."""
+
+    ros: Path
+
+
+def _entry_node(key: str, ros: Path) -> Node:
+    """A gz ``Header.Map`` entry: ``key`` and the ROS string at ``ros`` as its one value."""
+    return Node({"key": Text(key), "value": [Copy(ros)]})
+
+
+def _time(ros: Path, gz: Path, out: Node) -> None:
+    out.at(gz)
+    out.set((*gz, "sec"), Copy((*ros, "sec")))
+    out.set((*gz, "nsec"), Copy((*ros, "nanosec"), wrap=True))
+
+
+def _header(ros: Path, gz: Path, out: Node) -> None:
+    """``fill_gz_header``: the stamp (present), then one ``frame_id`` entry."""
+    _time((*ros, "stamp"), (*gz, "stamp"), out)
+    out.append((*gz, "data"), _entry_node(FRAME_ID_KEY, (*ros, "frame_id")))
+
+
+def _frames(ros: Path, gz: Path, out: Node) -> None:
+    _header((*ros, "header"), (*gz, "header"), out)
+    out.append((*gz, "header", "data"), _entry_node(CHILD_FRAME_ID_KEY, (*ros, "child_frame_id")))
+
+
+def _covariance(ros: Path, gz: Path, out: Node) -> None:
+    """``fill_gz_covariance``: the Float_V present, every value in ``data``."""
+    out.at(gz).fields["data"] = Packed(ros)
+
+
+#: The hand-written Fills the tables build on, by their ``to_gz`` half.
+_LEAVES: dict[Callable[[Any, Any], None], Callable[[Path, Path, Node], None]] = {
+    fill_gz_present_time: _time,
+    HEADER.to_gz: _header,
+    FRAMES.to_gz: _frames,
+    fill_gz_covariance: _covariance,
+}
+_VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint32: True}
+
+
+def _assign(fill: Fill, ros: Path, gz: Path, out: Node) -> None:
+    leaf = _LEAVES.get(fill.to_gz)
+    if leaf is not None:
+        leaf(ros, gz, out)
+    elif isinstance(fill.shape, Table):
+        for ros_path, gz_path, how in fill.shape.parts:
+            _entry((*ros, *_split(ros_path)), (*gz, *_split(gz_path)), how, out)
+    elif isinstance(fill.shape, Each):
+        element = Node()
+        _assign(fill.shape.fill, (), (), element)
+        out.set(gz, Sequence(ros, element))
+    else:
+        msg = f"a Fill of hand-written functions ({fill.to_gz.__qualname__})"
+        raise NotExpressibleError(msg)
+
+
+def _entry(ros: Path, gz: Path, how: Fill | Value | None, out: Node) -> None:
+    if how is None:
+        out.set(gz, Copy(ros))
+    elif isinstance(how, Fill):
+        _assign(how, ros, gz, out)
+    elif how.to_gz is None:
+        return
+    elif how.to_gz in _VALUES:
+        out.set(gz, Copy(ros, wrap=_VALUES[how.to_gz]))
+    else:
+        msg = f"a Value of {how.to_gz.__qualname__}"
+        raise NotExpressibleError(msg)
+
+
+# ---- the ROS side: read ops and slots ---------------------------------------------------------
+
+
+class _Frame:
+    """The slots of one frame (the message, or one element of a message sequence)."""
+
+    def __init__(self, used: set[Path]) -> None:
+        self.used = used
+        self.slots: dict[Path, int] = {}
+        self.kinds: dict[Path, Any] = {}
+        self.elements: dict[Path, _Frame] = {}
+
+    def slot(self, path: Path, rosidl: Any) -> int:
+        if path not in self.used:
+            return -1
+        self.slots[path] = len(self.slots)
+        self.kinds[path] = rosidl
+        return self.slots[path]
+
+
+def _used(node: Node, out: set[Path]) -> set[Path]:
+    """Every ROS path ``node``'s sources read (a sequence's own path, not its elements')."""
+    for value in node.fields.values():
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, Node):
+                _used(item, out)
+            elif isinstance(item, (Copy, Sequence, Packed)):
+                out.add(item.ros)
+    return out
+
+
+def _read_ops(
+    msg_class: type[Any], prefix: Path, frame: _Frame, elements: dict[Path, Node]
+) -> list[int]:
+    ops: list[int] = []
+    fields = cdr.fields_of(msg_class)
+    if not fields:
+        return [R_NUM, ROS_KINDS["uint8"][0], -1]
+    for name, rosidl in fields:
+        path = (*prefix, name)
+        kind = type(rosidl).__name__
+        basic = cdr.basic_of(rosidl)
+        if basic is not None:
+            ops += [R_NUM, _kind(rosidl), frame.slot(path, rosidl)]
+        elif kind in cdr.STRING_TYPES:
+            ops += [R_STR, frame.slot(path, rosidl)]
+        elif kind == "NamespacedType":
+            ops += _read_ops(cdr.nested_class(rosidl), path, frame, elements)
+        elif kind == "Array" and cdr.basic_of(rosidl.value_type) is not None:
+            ops += [R_ARR, _kind(rosidl.value_type), rosidl.size, frame.slot(path, rosidl)]
+        elif kind in cdr.SEQUENCE_TYPES and cdr.basic_of(rosidl.value_type) is not None:
+            ops += [R_SEQ_NUM, _kind(rosidl.value_type), frame.slot(path, rosidl)]
+        elif kind in cdr.SEQUENCE_TYPES and type(rosidl.value_type).__name__ in cdr.STRING_TYPES:
+            ops += [R_SEQ_STR, frame.slot(path, rosidl)]
+        elif kind in cdr.SEQUENCE_TYPES and type(rosidl.value_type).__name__ == "NamespacedType":
+            element_node = elements.get(path, Node())
+            element = _Frame(_used(element_node, set()))
+            body = _read_ops(
+                cdr.nested_class(rosidl.value_type), (), element, _sequences(element_node)
+            )
+            body.append(R_END)
+            slot = frame.slot(path, rosidl)
+            frame.elements[path] = element
+            ops += [R_SEQ_MSG, slot, len(element.slots), len(body), *body]
+        else:
+            msg = f"a ROS {kind} field ({'.'.join(path)}) the encoder does not read"
+            raise NotExpressibleError(msg)
+    return ops
+
+
+def _sequences(node: Node) -> dict[Path, Node]:
+    """The element Node of each ROS sequence ``node``'s sources read."""
+    found: dict[Path, Node] = {}
+    for value in node.fields.values():
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, Node):
+                found.update(_sequences(item))
+            elif isinstance(item, Sequence):
+                found[item.ros] = item.element
+    return found
+
+
+def _kind(rosidl: Any) -> int:
+    basic = cdr.basic_of(rosidl)
+    if basic not in ROS_KINDS:
+        msg = f"ROS type {basic} is not read natively"
+        raise NotExpressibleError(msg)
+    return ROS_KINDS[basic][0]
+
+
+# ---- the gz side: write ops ---------------------------------------------------------------------
+
+
+def _write_ops(node: Node, descriptor: Any, frame: _Frame) -> list[int]:
+    ops: list[int] = []
+    ordered = sorted(node.fields.items(), key=lambda item: _field(descriptor, item[0]).number)
+    for name, value in ordered:
+        gz_field = _field(descriptor, name)
+        for item in value if isinstance(value, list) else [value]:
+            ops += _write_one(item, gz_field, frame, repeated=isinstance(value, list))
+    return ops
+
+
+def _write_one(item: Any, gz_field: Any, frame: _Frame, *, repeated: bool) -> list[int]:
+    number = gz_field.number
+    if isinstance(item, Node):
+        if gz_field.message_type is None or gz_field.is_repeated != repeated:
+            msg = f"{gz_field.full_name} is not a message field"
+            raise NotExpressibleError(msg)
+        body = _write_ops(item, gz_field.message_type, frame)
+        body.append(W_END)
+        return [W_MSG, number, len(body), *body]
+    if isinstance(item, Text):
+        if gz_field.type != _PB_STRING or gz_field.is_repeated:
+            msg = f"{gz_field.full_name} is not a string"
+            raise NotExpressibleError(msg)
+        return [W_CONST_STR, number, *_text(item.value.encode())]
+    if isinstance(item, Sequence):
+        element = frame.elements.get(item.ros)
+        if element is None or gz_field.message_type is None or not gz_field.is_repeated:
+            msg = f"{gz_field.full_name} from {'.'.join(item.ros)}: not a repeated message"
+            raise NotExpressibleError(msg)
+        body = _write_ops(item.element, gz_field.message_type, element)
+        body.append(W_END)
+        return [W_SEQ_MSG, number, frame.slots[item.ros], len(element.slots), len(body), *body]
+    if isinstance(item, Packed):
+        rosidl = frame.kinds[item.ros]
+        if not gz_field.is_repeated or gz_field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
+            msg = f"{gz_field.full_name} is not a repeated number"
+            raise NotExpressibleError(msg)
+        kind = _kind(rosidl.value_type)
+        _check_number(gz_field, kind)
+        return [W_PACKED, number, gz_field.type, kind, frame.slots[item.ros]]
+    if isinstance(item, Copy):
+        rosidl = frame.kinds[item.ros]
+        slot = frame.slots[item.ros]
+        if type(rosidl).__name__ in cdr.STRING_TYPES:
+            if gz_field.type != _PB_STRING:
+                msg = f"{gz_field.full_name} is not a string"
+                raise NotExpressibleError(msg)
+            return [W_STR_REP if repeated else W_STR, number, slot]
+        if repeated or gz_field.is_repeated:
+            msg = f"{gz_field.full_name}: one number into a repeated field"
+            raise NotExpressibleError(msg)
+        kind = _kind(rosidl)
+        _check_number(gz_field, kind)
+        return [W_NUM, number, gz_field.type, kind, CONV_WRAP if item.wrap else CONV_EXACT, slot]
+    msg = f"{type(item).__name__} into {gz_field.full_name}"
+    raise NotExpressibleError(msg)
+
+
+_FLOAT_KINDS = frozenset({ROS_KINDS["float"][0], ROS_KINDS["double"][0]})
+
+
+def _check_number(gz_field: Any, kind: int) -> None:
+    """Only what Python assigns without a conversion of its own: floats into float fields,
+    booleans into bool fields, integers into integer fields."""
+    floats = gz_field.type in _PB_FLOATS
+    boolean = kind == ROS_KINDS["boolean"][0]
+    if floats != (kind in _FLOAT_KINDS) or (gz_field.type == _PB_BOOL) != boolean:
+        msg = f"{gz_field.full_name} from a ROS number of another sort"
+        raise NotExpressibleError(msg)
+    if gz_field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP):
+        msg = f"{gz_field.full_name} is not a number"
+        raise NotExpressibleError(msg)
+
+
+def _field(descriptor: Any, name: str) -> Any:
+    found = descriptor.fields_by_name.get(name)
+    if found is None:
+        msg = f"{descriptor.full_name} has no field {name!r}"
+        raise NotExpressibleError(msg)
+    return found
+
+
+def _clock(out: Node) -> None:
+    """``clock_to_gz``: the clock as the (present) ``sim`` time."""
+    _time(("clock",), ("sim",), out)
+
+
+#: Whole hand-written converters, by module and name (not imported: see program.py).
+_WHOLE: dict[tuple[str, str], Callable[[Node], None]] = {
+    ("ros_gz_bridge_py.converters.rosgraph_msgs", "clock_to_gz"): _clock,
+}
+
+
+def compile_to_gz(pair: Pair) -> bytes:
+    """The words of the encoder from ``pair``'s ROS messages (CDR) to its Gazebo payloads.
+
+    Raises:
+        NotExpressibleError: the pair stays on the Python path (the reason says why).
+    """
+    if pair.bulk is not None:
+        msg = "a bulk pair (it has its own path)"
+        raise NotExpressibleError(msg)
+    tree = Node()
+    fill = gz_declaration_of(pair.to_gz)
+    whole = named(pair.to_gz, _WHOLE)
+    if fill is not None:
+        _assign(fill, (), (), tree)
+    elif whole is not None:
+        whole(tree)
+    else:
+        msg = f"a hand-written converter ({pair.to_gz.__qualname__})"
+        raise NotExpressibleError(msg)
+    top = _Frame(_used(tree, set()))
+    read = _read_ops(pair.ros_class, (), top, _sequences(tree))
+    read.append(R_END)
+    write = _write_ops(tree, message_class(pair.gz_type).DESCRIPTOR, top)
+    write.append(W_END)
+    return array("i", [len(top.slots), len(read), *read, *write]).tobytes()
