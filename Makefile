@@ -12,15 +12,16 @@ LOOPBACK := ../shared/tools/loopback-env
 # Keep ROS, Gazebo Transport and Zenoh traffic on this host (see DEVELOPERS.md).
 WITH_LOOPBACK := if [ -f $(LOOPBACK) ]; then source $(LOOPBACK); else source tools/loopback-env; fi;
 
-.PHONY: setup test lint typecheck unit demo bench soak clean
+.PHONY: setup test lint typecheck unit demo bench soak fuzz clean
 
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml tools/setup_peer.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
+$(STAMP): pyproject.toml tools/setup_peer.sh tools/setup_fuzz.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[ros,dev]'
 	bash tools/setup_peer.sh
+	bash tools/setup_fuzz.sh
 	bash tools/setup_interfaces.sh $(VENV)
 	@touch $(STAMP)
 
@@ -47,9 +48,16 @@ $(BENCH_STAMP): $(STAMP)
 bench: $(BENCH_STAMP)
 	$(WITH_LOOPBACK) $(PY) -m benchmarks.run
 
-# Ten minutes of mixed traffic and faults; writes SOAK.md (a short version runs in `make test`).
+# Ten minutes of mixed traffic and faults; writes SOAK.md (a short version runs in `make test`);
+# then the fuzzing of `make fuzz`.
 soak: setup
 	$(WITH_LOOPBACK) $(PY) -m benchmarks.soak --seconds $${SOAK_SECONDS:-600}
+	$(MAKE) --no-print-directory fuzz
+
+# The native transcoder under libFuzzer with ASan and UBSan, then MSan, for FUZZ_SECONDS in all
+# (600 by default; `make test` runs 60): tests/unit/native/test_fuzz.py, corpus in .build/fuzz.
+fuzz: setup
+	FUZZ_SECONDS=$${FUZZ_SECONDS:-600} $(PY) -m pytest -q tests/unit/native/test_fuzz.py
 
 clean:
 	rm -rf .build .pytest_cache .mypy_cache .ruff_cache

@@ -679,10 +679,11 @@ struct header_lookup {
 static int header_entry(void *ctx, const struct field *f) {
     struct header_lookup *h = ctx;
     if (h->found && !h->last) return 0;
+    if (f->wire != WIRE_LEN) return RGB_FALLBACK; /* f->payload is only set for WIRE_LEN */
     struct field key, value;
     int found_key, status = find_last(f->payload, 1, &key, &found_key);
     if (status) return status;
-    if (f->wire != WIRE_LEN || (found_key && key.wire != WIRE_LEN)) return RGB_FALLBACK;
+    if (found_key && key.wire != WIRE_LEN) return RGB_FALLBACK;
     struct view key_bytes = found_key ? key.payload : (struct view){NULL, 0};
     if (key_bytes.n != h->key_len || (h->key_len && memcmp(key_bytes.p, h->key, h->key_len)))
         return 0;
@@ -703,7 +704,9 @@ static int header_entry(void *ctx, const struct field *f) {
 
 /* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
 static const uint8_t *word_bytes(const int32_t *words) { return (const uint8_t *)(words + 1); }
-static int32_t word_span(int32_t nbytes) { return 1 + (nbytes + 3) / 4; }
+/* The words a string takes (nbytes >= 0, as check_text made sure), counted in size_t: a
+ * length near INT32_MAX must not overflow. */
+static size_t word_span(int32_t nbytes) { return 1 + ((size_t)nbytes + 3) / 4; }
 
 static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *end,
                struct view v, struct rgb_out *out) {
@@ -920,7 +923,7 @@ static int room(size_t n, size_t at, size_t k) { return at <= n && k <= n - at ?
 
 static int check_text(const int32_t *ops, size_t n, size_t *at) {
     if (room(n, *at, 1) || ops[*at] < 0) return -1;
-    size_t span = (size_t)word_span(ops[*at]);
+    size_t span = word_span(ops[*at]);
     if (room(n, *at, span)) return -1;
     *at += span;
     return 0;

@@ -1,0 +1,175 @@
+"""Write the inputs of the native transcoder's fuzz target (fuzz/transcode_fuzz.c).
+
+Usage::
+
+    python -m tools.native_fuzz_programs OUT_DIR
+
+writes ``OUT_DIR/programs.h``, the words of every pair whose program compiles
+(``compile_to_ros``) as C arrays, and ``OUT_DIR/corpus/``, the seed inputs: per program, its
+index byte then a valid payload (empty, and a message with every field set,
+:func:`distinctive`); and one seed of each program-loading mode (the fuzz target's comment
+says how an input is read). Both are build products under ``.build/``, never committed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import struct
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from ros_gz_bridge_py.converters.registry import Pair, default_registry
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.native.program import Compiled, NotExpressibleError, compile_to_ros
+
+#: The fuzz target's modes, by the first input byte (fuzz/transcode_fuzz.c).
+LOAD_MODE, MUTATE_MODE = 0x80, 0xC0
+_HEADER_TYPES = {"gz.msgs.Header", "ignition.msgs.Header"}
+_FLOAT, _DOUBLE, _BOOL, _STRING, _BYTES, _ENUM = 2, 1, 8, 9, 12, 14
+_WIDE = {3, 4, 6, 16, 18}  # the 64-bit integers
+
+
+def compiled_pairs() -> list[tuple[Pair, Compiled]]:
+    """Every pair of the default registry whose program compiles, in registry order."""
+    found = []
+    for pair in default_registry().pairs:
+        try:
+            found.append((pair, compile_to_ros(pair)))
+        except NotExpressibleError:
+            continue
+    return found
+
+
+def _scalar(field: Any, n: int) -> Any:
+    """A positive value of ``field``'s type that no other field given another ``n`` has (n >= 1;
+    a 64-bit one narrows to the same positive int32, or Clock would refuse the message)."""
+    kind = field.type
+    if kind == _DOUBLE:
+        return n * 1.5 + 0.25
+    if kind == _FLOAT:
+        return n + 0.5
+    if kind == _BOOL:
+        return True
+    if kind == _STRING:
+        return f"s{n}::part::{n}é"
+    if kind == _BYTES:
+        return bytes([n % 256, 0, 255])
+    if kind == _ENUM:
+        numbers = [value.number for value in field.enum_type.values if value.number != 0]
+        return numbers[n % len(numbers)] if numbers else n
+    value = n * 7 + 3
+    return (value << 32) + value if kind in _WIDE else value
+
+
+def _header(header: Any, counter: Iterator[int], ancestors: frozenset[str]) -> None:
+    """A gz Header whose ``data`` tries the converters' rules: entries without a value, the
+    first ``child_frame_id`` and the last ``frame_id`` that have one, a key nobody reads."""
+    fill(header.stamp, counter, ancestors)
+    n = next(counter)
+    entries = [
+        ("frame_id", [f"world::early{n}", "unused"]),
+        ("child_frame_id", [f"robot::base{n}é", "unused"]),
+        ("frame_id", []),
+        ("other", [f"other{n}"]),
+        ("frame_id", [f"world::model::link{n}é"]),
+        ("child_frame_id", [f"late_child{n}"]),
+        ("child_frame_id", []),
+    ]
+    for key, values in entries:
+        entry = header.data.add()
+        entry.key = key
+        entry.value.extend(values)
+
+
+def fill(msg: Any, counter: Iterator[int], ancestors: frozenset[str] = frozenset()) -> Any:
+    """Sets every field of ``msg`` (counter values, several elements per repeated field) and
+    returns it; a message type already being filled further up is left empty (recursion)."""
+    name = msg.DESCRIPTOR.full_name
+    if name in _HEADER_TYPES:
+        _header(msg, counter, ancestors | {name})
+        return msg
+    inner = ancestors | {name}
+    for field in msg.DESCRIPTOR.fields:
+        count = (3 if len(ancestors) < 3 else 1) if field.is_repeated else 1
+        if field.message_type is not None:
+            if field.message_type.full_name in inner:
+                continue
+            for _ in range(count):
+                sub = (
+                    getattr(msg, field.name).add()
+                    if field.is_repeated
+                    else getattr(msg, field.name)
+                )
+                sub.SetInParent()
+                fill(sub, counter, inner)
+        elif field.is_repeated:
+            getattr(msg, field.name).extend(_scalar(field, next(counter)) for _ in range(count))
+        else:
+            setattr(msg, field.name, _scalar(field, next(counter)))
+    return msg
+
+
+def distinctive(gz_type: str) -> Any:
+    """A ``gz_type`` message with every field set to a value no other field has."""
+    return fill(message_class(gz_type)(), itertools.count(1))
+
+
+def _words(name: str, data: bytes) -> str:
+    values = struct.unpack(f"<{len(data) // 4}i", data)
+    return f"static const int32_t {name}[] = {{{', '.join(map(str, values))}}};\n"
+
+
+def header_text(programs: Sequence[tuple[Pair, Compiled]]) -> str:
+    """The C header: one schema and one ops array per program, and the table of them."""
+    lines = ["/* Generated by tools/native_fuzz_programs.py: do not edit, do not commit. */\n"]
+    lines.append("#include <stddef.h>\n#include <stdint.h>\n\n")
+    for i, (_pair, compiled) in enumerate(programs):
+        lines.append(_words(f"schema_{i}", compiled.schema))
+        lines.append(_words(f"ops_{i}", compiled.ops))
+    lines.append("\nstruct fuzz_program {\n    const char *name;\n")
+    lines.append("    const int32_t *schema;\n    size_t schema_len;\n")
+    lines.append("    const int32_t *ops;\n    size_t ops_len;\n};\n\n")
+    lines.append("static const struct fuzz_program PROGRAMS[] = {\n")
+    for i, (pair, compiled) in enumerate(programs):
+        lines.append(
+            f'    {{"{pair.ros_type} <- {pair.gz_type}", schema_{i}, '
+            f"{len(compiled.schema) // 4}, ops_{i}, {len(compiled.ops) // 4}}},\n"
+        )
+    lines.append("};\n")
+    lines.append(f"#define PROGRAM_COUNT {len(programs)}\n")
+    return "".join(lines)
+
+
+def seeds(programs: Sequence[tuple[Pair, Compiled]]) -> dict[str, bytes]:
+    """Seed inputs by file name (fuzz/transcode_fuzz.c reads the first byte as the mode)."""
+    found = {}
+    for i, (pair, compiled) in enumerate(programs):
+        payload = distinctive(pair.gz_type).SerializeToString()
+        found[f"program{i:02d}-empty"] = bytes([i])
+        found[f"program{i:02d}-distinctive"] = bytes([i]) + payload
+        words = compiled.schema + compiled.ops
+        split = struct.pack("<I", len(compiled.schema) // 4)
+        found[f"load{i:02d}"] = bytes([LOAD_MODE]) + split + words
+        # Mutate mode: program i, no edit (the edit count byte is 0), then the payload.
+        found[f"mutate{i:02d}"] = bytes([MUTATE_MODE, i, 0]) + payload
+    return found
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", type=Path, help="directory for programs.h and corpus/")
+    args = parser.parse_args(argv)
+    programs = compiled_pairs()
+    corpus = args.out / "corpus"
+    corpus.mkdir(parents=True, exist_ok=True)
+    (args.out / "programs.h").write_text(header_text(programs))
+    for name, data in seeds(programs).items():
+        (corpus / name).write_bytes(data)
+    print(f"{len(programs)} programs into {args.out / 'programs.h'}, seeds into {corpus}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
