@@ -14,6 +14,7 @@ NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/_native.c",
     "ros_gz_bridge_py/native/encode.c",
     "ros_gz_bridge_py/native/pump.c",
+    "ros_gz_bridge_py/native/ros_pump.c",
     "ros_gz_bridge_py/native/transcode.c",
 ]
 

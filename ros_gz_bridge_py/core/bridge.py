@@ -46,7 +46,12 @@ from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import Spelling
-from ros_gz_bridge_py.ros.side_node import SideNode, side_node_name
+from ros_gz_bridge_py.ros.side_node import (
+    SideNode,
+    native_node_name,
+    side_node_name,
+    unspun_node,
+)
 from ros_gz_bridge_py.transport import GzNode, NodeOptions, create_gz_node
 
 __all__ = ["Bridge", "BridgeHandle", "BridgeOptions"]
@@ -83,14 +88,17 @@ class Bridge:
             )
         self.gz_node = gz_node if gz_node is not None else create_gz_node(gz_options)
         self._side: SideNode | None = None
+        self._native: Any = None
         self._ctx = ChannelContext(
             ros_node=ros_node,
             gz_node=self.gz_node,
             side_node=lambda: self._side_node().node,
+            native_node=self._native_node,
             own_nodes=frozenset(
                 {
                     (ros_node.get_name(), ros_node.get_namespace()),
                     (side_node_name(ros_node), ros_node.get_namespace()),
+                    (native_node_name(ros_node), ros_node.get_namespace()),
                 }
             ),
             options=self.options,
@@ -197,6 +205,8 @@ class Bridge:
             _close_handle(handle)
         if self._side is not None:
             self._side.close()
+        if self._native is not None:
+            self._native.destroy_node()
         if self._owns_gz_node:
             self.gz_node.close()
 
@@ -232,6 +242,12 @@ class Bridge:
             _close_handle(handle)
             raise ConfigError(_failed_text(spec, str(err)), spec.source or None) from err
         return handle
+
+    def _native_node(self) -> Any:
+        with self._lock:
+            if self._native is None:
+                self._native = unspun_node(self.ros_node)
+            return self._native
 
     def _side_node(self) -> SideNode:
         with self._lock:

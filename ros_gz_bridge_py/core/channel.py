@@ -142,6 +142,9 @@ class ChannelContext:
     gz_node: GzNode
     #: The bridge's side node (created on first use), for subscriptions that need message info.
     side_node: Callable[[], Any]
+    #: The bridge's node that no executor spins (created on first use): the subscriptions of
+    #: native ROS -> Gazebo loops, which take their messages themselves (docs/native.md §7).
+    native_node: Callable[[], Any]
     options: BridgeOptions
     #: (name, namespace) of the bridge's own ROS nodes, left out when counting readers.
     own_nodes: frozenset[tuple[str, str]] = frozenset()
@@ -185,6 +188,11 @@ class Channel(abc.ABC):
         self._error_log = Throttle(ERROR_LOG_PERIOD)
         self.bulk: BulkPath | None = self.pair.bulk if ctx.options.bulk_path else None
         self._limiter = rate_limiter(spec.max_rate, ctx.options.max_rate)
+
+    @property
+    def native(self) -> bool:
+        """Whether a native loop carries the channel's messages (docs/native.md)."""
+        return False
 
     def limited(self) -> bool:
         """Count a received message; True (and counted as rate-limited) when ``max_rate``

@@ -122,6 +122,7 @@ class GzToRosChannel(Channel):
         else:
             publisher = self._publisher
         own = self.ctx.own_publications(self.ros_topic)
+        own.add_rcl_publisher(self._publisher.handle.pointer)
         if self._programs:
             self._pump = ChannelPump(
                 topic=self.ctx.gz_node.fqn(self.spec.gz_topic),
@@ -148,10 +149,12 @@ class GzToRosChannel(Channel):
 
     def _close_output(self) -> None:
         self._publish = _closed_publish
+        own = self.ctx.own_publications(self.ros_topic)
         if self._pump is not None:
-            self.ctx.own_publications(self.ros_topic).remove_numbered(self._pump)
+            own.remove_numbered(self._pump)
             self._pump = None
         if self._publisher is not None:
+            own.remove_rcl_publisher(self._publisher.handle.pointer)
             self.ctx.ros_node.destroy_publisher(self._publisher)
             self._publisher = None
 

@@ -42,6 +42,21 @@ class OwnPublications:
         self._windows: OrderedDict[tuple[int, int], tuple[int, int]] = OrderedDict()
         self._sequences: dict[int, int] = {}
         self._numbered: list[NumberedPublisher] = []
+        #: The rcl publishers (addresses) the bridge has on the topic: a native ROS -> Gazebo
+        #: loop skips their samples by publisher GID (``native/ros_pump.py``).
+        self._rcl_publishers: frozenset[int] = frozenset()
+
+    def add_rcl_publisher(self, pointer: int) -> None:
+        with self._lock:
+            self._rcl_publishers = self._rcl_publishers | {pointer}
+
+    def remove_rcl_publisher(self, pointer: int) -> None:
+        with self._lock:
+            self._rcl_publishers = self._rcl_publishers - {pointer}
+
+    def rcl_publishers(self) -> frozenset[int]:
+        """The rcl publishers of the bridge on this topic now."""
+        return self._rcl_publishers
 
     def add_numbered(self, publisher: NumberedPublisher) -> None:
         """Also ask ``publisher`` whether a sample is ours (until :meth:`remove_numbered`)."""

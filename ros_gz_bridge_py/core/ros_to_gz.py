@@ -20,6 +20,7 @@ from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import Channel, ChannelContext, ChannelState
 from ros_gz_bridge_py.native.channel import native_encoders
+from ros_gz_bridge_py.native.ros_pump import RosChannelPump, ros_functions
 from ros_gz_bridge_py.ros import light_reader
 from ros_gz_bridge_py.ros.qos import (
     SUBSCRIPTION_OVERRIDES,
@@ -57,17 +58,33 @@ class RosToGzChannel(Channel):
         #: Native encoders of the wire spellings, where the light read's CDR is encoded in C
         #: (docs/native.md §6): no light tree, converter or protobuf objects per message.
         self._encoders = native_encoders(layouts, ctx.options) if self._light else {}
+        #: Whether a native loop takes the messages, encodes and sends them itself
+        #: (docs/native.md §7): where the encoders are, and the backend gives publishers a
+        #: socket of their own.
+        self._native_loop = (
+            bool(self._encoders)
+            and ctx.gz_node.runs_native_loops
+            and ctx.options.rcl_serialized_publish
+            and ros_functions() is not None
+        )
+        self._pump: RosChannelPump | None = None
         self._subscription: Any = None
         self._subscription_node: Any = None
         self._announced = False
         self.loop_guard = False
 
+    @property
+    def native(self) -> bool:
+        """Whether a native loop carries the channel's messages (docs/native.md §7)."""
+        return self._native_loop
+
     def enable_loop_guard(self) -> None:
-        """Start skipping the bridge's own publications (re-subscribing if open)."""
+        """Start skipping the bridge's own publications (re-subscribing if open; a native loop
+        skips them by publisher GID and needs nothing more)."""
         if self.loop_guard:
             return
         self.loop_guard = True
-        if self.state is ChannelState.ACTIVE:
+        if self.state is ChannelState.ACTIVE and not self._native_loop:
             self._close_input()
             self._open_input()
 
@@ -76,7 +93,9 @@ class RosToGzChannel(Channel):
         return f"[{ros_topic} ({spec.ros_type}) -> {spec.gz_topic} ({spec.gz_type})]"
 
     def _open_output(self) -> None:
-        self._gz_publisher = self.ctx.gz_node.advertise(self.spec.gz_topic, self.spec.gz_type)
+        self._gz_publisher = self.ctx.gz_node.advertise(
+            self.spec.gz_topic, self.spec.gz_type, own_socket=self._native_loop
+        )
 
     def _close_output(self) -> None:
         if self._gz_publisher is not None:
@@ -84,6 +103,9 @@ class RosToGzChannel(Channel):
             self._gz_publisher = None
 
     def _open_input(self) -> None:
+        if self._native_loop:
+            self._open_native_input()
+            return
         callback: Callable[..., None]
         overrides: QoSOverridingOptions | None = SUBSCRIPTION_OVERRIDES
         if self.loop_guard:
@@ -102,7 +124,40 @@ class RosToGzChannel(Channel):
         )
         self._subscription_node = node
 
+    def _open_native_input(self) -> None:
+        """The subscription on the node no executor spins, and the loop that takes from it."""
+        apply_subscription_overrides(self.ctx.ros_node, self.spec.ros_topic, self._qos)
+        node = self.ctx.native_node()
+        self._subscription = node.create_subscription(
+            self.pair.ros_class, self.spec.ros_topic, _taken_natively, self._qos, raw=True
+        )
+        self._subscription_node = node
+        own = self._own
+        self._pump = RosChannelPump(
+            subscription=self._subscription,
+            publisher=self._gz_publisher,
+            encoders=self._encoders,
+            max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
+            refused=self._convert_and_publish,
+            counted=self._counted,
+            own_publishers=own.rcl_publishers,
+            name=self.spec.gz_topic,
+        )
+
+    def _counted(self, received: int, own_skipped: int, rate_limited: int, published: int) -> None:
+        """What the native loop did since it last said (on its thread)."""
+        stats = self.stats
+        stats.received += received
+        stats.own_skipped += own_skipped
+        stats.rate_limited += rate_limited
+        stats.published += published
+        if published and not self._announced:
+            self._announce()
+
     def _close_input(self) -> None:
+        if self._pump is not None:
+            self._pump.close()
+            self._pump = None
         if self._subscription is not None:
             self._subscription_node.destroy_subscription(self._subscription)
             self._subscription = None
@@ -126,8 +181,11 @@ class RosToGzChannel(Channel):
 
     def _on_ros_message(self, ros_msg: Any) -> None:
         """``ros_msg`` is a message object, or its CDR bytes (bulk path, light read)."""
-        if self.limited():
-            return
+        if not self.limited():
+            self._convert_and_publish(ros_msg)
+
+    def _convert_and_publish(self, ros_msg: Any) -> None:
+        """The Python path of one admitted message: convert, publish, or count why not."""
         publisher = self._gz_publisher
         if publisher is None:
             return
@@ -147,11 +205,14 @@ class RosToGzChannel(Channel):
             return
         self.stats.published += 1
         if not self._announced:
-            self._announced = True
-            self._logger.info(
-                f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
-                "(showing msg only once per type)"
-            )
+            self._announce()
+
+    def _announce(self) -> None:
+        self._announced = True
+        self._logger.info(
+            f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
+            "(showing msg only once per type)"
+        )
 
     def _publish_encoded(self, publisher: Publisher, cdr: bytes) -> bool:
         """Encode natively and publish, in each spelling the layouts need; False (nothing
@@ -192,3 +253,8 @@ class RosToGzChannel(Channel):
             publisher.publish(self.pair.to_gz(self._read(cdr)))
         else:
             publisher.publish_raw(payload)
+
+
+def _taken_natively(_msg: Any) -> None:
+    """The callback of a native loop's subscription: no executor spins its node, so it is
+    never called (the loop takes the messages itself)."""

@@ -224,7 +224,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
             sorted(dict(stats.errors_by_reason).items(), key=lambda item: (-item[1], item[0]))
         ),
         conversion_errors=stats.conversion_errors,
-        native=isinstance(channel, GzToRosChannel) and channel.native,
+        native=channel.native,
     )
 
 

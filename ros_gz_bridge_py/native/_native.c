@@ -1,7 +1,9 @@
 /* The Python face of the native data plane (docs/native.md).
  *
  * Program: one pair's transcoder, loaded from the words program.py compiles.
- * Pump: the per-message loop of one Gazebo -> ROS channel (pump.c). */
+ * Encoder: one pair's ROS -> Gazebo transcoder (encode.c).
+ * Pump: the per-message loop of one Gazebo -> ROS channel (pump.c).
+ * RosPump: the per-message loop of one ROS -> Gazebo channel (ros_pump.c). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
@@ -190,7 +192,8 @@ PyMODINIT_FUNC PyInit__native(void) {
     Py_INCREF(&ProgramType);
     Py_INCREF(&EncoderType);
     if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0 ||
-        PyModule_AddObject(m, "Encoder", (PyObject *)&EncoderType) < 0 || pump_register(m) < 0) {
+        PyModule_AddObject(m, "Encoder", (PyObject *)&EncoderType) < 0 || pump_register(m) < 0 ||
+        ros_pump_register(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

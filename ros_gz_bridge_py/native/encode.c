@@ -232,7 +232,8 @@ static int new_frames(struct reader *r, size_t count, int32_t nslots, size_t *fi
         r->pool = pool;
         r->cap = cap;
     }
-    memset(r->pool + r->used, 0, (need - r->used) * sizeof *r->pool);
+    /* nothing to clear for frames without slots (the pool may still be NULL then) */
+    if (need > r->used) memset(r->pool + r->used, 0, (need - r->used) * sizeof *r->pool);
     *first = r->used;
     r->used = need;
     return 0;
@@ -654,6 +655,9 @@ static int pb_ok(int32_t type) {
     return (type >= PB_DOUBLE && type <= PB_BOOL) || (type >= PB_UINT32 && type <= PB_SINT64);
 }
 
+/* A protobuf field number (1 to 2^29 - 1: the tag keeps 3 bits for the wire type). */
+static int field_ok(int32_t field) { return field >= 1 && field <= (1 << 29) - 1; }
+
 static int room(size_t n, size_t at, size_t k) { return at <= n && k <= n - at ? 0 : -1; }
 
 /* Checks read ops [0, n) of a frame of `nslots` slots. */
@@ -777,7 +781,8 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
         case W_END:
             return at == n ? 0 : -1;
         case W_NUM:
-            if (room(n, at, 5) || ops[at] <= 0 || !pb_ok(ops[at + 1]) || !kind_ok(ops[at + 2]) ||
+            if (room(n, at, 5) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
+                !kind_ok(ops[at + 2]) ||
                 (ops[at + 3] != CONV_EXACT && ops[at + 3] != CONV_WRAP) ||
                 !FILLED(ops[at + 4], R_NUM) || f->kinds[ops[at + 4]] != ops[at + 2])
                 return -1;
@@ -785,24 +790,24 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
             break;
         case W_STR:
         case W_STR_REP:
-            if (room(n, at, 2) || ops[at] <= 0 || !FILLED(ops[at + 1], R_STR)) return -1;
+            if (room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_STR)) return -1;
             at += 2;
             break;
         case W_CONST_STR:
-            if (room(n, at, 2) || ops[at] <= 0 || ops[at + 1] < 0 ||
+            if (room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 0 ||
                 room(n, at + 1, (size_t)text_span(ops[at + 1])))
                 return -1;
             at += 1 + (size_t)text_span(ops[at + 1]);
             break;
         case W_MSG:
-            if (room(n, at, 2) || ops[at] <= 0 || ops[at + 1] < 1 ||
+            if (room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 1 ||
                 room(n, at + 2, (size_t)ops[at + 1]) ||
                 check_write(ops + at + 2, (size_t)ops[at + 1], f, depth + 1))
                 return -1;
             at += 2 + (size_t)ops[at + 1];
             break;
         case W_SEQ_MSG: {
-            if (room(n, at, 4) || ops[at] <= 0 || !FILLED(ops[at + 1], R_SEQ_MSG) ||
+            if (room(n, at, 4) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_MSG) ||
                 ops[at + 2] != f->body_slots[ops[at + 1]] || ops[at + 3] < 1 ||
                 room(n, at + 4, (size_t)ops[at + 3]))
                 return -1;
@@ -816,14 +821,15 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
             break;
         }
         case W_PACKED:
-            if (room(n, at, 4) || ops[at] <= 0 || !pb_ok(ops[at + 1]) || !kind_ok(ops[at + 2]) ||
+            if (room(n, at, 4) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
+                !kind_ok(ops[at + 2]) ||
                 !(FILLED(ops[at + 3], R_ARR) || FILLED(ops[at + 3], R_SEQ_NUM)) ||
                 f->kinds[ops[at + 3]] != ops[at + 2])
                 return -1;
             at += 4;
             break;
         case W_SEQ_STR:
-            if (room(n, at, 2) || ops[at] <= 0 || !FILLED(ops[at + 1], R_SEQ_STR)) return -1;
+            if (room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_STR)) return -1;
             at += 2;
             break;
         default:

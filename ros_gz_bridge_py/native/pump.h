@@ -10,6 +10,9 @@
 /* Adds the Pump type to the module; -1 on error. */
 int pump_register(PyObject *module);
 
+/* Adds the RosPump type (ros_pump.c) to the module; -1 on error. */
+int ros_pump_register(PyObject *module);
+
 /* The loaded encoder of an Encoder object, or NULL when `object` is not one. */
 struct rgb_encoder *native_encoder_of(PyObject *object);
 

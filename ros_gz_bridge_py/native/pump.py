@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-import zmq
+import zmq  # noqa: F401 - loads pyzmq's libzmq, which libzmq_path finds
 
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.transport import MessageInfo
@@ -41,17 +41,19 @@ _ZMQ_FUNCTIONS = (
 _UNROUTED, _REFUSED = 0, 1
 
 
-def _libzmq_path() -> str | None:
-    """The libzmq pyzmq loaded (its wheel bundles one), from this process's mappings."""
+def loaded_libraries() -> list[str]:
+    """The paths of the shared libraries this process has loaded (Linux), in load order."""
     try:
         maps = Path("/proc/self/maps").read_text()
     except OSError:
-        return None
-    for line in maps.splitlines():
-        path = line.rpartition(" ")[2]
-        if "/libzmq" in path and ".so" in path:
-            return path
-    return None
+        return []
+    paths = [line.rpartition(" ")[2] for line in maps.splitlines()]
+    return list(dict.fromkeys(path for path in paths if ".so" in path))
+
+
+def libzmq_path() -> str | None:
+    """The libzmq pyzmq loaded (its wheel bundles one)."""
+    return next((path for path in loaded_libraries() if "/libzmq" in path), None)
 
 
 @functools.cache
@@ -67,8 +69,7 @@ def why_no_functions() -> str:
 
 @functools.cache
 def _resolve() -> tuple[tuple[int, ...] | None, str]:
-    zmq.Context.instance()  # pyzmq loads libzmq with its backend
-    path = _libzmq_path()
+    path = libzmq_path()  # importing zmq loaded it, with pyzmq's backend
     if path is None:
         return None, "pyzmq's libzmq is not among the loaded libraries"
     try:

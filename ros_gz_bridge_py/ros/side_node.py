@@ -24,10 +24,28 @@ from rclpy.node import Node as RosNode
 from rclpy.task import Future
 
 SUFFIX = "_side"
+#: The suffix of the bridge's node that no executor spins.
+NATIVE_SUFFIX = "_native"
 
 
 def side_node_name(owner: Any) -> str:
     return f"{owner.get_name()}{SUFFIX}"
+
+
+def native_node_name(owner: Any) -> str:
+    return f"{owner.get_name()}{NATIVE_SUFFIX}"
+
+
+def unspun_node(owner: Any) -> Any:
+    """A node beside ``owner`` (same context and namespace) that no executor spins: the
+    subscriptions of native ROS -> Gazebo loops live there, so that only those loops take
+    their messages (docs/native.md §7)."""
+    return RosNode(
+        native_node_name(owner),
+        namespace=owner.get_namespace(),
+        context=owner.context,
+        start_parameter_services=False,
+    )
 
 
 class SideNode:

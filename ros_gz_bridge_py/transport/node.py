@@ -127,15 +127,19 @@ class GzNode(abc.ABC):
 
     # --- topics -----------------------------------------------------------------------------
 
-    def advertise(self, topic: str, msg_type: str) -> Publisher:
+    def advertise(self, topic: str, msg_type: str, *, own_socket: bool = False) -> Publisher:
         """Advertise ``topic`` under the spellings of ``msg_type``.
+
+        ``own_socket``: where the backend can (ZeroMQ), the publisher sends from a socket of its
+        own, announced at its own address, instead of the node's shared one; then it must be
+        published from one thread at a time (a native loop's, ``native/ros_pump.py``).
 
         Raises:
             LocalProtocolError: the name is not a valid Gazebo topic.
             TransportError: the node is closed.
         """
         self._check_open()
-        return self._open_publisher(topic, self.fqn(topic), msg_type)
+        return self._open_publisher(topic, self.fqn(topic), msg_type, own_socket=own_socket)
 
     def unadvertise(self, publisher: Publisher) -> None:
         """Withdraw ``publisher`` (called by its ``close``)."""
@@ -461,7 +465,9 @@ class GzNode(abc.ABC):
     # --- the backend's hooks ------------------------------------------------------------------
 
     @abc.abstractmethod
-    def _open_publisher(self, topic: str, fqn: str, msg_type: str) -> Publisher:
+    def _open_publisher(
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+    ) -> Publisher:
         """Create and announce a publisher (a :class:`Publisher`, or a subclass)."""
 
     @abc.abstractmethod

@@ -1,11 +1,12 @@
 """The native data plane against real peers, and the bridge without it (docs/native.md §1).
 
 A Fortress C++ peer publishes Odometry, JointState (a Model) and a Clock; a ``parameter_bridge``
-carries them to an rclpy checker process. The same run is made with the native path (where the
-extension is built), with ``ROS_GZ_BRIDGE_NATIVE=off``, and with the extension absent (an
-import blocker in the bridge process's ``sitecustomize``): the values must arrive alike, the
-SIGUSR1 table must name the path each channel took, and a bridge without the extension says once
-why. The core tests also run in a process where the extension cannot be imported.
+carries them to an rclpy checker process, which also publishes a Twist that the bridge carries
+to a Fortress subscriber (``cmd_vel``, as DiffDrive takes it). The same run is made with the
+native path (where the extension is built), with ``ROS_GZ_BRIDGE_NATIVE=off``, and with the
+extension absent (an import blocker in the bridge process's ``sitecustomize``): the values must
+arrive alike, the SIGUSR1 table must name the path each channel took, and a bridge without the
+extension says once why. The core tests also run in a process where the extension cannot be imported.
 """
 
 from __future__ import annotations
@@ -16,14 +17,28 @@ import re
 import signal
 import subprocess
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
 from ros_gz_bridge_py.native import extension
-from tests.bridge.e2e_harness import RUN_TIMEOUT, ProcessGroup, RosChecker, wait_all
-from tests.bridge.e2e_values import CLOCK, JOINT_STATES, ODOMETRY, GzSample, mismatches
+from tests.bridge.e2e_harness import (
+    RUN_TIMEOUT,
+    GzEcho,
+    ProcessGroup,
+    RosChecker,
+    parse_gz,
+    wait_all,
+)
+from tests.bridge.e2e_values import (
+    CLOCK,
+    JOINT_STATES,
+    ODOMETRY,
+    TWIST_TO_GZ,
+    GzSample,
+    mismatches,
+)
 from tests.gzpeer import ROOT, unique_name, wait_for_line
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
@@ -78,23 +93,32 @@ class Run:
         self.topics = {
             sample.type_name: unique_name(f"native_{sample.type_name}") for _, sample in CHANNELS
         }
+        self.cmd_vel = unique_name("native_cmd_vel")
         arguments = [
             f"{self.topics[sample.type_name]}@{ros_type}[{sample.gz_type}"
             for ros_type, sample in CHANNELS
         ]
+        arguments.append(f"{self.cmd_vel}@{TWIST_TO_GZ.ros_type}]gz.msgs.Twist")
         self.bridge = group.bridge(*arguments, env=env)
         for _, sample in CHANNELS:
             group.peer(*sample.peer_pub_args(self.topics[sample.type_name]))
+        self.echo = GzEcho.peer(group, self.cmd_vel, "Twist", "ignition.msgs.Twist")
         self.checker = RosChecker(
-            group, [(self.topics[sample.type_name], ros_type) for ros_type, sample in CHANNELS]
+            group,
+            [(self.topics[sample.type_name], ros_type) for ros_type, sample in CHANNELS],
+            [(self.cmd_vel, TWIST_TO_GZ.ros_type, TWIST_TO_GZ.values)],
         )
 
     def arrived(self, sample: GzSample) -> bool:
         messages = self.checker.messages(self.topics[sample.type_name])
         return any(not mismatches(sample.ros, message) for message in messages)
 
+    def twist_arrived(self) -> bool:
+        return parse_gz("Twist", TWIST_TO_GZ.gz_text) in self.echo.messages()
+
     def wait_for_values(self) -> None:
-        checks = {
+        checks: dict[str, Callable[[], bool]] = {"cmd_vel": self.twist_arrived}
+        checks |= {
             sample.type_name: functools.partial(self.arrived, sample) for _, sample in CHANNELS
         }
         held = wait_all(checks, RUN_TIMEOUT)
@@ -104,11 +128,15 @@ class Run:
         """The PATH column of each channel's row in the SIGUSR1 table."""
         self.bridge.send_signal(signal.SIGUSR1)
         found = {}
-        for _, sample in CHANNELS:
-            topic = re.escape(self.topics[sample.type_name])
-            row = rf"^\w+\s+GZ->ROS\s+{topic}\s.*\s(native|python)$"
-            found[sample.type_name] = wait_for_line(self.bridge, row).group(1)
+        rows = [("GZ->ROS", self.topics[sample.type_name]) for _, sample in CHANNELS]
+        rows.append(("ROS->GZ", self.cmd_vel))
+        for direction, topic in rows:
+            row = rf"^\w+\s+{direction}\s+{re.escape(topic)}\s.*\s(native|python)$"
+            found[topic] = wait_for_line(self.bridge, row).group(1)
         return found
+
+    def all_paths(self, path: str) -> dict[str, str]:
+        return dict.fromkeys([*self.topics.values(), self.cmd_vel], path)
 
 
 @pytest.fixture
@@ -122,14 +150,14 @@ def test_the_native_path_carries_fortress_messages_with_their_values(group: Proc
     require_extension()
     run = Run(group, None)
     run.wait_for_values()
-    assert run.paths() == dict.fromkeys(run.topics, "native")
+    assert run.paths() == run.all_paths("native")
     assert "Every channel takes the Python path" not in run.bridge.output()
 
 
 def test_native_off_keeps_the_python_path_with_the_same_values(group: ProcessGroup) -> None:
     run = Run(group, {**os.environ, "ROS_GZ_BRIDGE_NATIVE": "off"})
     run.wait_for_values()
-    assert run.paths() == dict.fromkeys(run.topics, "python")
+    assert run.paths() == run.all_paths("python")
 
 
 def test_without_the_extension_the_bridge_says_why_once_and_works(
@@ -137,7 +165,7 @@ def test_without_the_extension_the_bridge_says_why_once_and_works(
 ) -> None:
     run = Run(group, blocker_env(tmp_path))
     run.wait_for_values()
-    assert run.paths() == dict.fromkeys(run.topics, "python")
+    assert run.paths() == run.all_paths("python")
     assert run.bridge.output().count(WHY_NOT_BUILT) == 1, run.bridge.output()
 
 

@@ -134,7 +134,10 @@ class MemoryGzNode(GzNode):
 
     # --- topics -----------------------------------------------------------------------------
 
-    def _open_publisher(self, topic: str, fqn: str, msg_type: str) -> Publisher:
+    def _open_publisher(
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+    ) -> Publisher:
+        """``own_socket`` changes nothing here (a ZeroMQ notion)."""
         publisher = MemoryPublisher(self, topic, fqn, msg_type)
         publisher.announcements = tuple(
             Announcement(fqn, name, self, self.address) for name in publisher.names

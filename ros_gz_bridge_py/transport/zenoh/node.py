@@ -173,8 +173,11 @@ class ZenohGzNode(GzNode):
 
     # --- topics -----------------------------------------------------------------------------
 
-    def _open_publisher(self, topic: str, fqn: str, msg_type: str) -> Publisher:
-        """A Zenoh publisher on the FQN (remote destinations only) and its MP token."""
+    def _open_publisher(
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+    ) -> Publisher:
+        """A Zenoh publisher on the FQN (remote destinations only) and its MP token;
+        ``own_socket`` changes nothing here (a ZeroMQ notion)."""
         publisher = ZenohPublisher(self, topic, fqn, msg_type)
         token = message_token(
             fqn, self.process_uuid, self.node_uuid, EntityKind.PUBLISHER, canonical_type(msg_type)

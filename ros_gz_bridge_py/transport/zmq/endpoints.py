@@ -8,7 +8,7 @@ SUB socket and thread, ``zmq/reader.py``); a service offer its record.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.zmq.wire import Frame, PublisherRecord, encode_data
@@ -19,7 +19,8 @@ if TYPE_CHECKING:
 
 class ZmqPublisher(Publisher):
     """Announced once per spelling of its type (``records``, the configured one first), from
-    the node's PUB address (docs/protocol.md §9)."""
+    the node's PUB address (docs/protocol.md §9), or from the address of a PUB socket of its own
+    (``sock``)."""
 
     def __init__(
         self,
@@ -28,9 +29,13 @@ class ZmqPublisher(Publisher):
         fqn: str,
         msg_type: str,
         records: tuple[PublisherRecord, ...],
+        *,
+        sock: Any = None,
     ) -> None:
         super().__init__(node, topic, fqn, msg_type)
         self.records = records
+        #: Its own PUB socket, or None (the node's).
+        self.sock = sock
         #: The data frames with an empty payload per spelling, encoded once (§2.8.2).
         self.wire_frames: dict[str, list[Frame]] = {
             record.msg_type: encode_data(record.topic, record.address, b"", record.msg_type)

@@ -56,7 +56,7 @@ from ros_gz_bridge_py.transport.zmq.intake import DataIntake
 from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader, receive_message
 from ros_gz_bridge_py.transport.zmq.routes import DataRouter
 from ros_gz_bridge_py.transport.zmq.services import PendingCall, RouterSockets, ServiceRouter
-from ros_gz_bridge_py.transport.zmq.sockets import open_sockets
+from ros_gz_bridge_py.transport.zmq.sockets import open_sockets, publisher_socket
 from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket, determine_host
 from ros_gz_bridge_py.transport.zmq.wire import (
     Frame,
@@ -193,16 +193,24 @@ class ZmqGzNode(GzNode):
 
     # --- topics -----------------------------------------------------------------------------
 
-    def _open_publisher(self, topic: str, fqn: str, msg_type: str) -> Publisher:
-        """Announce ``topic`` under each spelling; re-announced every second (§2.5)."""
+    def _open_publisher(
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+    ) -> Publisher:
+        """Announce ``topic`` under each spelling; re-announced every second (§2.5). With
+        ``own_socket``, from a PUB socket of the publisher's own, at its own address (a record
+        names the address subscribers connect to, §2.8.1)."""
+        sock = (
+            publisher_socket(self._io.context, self._io.host, self.settings) if own_socket else None
+        )
+        address = self.pub_address if sock is None else self._io.address(sock)
         nodes = (self.node_uuid, self.respelled_node_uuid)
         records = tuple(
             PublisherRecord(
-                fqn, self.pub_address, self.process_uuid, node, Scope.ALL, MessagePublisher(name)
+                fqn, address, self.process_uuid, node, Scope.ALL, MessagePublisher(name)
             )
             for name, node in zip(self.names_of(msg_type), nodes, strict=False)
         )
-        publisher = ZmqPublisher(self, topic, fqn, msg_type, records)
+        publisher = ZmqPublisher(self, topic, fqn, msg_type, records, sock=sock)
 
         def command() -> None:
             for record in records:
@@ -212,7 +220,8 @@ class ZmqGzNode(GzNode):
         return publisher
 
     def _close_publisher(self, publisher: Publisher) -> None:
-        records = cast(ZmqPublisher, publisher).records
+        zmq_publisher = cast(ZmqPublisher, publisher)
+        records = zmq_publisher.records
 
         def command() -> None:
             for record in records:
@@ -221,11 +230,17 @@ class ZmqGzNode(GzNode):
 
         with contextlib.suppress(TransportError):
             self._call(command)
+        if zmq_publisher.sock is not None:
+            zmq_publisher.sock.close(linger=0)
 
     def _send(self, publisher: Publisher, wire_type: str, payload: Payload) -> None:
         """The four data frames on the PUB socket (§2.8.2), from the publishing thread."""
-        topic, sender, _, type_frame = cast(ZmqPublisher, publisher).wire_frames[wire_type]
-        send = self._io.pub.send
+        zmq_publisher = cast(ZmqPublisher, publisher)
+        topic, sender, _, type_frame = zmq_publisher.wire_frames[wire_type]
+        own = zmq_publisher.sock
+        send = self._io.pub.send if own is None else own.send
+        # A socket of the publisher's own is used by one thread (see advertise); the lock
+        # still keeps the send from racing with the node's close.
         with self._io.pub_lock:
             if self.closed:
                 return

@@ -89,7 +89,7 @@ def open_sockets(
             context=context,
             msg_udp=opened[0],
             srv_udp=opened[1],
-            pub=_publisher(context, host, settings),
+            pub=publisher_socket(context, host, settings),
             sub=subscriber_socket(context, settings),
             replier=_bound(context, host, zmq.ROUTER, routing_id=replier_id, mandatory=True),
             requester=_socket(context, zmq.ROUTER, mandatory=True),
@@ -133,9 +133,10 @@ def subscriber_socket(context: Any, settings: TransportSettings) -> Any:
     return sock
 
 
-def _publisher(context: Any, host: str, settings: TransportSettings) -> Any:
-    """The PUB socket: a PLAIN server in ZAP domain ``gz-auth`` with credentials (§2.8.6);
-    the ZAP handler (``auth.py``) must be bound before, or libzmq lets everyone in."""
+def publisher_socket(context: Any, host: str, settings: TransportSettings) -> Any:
+    """A PUB socket bound on ``host``: a PLAIN server in ZAP domain ``gz-auth`` with
+    credentials (§2.8.6); the ZAP handler (``auth.py``) must be bound before, or libzmq lets
+    everyone in. The node's own, and that of each publisher with a socket of its own."""
     sock = _socket(context, zmq.PUB)
     if settings.sndhwm:
         sock.setsockopt(zmq.SNDHWM, settings.sndhwm)
