@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from typing import TextIO
 
 from ros_gz_bridge_py.converters.registry import Registry, build_registry
-from ros_gz_bridge_py.native.program import expressible
+from ros_gz_bridge_py.native.channel import expressible
 
 USAGE = """\
 usage: bridge_types [OPTION [TYPE]]
@@ -52,16 +52,18 @@ def _print_pairs(registry: Registry, out: TextIO) -> None:
 
 
 def _as_json(registry: Registry) -> str:
-    why_python = expressible(registry.pairs)
+    # Per direction, whether the native data plane carries the pair (docs/native.md), or why not.
+    to_ros, to_gz = expressible(registry.pairs)
     document = {
         "pairs": [
             {
                 "ros_type": p.ros_type,
                 "gz_type": p.gz_type,
                 "origin": p.origin,
-                # Gazebo -> ROS through a native program (docs/native.md), or why not.
-                "native": not why_python[(p.ros_type, p.gz_type)],
-                "python_because": why_python[(p.ros_type, p.gz_type)],
+                "native_to_ros": not to_ros[(p.ros_type, p.gz_type)],
+                "native_to_gz": not to_gz[(p.ros_type, p.gz_type)],
+                "python_to_ros_because": to_ros[(p.ros_type, p.gz_type)],
+                "python_to_gz_because": to_gz[(p.ros_type, p.gz_type)],
             }
             for p in registry.pairs
         ],

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import logging
+from collections.abc import Iterable
 from typing import Any
 
 from ros_gz_bridge_py.converters.registry import Pair
@@ -20,6 +21,25 @@ from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
 from ros_gz_bridge_py.native.pump import foreign_functions, why_no_functions
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
+
+
+Reasons = dict[tuple[str, str], str]
+
+
+def expressible(pairs: Iterable[Pair]) -> tuple[Reasons, Reasons]:
+    """Per (ROS type, Gazebo type), for each direction (to ROS, to Gazebo): "" where a native
+    program compiles, else why not."""
+    to_ros: Reasons = {}
+    to_gz: Reasons = {}
+    for pair in pairs:
+        key = (pair.ros_type, pair.gz_type)
+        for found, compile_one in ((to_ros, compile_to_ros), (to_gz, compile_to_gz)):
+            try:
+                compile_one(pair)
+                found[key] = ""
+            except NotExpressibleError as err:
+                found[key] = str(err)
+    return to_ros, to_gz
 
 
 def native_programs(layouts: dict[str, Pair], options: Any, gz_node: Any) -> dict[str, Any]:

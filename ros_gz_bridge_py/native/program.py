@@ -16,7 +16,7 @@ from __future__ import annotations
 import struct
 import sys
 from array import array
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
@@ -479,15 +479,3 @@ def compile_to_ros(pair: Pair) -> Compiled:
     ops = _Emitter(schema).message(pair.ros_class, (), given, default, root)
     ops.append(OP_END)
     return Compiled(array("i", schema.words()).tobytes(), array("i", ops).tobytes())
-
-
-def expressible(pairs: Iterable[Pair]) -> dict[tuple[str, str], str]:
-    """Per (ROS type, Gazebo type): "" where a program compiles, else why not."""
-    found = {}
-    for pair in pairs:
-        try:
-            compile_to_ros(pair)
-            found[(pair.ros_type, pair.gz_type)] = ""
-        except NotExpressibleError as err:
-            found[(pair.ros_type, pair.gz_type)] = str(err)
-    return found

@@ -92,12 +92,16 @@ def test_json_document(capsys: pytest.CaptureFixture[str]) -> None:
         "ros_type": "std_msgs/msg/Bool",
         "gz_type": "gz.msgs.Boolean",
         "origin": "std_msgs",
-        "native": True,
-        "python_because": "",
+        "native_to_ros": True,
+        "native_to_gz": True,
+        "python_to_ros_because": "",
+        "python_to_gz_because": "",
     } in (document["pairs"])
     by_types = {(pair["ros_type"], pair["gz_type"]): pair for pair in document["pairs"]}
     image = by_types[("sensor_msgs/msg/Image", "gz.msgs.Image")]
-    assert image["native"] is False
-    assert image["python_because"] == "a bulk pair (it has its own path)"
+    assert (image["native_to_ros"], image["native_to_gz"]) == (False, False)
+    assert image["python_to_gz_because"] == "a bulk pair (it has its own path)"
+    clock = by_types[("rosgraph_msgs/msg/Clock", "gz.msgs.Clock")]
+    assert (clock["native_to_ros"], clock["native_to_gz"]) == (True, True)
     assert isinstance(document["services"], list)
     assert isinstance(document["unavailable"], dict)
