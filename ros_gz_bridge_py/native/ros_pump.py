@@ -17,6 +17,7 @@ import functools
 import logging
 import socket
 import threading
+import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -148,6 +149,7 @@ class RosChannelPump:
                 self._count()
             except Exception:  # the loop must outlive anything, as the readers do
                 _LOG.exception("unexpected error in the native loop of %s", self._publisher.topic)
+                time.sleep(TURN)  # and not spin on an error that stays
 
     def _sync(self) -> None:
         """Tell the C loop the spellings subscribers take and the publishers to skip."""
