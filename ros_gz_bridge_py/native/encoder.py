@@ -43,9 +43,11 @@ from ros_gz_bridge_py.native.program import (
     ROS_KINDS,
     NotExpressibleError,
     Path,
-    _split,
-    _text,
+    gz_field,
     named,
+    ros_kind,
+    split_path,
+    text_words,
 )
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
@@ -158,7 +160,7 @@ def _assign(fill: Fill, ros: Path, gz: Path, out: Node) -> None:
         leaf(ros, gz, out)
     elif isinstance(fill.shape, Table):
         for ros_path, gz_path, how in fill.shape.parts:
-            _entry((*ros, *_split(ros_path)), (*gz, *_split(gz_path)), how, out)
+            _entry((*ros, *split_path(ros_path)), (*gz, *split_path(gz_path)), how, out)
     elif isinstance(fill.shape, Each):
         element = Node()
         _assign(fill.shape.fill, (), (), element)
@@ -225,15 +227,15 @@ def _read_ops(
         kind = type(rosidl).__name__
         basic = cdr.basic_of(rosidl)
         if basic is not None:
-            ops += [R_NUM, _kind(rosidl), frame.slot(path, rosidl)]
+            ops += [R_NUM, ros_kind(rosidl)[0], frame.slot(path, rosidl)]
         elif kind in cdr.STRING_TYPES:
             ops += [R_STR, frame.slot(path, rosidl)]
         elif kind == "NamespacedType":
             ops += _read_ops(cdr.nested_class(rosidl), path, frame, elements)
         elif kind == "Array" and cdr.basic_of(rosidl.value_type) is not None:
-            ops += [R_ARR, _kind(rosidl.value_type), rosidl.size, frame.slot(path, rosidl)]
+            ops += [R_ARR, ros_kind(rosidl.value_type)[0], rosidl.size, frame.slot(path, rosidl)]
         elif kind in cdr.SEQUENCE_TYPES and cdr.basic_of(rosidl.value_type) is not None:
-            ops += [R_SEQ_NUM, _kind(rosidl.value_type), frame.slot(path, rosidl)]
+            ops += [R_SEQ_NUM, ros_kind(rosidl.value_type)[0], frame.slot(path, rosidl)]
         elif kind in cdr.SEQUENCE_TYPES and type(rosidl.value_type).__name__ in cdr.STRING_TYPES:
             ops += [R_SEQ_STR, frame.slot(path, rosidl)]
         elif kind in cdr.SEQUENCE_TYPES and type(rosidl.value_type).__name__ == "NamespacedType":
@@ -264,24 +266,16 @@ def _sequences(node: Node) -> dict[Path, Node]:
     return found
 
 
-def _kind(rosidl: Any) -> int:
-    basic = cdr.basic_of(rosidl)
-    if basic not in ROS_KINDS:
-        msg = f"ROS type {basic} is not read natively"
-        raise NotExpressibleError(msg)
-    return ROS_KINDS[basic][0]
-
-
 # ---- the gz side: write ops ---------------------------------------------------------------------
 
 
 def _write_ops(node: Node, descriptor: Any, frame: _Frame) -> list[int]:
     ops: list[int] = []
-    ordered = sorted(node.fields.items(), key=lambda item: _field(descriptor, item[0]).number)
+    ordered = sorted(node.fields.items(), key=lambda item: gz_field(descriptor, item[0]).number)
     for name, value in ordered:
-        gz_field = _field(descriptor, name)
+        field = gz_field(descriptor, name)
         for item in value if isinstance(value, list) else [value]:
-            ops += _write_one(item, gz_field, frame, repeated=isinstance(value, list))
+            ops += _write_one(item, field, frame, repeated=isinstance(value, list))
     return ops
 
 
@@ -298,7 +292,7 @@ def _write_one(item: Any, gz_field: Any, frame: _Frame, *, repeated: bool) -> li
         if gz_field.type != _PB_STRING or gz_field.is_repeated:
             msg = f"{gz_field.full_name} is not a string"
             raise NotExpressibleError(msg)
-        return [W_CONST_STR, number, *_text(item.value.encode())]
+        return [W_CONST_STR, number, *text_words(item.value.encode())]
     if isinstance(item, Sequence):
         element = frame.elements.get(item.ros)
         if element is None or gz_field.message_type is None or not gz_field.is_repeated:
@@ -312,7 +306,7 @@ def _write_one(item: Any, gz_field: Any, frame: _Frame, *, repeated: bool) -> li
         if not gz_field.is_repeated or gz_field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
             msg = f"{gz_field.full_name} is not a repeated number"
             raise NotExpressibleError(msg)
-        kind = _kind(rosidl.value_type)
+        kind = ros_kind(rosidl.value_type)[0]
         _check_number(gz_field, kind)
         return [W_PACKED, number, gz_field.type, kind, frame.slots[item.ros]]
     if isinstance(item, Copy):
@@ -326,7 +320,7 @@ def _write_one(item: Any, gz_field: Any, frame: _Frame, *, repeated: bool) -> li
         if repeated or gz_field.is_repeated:
             msg = f"{gz_field.full_name}: one number into a repeated field"
             raise NotExpressibleError(msg)
-        kind = _kind(rosidl)
+        kind = ros_kind(rosidl)[0]
         _check_number(gz_field, kind)
         return [W_NUM, number, gz_field.type, kind, CONV_WRAP if item.wrap else CONV_EXACT, slot]
     msg = f"{type(item).__name__} into {gz_field.full_name}"
@@ -347,14 +341,6 @@ def _check_number(gz_field: Any, kind: int) -> None:
     if gz_field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP):
         msg = f"{gz_field.full_name} is not a number"
         raise NotExpressibleError(msg)
-
-
-def _field(descriptor: Any, name: str) -> Any:
-    found = descriptor.fields_by_name.get(name)
-    if found is None:
-        msg = f"{descriptor.full_name} has no field {name!r}"
-        raise NotExpressibleError(msg)
-    return found
 
 
 def _clock(out: Node) -> None:

@@ -120,7 +120,7 @@ Source = Copy | HeaderText | FixedList | Sequence | Column | ClockPart
 Assignments = dict[Path, Source]
 
 
-def _split(path: str) -> Path:
+def split_path(path: str) -> Path:
     return tuple(path.split(".")) if path else ()
 
 
@@ -209,7 +209,7 @@ def _assign(fill: Fill, ros: Path, gz: Path, out: Assignments) -> None:
         leaf(ros, gz, out)
     elif isinstance(fill.shape, Table):
         for ros_path, gz_path, how in fill.shape.parts:
-            _entry((*ros, *_split(ros_path)), (*gz, *_split(gz_path)), how, out)
+            _entry((*ros, *split_path(ros_path)), (*gz, *split_path(gz_path)), how, out)
     elif isinstance(fill.shape, Each):
         out[ros] = Sequence(gz, assignments_of(fill.shape.fill), fill.shape.new_ros)
     else:
@@ -275,7 +275,7 @@ class _Schema:
 # ---- ops -------------------------------------------------------------------------------------
 
 
-def _text(data: bytes) -> list[int]:
+def text_words(data: bytes) -> list[int]:
     """A byte string as words: its length, then the bytes four to a word."""
     padded = data + bytes(-len(data) % 4)
     return [len(data), *array("i", padded)]
@@ -292,13 +292,13 @@ def _walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
     descriptor of the field the last name names."""
     steps = []
     for name in path[:-1]:
-        field = _field(descriptor, name)
+        field = gz_field(descriptor, name)
         if field.message_type is None or field.is_repeated:
             msg = f"{descriptor.full_name}.{name} is not a singular submessage"
             raise NotExpressibleError(msg)
         steps.append(field.number)
         descriptor = field.message_type
-    return steps, _field(descriptor, path[-1])
+    return steps, gz_field(descriptor, path[-1])
 
 
 def _descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
@@ -312,7 +312,8 @@ def _descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
     return [*steps, field.number], field.message_type
 
 
-def _field(descriptor: Any, name: str) -> Any:
+def gz_field(descriptor: Any, name: str) -> Any:
+    """The field ``name`` of a protobuf message ``descriptor``."""
     field = descriptor.fields_by_name.get(name)
     if field is None:
         msg = f"{descriptor.full_name} has no field {name!r}"
@@ -326,7 +327,8 @@ def _scalar_field(field: Any) -> None:
         raise NotExpressibleError(msg)
 
 
-def _kind(slot: Any) -> tuple[int, str]:
+def ros_kind(slot: Any) -> tuple[int, str]:
+    """The program's number and the struct code of a ROS basic type."""
     basic = cdr.basic_of(slot)
     if basic not in ROS_KINDS:
         msg = f"ROS type {basic or type(slot).__name__} is not written natively"
@@ -370,25 +372,25 @@ class _Emitter:
         if isinstance(source, Copy):
             steps, field = _walk(gz, source.gz)
             _scalar_field(field)
-            ros_kind, code = _kind(slot)
+            kind_number, code = ros_kind(slot)
             if code in "fd" and field.cpp_type not in (5, 6):  # CPPTYPE_DOUBLE, CPPTYPE_FLOAT
                 msg = f"{field.full_name} is not a floating-point number"
                 raise NotExpressibleError(msg)
             conv = CONV_WRAP if source.wrap else CONV_EXACT
-            return [OP_NUM, len(steps), *steps, field.number, field.type, ros_kind, conv]
+            return [OP_NUM, len(steps), *steps, field.number, field.type, kind_number, conv]
         if isinstance(source, HeaderText) and kind in cdr.STRING_TYPES:
             steps, _header_type = _descend(gz, source.gz)
             return [
                 OP_HEADER_STR, len(steps), *steps, int(source.last),
-                *_text(source.key.encode()), *_text(_plain(default)),
+                *text_words(source.key.encode()), *text_words(_plain(default)),
             ]  # fmt: skip
         if isinstance(source, FixedList) and kind == "Array":
             steps, field = _walk(gz, source.gz)
             if not field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
                 msg = f"{field.full_name} is not a repeated number"
                 raise NotExpressibleError(msg)
-            ros_kind, _code = _kind(slot.value_type)
-            return [OP_FIXED_LIST, len(steps), *steps, field.number, field.type, ros_kind,
+            kind_number, _code = ros_kind(slot.value_type)
+            return [OP_FIXED_LIST, len(steps), *steps, field.number, field.type, kind_number,
                     slot.size]  # fmt: skip
         if isinstance(source, Sequence) and kind in cdr.SEQUENCE_TYPES:
             steps, field = _walk(gz, source.gz)
@@ -411,8 +413,8 @@ class _Emitter:
             if type(slot.value_type).__name__ in cdr.STRING_TYPES and sub.type == _PB_STRING:
                 return [OP_COLUMN_STR, *head]
             _scalar_field(sub)
-            ros_kind, _code = _kind(slot.value_type)
-            return [OP_COLUMN, *head, sub.type, ros_kind]
+            kind_number, _code = ros_kind(slot.value_type)
+            return [OP_COLUMN, *head, sub.type, kind_number]
         if isinstance(source, ClockPart) and cdr.basic_of(slot) is not None:
             steps, _time_type = _descend(gz, source.gz)
             return [OP_CLOCK, len(steps), *steps, source.part]
@@ -423,14 +425,14 @@ class _Emitter:
         """The ops that write ``value``, a ROS field's default."""
         kind = type(slot).__name__
         if cdr.basic_of(slot) is not None:
-            ros_kind, code = _kind(slot)
-            return [OP_CONST, ros_kind, *_bits(code, value)]
+            kind_number, code = ros_kind(slot)
+            return [OP_CONST, kind_number, *_bits(code, value)]
         if kind in cdr.STRING_TYPES:
-            return [OP_CONST_STR, *_text(_plain(value))]
+            return [OP_CONST_STR, *text_words(_plain(value))]
         if kind == "Array" and cdr.basic_of(slot.value_type) is not None:
-            _ros_kind, code = _kind(slot.value_type)
+            _kind_number, code = ros_kind(slot.value_type)
             data = struct.pack(f"<{slot.size}{code}", *value)
-            return [OP_CONST_BLOCK, struct.calcsize(code), *_text(data)]
+            return [OP_CONST_BLOCK, struct.calcsize(code), *text_words(data)]
         if kind in cdr.SEQUENCE_TYPES and len(value) == 0:
             return [OP_CONST, ROS_KINDS["uint32"][0], 0, 0]
         msg = f"a default {kind} the program cannot write"
