@@ -1,14 +1,18 @@
-"""Write the inputs of the native transcoder's fuzz target (fuzz/transcode_fuzz.c).
+"""Write the inputs of the native transcoders' fuzz targets (fuzz/transcode_fuzz.c,
+fuzz/encode_fuzz.c).
 
 Usage::
 
-    python -m tools.native_fuzz_programs OUT_DIR
+    python -m tools.native_fuzz_programs OUT_DIR [--target encode]
 
 writes ``OUT_DIR/programs.h``, the words of every pair whose program compiles
 (``compile_to_ros``) as C arrays, and ``OUT_DIR/corpus/``, the seed inputs: per program, its
 index byte then a valid payload (empty, and a message with every field set,
 :func:`distinctive`); and one seed of each program-loading mode (the fuzz target's comment
-says how an input is read). Both are build products under ``.build/``, never committed.
+says how an input is read). With ``--target encode``, the same for the ROS -> Gazebo encoders
+(``compile_to_gz``): ``OUT_DIR/encoders.h``, and seeds of CDR messages (the default message,
+and one with every field set, :func:`distinctive_ros`). Both are build products under
+``.build/``, never committed.
 """
 
 from __future__ import annotations
@@ -20,11 +24,21 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from rclpy.serialization import serialize_message
+
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native.program import Compiled, NotExpressibleError, compile_to_ros
+from ros_gz_bridge_py.native import encoder as enc
+from ros_gz_bridge_py.native.encoder import compile_to_gz
+from ros_gz_bridge_py.native.program import (
+    ROS_KINDS,
+    Compiled,
+    NotExpressibleError,
+    compile_to_ros,
+)
+from ros_gz_bridge_py.ros import cdr_types as cdr
 
-#: The fuzz target's modes, by the first input byte (fuzz/transcode_fuzz.c).
+#: The fuzz targets' modes, by the first input byte (fuzz/transcode_fuzz.c, fuzz/encode_fuzz.c).
 LOAD_MODE, MUTATE_MODE = 0x80, 0xC0
 _HEADER_TYPES = {"gz.msgs.Header", "ignition.msgs.Header"}
 _FLOAT, _DOUBLE, _BOOL, _STRING, _BYTES, _ENUM = 2, 1, 8, 9, 12, 14
@@ -37,6 +51,17 @@ def compiled_pairs() -> list[tuple[Pair, Compiled]]:
     for pair in default_registry().pairs:
         try:
             found.append((pair, compile_to_ros(pair)))
+        except NotExpressibleError:
+            continue
+    return found
+
+
+def compiled_encoders() -> list[tuple[Pair, bytes]]:
+    """Every pair of the default registry whose encoder compiles, in registry order."""
+    found = []
+    for pair in default_registry().pairs:
+        try:
+            found.append((pair, compile_to_gz(pair)))
         except NotExpressibleError:
             continue
     return found
@@ -116,6 +141,62 @@ def distinctive(gz_type: str) -> Any:
     return fill(message_class(gz_type)(), itertools.count(1))
 
 
+#: Bits of the ROS integer types, and whether they are signed.
+_ROS_INTEGERS = {
+    "int8": (8, True), "uint8": (8, False), "int16": (16, True), "uint16": (16, False),
+    "int32": (32, True), "uint32": (32, False), "int64": (64, True), "uint64": (64, False),
+}  # fmt: skip
+
+
+def _ros_scalar(basic: str, n: int) -> Any:
+    """A positive value of ROS type ``basic`` that few other fields given another ``n`` have
+    (small enough for every Gazebo field a converter assigns it to)."""
+    if basic in ("float", "double"):
+        return n + 0.5
+    if basic == "boolean":
+        return True
+    bits, signed = _ROS_INTEGERS[basic]
+    return (n * 7 + 3) % 2 ** (bits - signed) or 1
+
+
+def fill_ros(msg: Any, counter: Iterator[int], depth: int = 0) -> Any:
+    """Sets every field of the ROS ``msg`` (counter values, several elements per sequence;
+    ``char`` and ``octet`` fields, which no encoder reads, keep their default) and returns it."""
+    for name, rosidl in cdr.fields_of(type(msg)):
+        kind, basic = type(rosidl).__name__, cdr.basic_of(rosidl)
+        element = getattr(rosidl, "value_type", None)
+        element_basic = cdr.basic_of(element)
+        if basic in ("char", "octet") or element_basic in ("char", "octet"):
+            continue
+        if basic is not None:
+            setattr(msg, name, _ros_scalar(basic, next(counter)))
+        elif kind in cdr.STRING_TYPES:
+            setattr(msg, name, f"s{next(counter)}::part::é")
+        elif kind == "NamespacedType":
+            fill_ros(getattr(msg, name), counter, depth + 1)
+        elif kind == "Array" and element_basic is not None:
+            values = [_ros_scalar(element_basic, next(counter)) for _ in range(rosidl.size)]
+            setattr(msg, name, values)
+        elif kind in cdr.SEQUENCE_TYPES:
+            setattr(msg, name, _ros_items(element, counter, 3 if depth < 2 else 1, depth))
+    return msg
+
+
+def _ros_items(element: Any, counter: Iterator[int], count: int, depth: int) -> list[Any]:
+    basic = cdr.basic_of(element)
+    if basic is not None:
+        return [_ros_scalar(basic, next(counter)) for _ in range(count)]
+    if type(element).__name__ in cdr.STRING_TYPES:
+        return [f"s{next(counter)}é" for _ in range(count)]
+    cls = cdr.nested_class(element)
+    return [fill_ros(cls(), counter, depth + 1) for _ in range(count)]
+
+
+def distinctive_ros(ros_class: type[Any]) -> Any:
+    """A ``ros_class`` message with every field set to a value few other fields have."""
+    return fill_ros(ros_class(), itertools.count(1))
+
+
 def _words(name: str, data: bytes) -> str:
     values = struct.unpack(f"<{len(data) // 4}i", data)
     return f"static const int32_t {name}[] = {{{', '.join(map(str, values))}}};\n"
@@ -157,17 +238,107 @@ def seeds(programs: Sequence[tuple[Pair, Compiled]]) -> dict[str, bytes]:
     return found
 
 
+def encoders_header_text(encoders: Sequence[tuple[Pair, bytes]]) -> str:
+    """The C header of the encoders: one words array per encoder, and the table of them."""
+    lines = ["/* Generated by tools/native_fuzz_programs.py: do not edit, do not commit. */\n"]
+    lines.append("#include <stddef.h>\n#include <stdint.h>\n\n")
+    for i, (_pair, words) in enumerate(encoders):
+        lines.append(_words(f"encoder_{i}", words))
+    lines.append("\nstruct fuzz_encoder {\n    const char *name;\n")
+    lines.append("    const int32_t *words;\n    size_t len;\n};\n\n")
+    lines.append("static const struct fuzz_encoder ENCODERS[] = {\n")
+    for i, (pair, words) in enumerate(encoders):
+        lines.append(
+            f'    {{"{pair.ros_type} -> {pair.gz_type}", encoder_{i}, {len(words) // 4}}},\n'
+        )
+    lines.append("};\n")
+    lines.append(f"#define ENCODER_COUNT {len(encoders)}\n")
+    return "".join(lines)
+
+
+def encoder_seeds(encoders: Sequence[tuple[Pair, bytes]]) -> dict[str, bytes]:
+    """Seed inputs of fuzz/encode_fuzz.c by file name (its comment says how they are read)."""
+    found = {}
+    for i, (pair, words) in enumerate(encoders):
+        cdr_default = serialize_message(pair.ros_class())
+        cdr_full = serialize_message(distinctive_ros(pair.ros_class))
+        found[f"encoder{i:02d}-default"] = bytes([i]) + cdr_default
+        found[f"encoder{i:02d}-distinctive"] = bytes([i]) + cdr_full
+        length = struct.pack("<I", len(words) // 4)
+        found[f"load{i:02d}"] = bytes([LOAD_MODE]) + length + words + cdr_full[4:]
+        # Mutate mode: encoder i, no edit (the edit count byte is 0), then the message.
+        found[f"mutate{i:02d}"] = bytes([MUTATE_MODE, i, 0]) + cdr_full
+    for name, (ops, body) in _SYNTHETIC.items():
+        found[f"load-{name}"] = struct.pack(f"<BI{len(ops)}i", LOAD_MODE, len(ops), *ops) + body
+    return found
+
+
+def _encoder_words(nslots: int, read: list[int], write: list[int]) -> list[int]:
+    return [nslots, len(read) + 1, *read, enc.R_END, *write, enc.W_END]
+
+
+_ROS = {name: kind for name, (kind, _code) in ROS_KINDS.items()}
+_PB_SINT32, _PB_UINT32, _PB_SINT64, _PB_FIXED32, _PB_ENUM = 17, 13, 18, 7, 14
+#: Encoders no pair compiles to, with a CDR body for each, as seeds of the load mode: the ops
+#: and types the compiled ones leave out (string sequences, 16-bit and 8-bit integers, a
+#: wrapped uint32, zigzag and fixed fields, nested message sequences).
+_SYNTHETIC: dict[str, tuple[list[int], bytes]] = {
+    "string-sequence": (
+        _encoder_words(1, [enc.R_SEQ_STR, 0], [enc.W_SEQ_STR, 1, 0]),
+        struct.pack("<II", 2, 2) + b"a\0\0\0" + struct.pack("<I", 3) + b"bc\0",
+    ),
+    "integers": (
+        _encoder_words(
+            4,
+            [enc.R_NUM, _ROS["int16"], 0, enc.R_NUM, _ROS["uint32"], 1,
+             enc.R_SEQ_NUM, _ROS["int8"], 2, enc.R_ARR, _ROS["uint16"], 3, 3],
+            [enc.W_NUM, 1, _PB_SINT32, _ROS["int16"], enc.CONV_EXACT, 0,
+             enc.W_NUM, 2, _PB_UINT32, _ROS["uint32"], enc.CONV_WRAP, 1,
+             enc.W_PACKED, 3, _PB_SINT64, _ROS["int8"], 2,
+             enc.W_PACKED, 4, _PB_FIXED32, _ROS["uint16"], 3],
+        ),
+        struct.pack("<hxxIIbbbxhhh", -5, 2**32 - 1, 3, -1, 0, 1, 7, -1, 300),
+    ),
+    "nested-sequences": (
+        _encoder_words(
+            1,
+            [enc.R_SEQ_MSG, 0, 2, 6, enc.R_NUM, _ROS["int32"], 0, enc.R_STR, 1, enc.R_END],
+            [enc.W_SEQ_MSG, 1, 0, 2, 10,
+             enc.W_NUM, 1, _PB_ENUM, _ROS["int32"], enc.CONV_EXACT, 0, enc.W_STR, 2, 1, enc.W_END],
+        ),
+        struct.pack("<Ii", 2, -3) + struct.pack("<I", 2) + b"x\0\0\0" + struct.pack("<iI", 9, 1)
+        + b"\0",
+    ),
+}  # fmt: skip
+
+
+def _write(out: Path, header: str, text: str, inputs: dict[str, bytes]) -> Path:
+    corpus = out / "corpus"
+    corpus.mkdir(parents=True, exist_ok=True)
+    (out / header).write_text(text)
+    for name, data in inputs.items():
+        (corpus / name).write_bytes(data)
+    return corpus
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out", type=Path, help="directory for programs.h and corpus/")
+    parser.add_argument("out", type=Path, help="directory for the header and corpus/")
+    parser.add_argument(
+        "--target", choices=("transcode", "encode"), default="transcode",
+        help="the fuzz target: transcode (programs.h) or encode (encoders.h)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
-    programs = compiled_pairs()
-    corpus = args.out / "corpus"
-    corpus.mkdir(parents=True, exist_ok=True)
-    (args.out / "programs.h").write_text(header_text(programs))
-    for name, data in seeds(programs).items():
-        (corpus / name).write_bytes(data)
-    print(f"{len(programs)} programs into {args.out / 'programs.h'}, seeds into {corpus}")
+    if args.target == "encode":
+        encoders = compiled_encoders()
+        text, inputs = encoders_header_text(encoders), encoder_seeds(encoders)
+        header, count = "encoders.h", f"{len(encoders)} encoders"
+    else:
+        programs = compiled_pairs()
+        text, inputs = header_text(programs), seeds(programs)
+        header, count = "programs.h", f"{len(programs)} programs"
+    corpus = _write(args.out, header, text, inputs)
+    print(f"{count} into {args.out / header}, seeds into {corpus}")
     return 0
 
 

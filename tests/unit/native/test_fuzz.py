@@ -1,12 +1,14 @@
-"""The native transcoder under libFuzzer, with AddressSanitizer and UndefinedBehaviorSanitizer,
+"""The native transcoders under libFuzzer, with AddressSanitizer and UndefinedBehaviorSanitizer,
 then with MemorySanitizer.
 
-The target (fuzz/transcode_fuzz.c) links transcode.c directly, with every compiled pair's
-program from a header generated here (tools/native_fuzz_programs.py). It is built with
-clang-14 into ``.build/fuzz/<sanitizer>-<hash>/``, once per hash of its sources, programs and
-flags; the builds share ``FUZZ_SECONDS`` (60 by default; ``make fuzz`` and ``make soak`` run
-it longer). The corpus is kept in ``.build/fuzz/corpus`` between runs; inputs that crash are
-written to ``.build/fuzz/artifacts/``, and every later run tries them first. Without clang-14
+Two targets: fuzz/transcode_fuzz.c links transcode.c (Gazebo -> ROS) with every compiled
+pair's program, fuzz/encode_fuzz.c links encode.c (ROS -> Gazebo) with every compiled pair's
+encoder, each from a header generated here (tools/native_fuzz_programs.py). Each is built with
+clang-14 into ``.build/fuzz/<target>-<sanitizer>-<hash>/``, once per hash of its sources,
+header and flags; the builds share ``FUZZ_SECONDS`` (60 by default; ``make fuzz`` and
+``make soak`` run it longer). Each target's corpus is kept in ``.build/fuzz/`` between runs
+(``corpus``, ``encode-corpus``); inputs that crash are written beside it (``artifacts/``,
+``encode-artifacts/``), and every later run tries them first. Without clang-14
 (``tools/setup_fuzz.sh`` installs it) the test skips, and fails under CI=true.
 """
 
@@ -19,6 +21,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -26,11 +29,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[3]
 BUILD = ROOT / ".build" / "fuzz"
 NATIVE = ROOT / "ros_gz_bridge_py" / "native"
-SOURCES = (ROOT / "fuzz" / "transcode_fuzz.c", NATIVE / "transcode.c", NATIVE / "transcode.h")
 CLANG = "clang-14"
 FLAGS = ("-g", "-O1", "-fno-sanitize-recover=all", "-std=gnu11", "-Wall", "-Wextra")
-#: The builds, and each one's share of the fuzzing time: AddressSanitizer with
-#: UndefinedBehaviorSanitizer, and MemorySanitizer, which alone sees a read of memory never
+#: The builds of each target, and each one's share of the target's time: AddressSanitizer
+#: with UndefinedBehaviorSanitizer, and MemorySanitizer, which alone sees a read of memory never
 #: written (it found one, in the header lookup of a program whose path misled it).
 SANITIZERS = {
     "asan-ubsan": (("-fsanitize=fuzzer,address,undefined",), 2 / 3),
@@ -41,6 +43,35 @@ FINDINGS = (
     "ERROR: AddressSanitizer", "WARNING: MemorySanitizer", "runtime error:", "ERROR: libFuzzer",
     "SUMMARY: ",
 )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Target:
+    """A fuzz target: its source, the native files it links or includes, the header
+    tools/native_fuzz_programs.py writes for it, where its corpus and findings are kept, and
+    its share of the fuzzing time."""
+
+    source: str
+    native: tuple[str, ...]
+    header: str
+    corpus: str
+    artifacts: str
+    share: float
+
+    def sources(self) -> list[Path]:
+        return [ROOT / "fuzz" / self.source, *(NATIVE / name for name in self.native)]
+
+
+TARGETS = {
+    "transcode": Target(
+        "transcode_fuzz.c", ("transcode.c", "transcode.h"), "programs.h", "corpus", "artifacts",
+        1 / 2,
+    ),
+    "encode": Target(
+        "encode_fuzz.c", ("encode.c", "encode.h", "transcode.h"), "encoders.h", "encode-corpus",
+        "encode-artifacts", 1 / 2,
+    ),
+}  # fmt: skip
 
 
 def fuzz_seconds() -> int:
@@ -58,46 +89,51 @@ def require_clang() -> str:
     pytest.skip(reason)
 
 
-def _generate(out: Path) -> None:
+def _generate(out: Path, name: str) -> None:
     subprocess.run(
-        [sys.executable, "-m", "tools.native_fuzz_programs", str(out)],
+        [sys.executable, "-m", "tools.native_fuzz_programs", str(out), "--target", name],
         check=True, cwd=ROOT, capture_output=True, text=True,
     )  # fmt: skip
 
 
-def build(clang: str, sanitizer: str) -> tuple[Path, Path]:
-    """The fuzz target and its seed corpus, built unless this hash was built already."""
+def build(clang: str, name: str, sanitizer: str) -> tuple[Path, Path]:
+    """Target ``name``'s binary and its seed corpus, built unless this hash was built already."""
     flags = (*FLAGS, *SANITIZERS[sanitizer][0])
+    sources = TARGETS[name].sources()
+    binary = f"{name}_fuzz"
     BUILD.mkdir(parents=True, exist_ok=True)
     work = Path(tempfile.mkdtemp(dir=BUILD, prefix="tmp-"))
     try:
-        _generate(work)
-        digest = hashlib.sha256((work / "programs.h").read_bytes())
-        for source in SOURCES:
+        _generate(work, name)
+        digest = hashlib.sha256((work / TARGETS[name].header).read_bytes())
+        for source in sources:
             digest.update(source.read_bytes())
         digest.update(" ".join((CLANG, *flags)).encode())
-        target = BUILD / f"{sanitizer}-{digest.hexdigest()[:16]}"
-        if not (target / "transcode_fuzz").exists():
+        target = BUILD / f"{name}-{sanitizer}-{digest.hexdigest()[:16]}"
+        if not (target / binary).exists():
+            compiled = [str(source) for source in sources if source.suffix == ".c"]
             result = subprocess.run(
-                [clang, *flags, "-I", str(work), "-I", str(NATIVE), str(SOURCES[0]),
-                 str(SOURCES[1]), "-o", str(work / "transcode_fuzz"), "-lm"],
+                [clang, *flags, "-I", str(work), "-I", str(NATIVE), *compiled,
+                 "-o", str(work / binary), "-lm"],
                 check=False, capture_output=True, text=True,
             )  # fmt: skip
             assert result.returncode == 0, f"building the fuzz target failed:\n{result.stderr}"
             with contextlib.suppress(OSError):  # built meanwhile by another run
                 work.rename(target)
-        return target / "transcode_fuzz", target / "corpus"
+        return target / binary, target / "corpus"
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("sanitizer", SANITIZERS)
-def test_transcoder_survives_fuzzing(sanitizer: str) -> None:
-    binary, seeds = build(require_clang(), sanitizer)
-    seconds = max(1, round(fuzz_seconds() * SANITIZERS[sanitizer][1]))
-    corpus = BUILD / "corpus"
-    artifacts = BUILD / "artifacts"
+@pytest.mark.parametrize("name", TARGETS)
+def test_target_survives_fuzzing(name: str, sanitizer: str) -> None:
+    binary, seeds = build(require_clang(), name, sanitizer)
+    share = TARGETS[name].share * SANITIZERS[sanitizer][1]
+    seconds = max(1, round(fuzz_seconds() * share))
+    corpus = BUILD / TARGETS[name].corpus
+    artifacts = BUILD / TARGETS[name].artifacts
     corpus.mkdir(exist_ok=True)
     artifacts.mkdir(exist_ok=True)
     result = subprocess.run(
