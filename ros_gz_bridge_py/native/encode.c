@@ -5,7 +5,8 @@
  * them, and the slots and the output grow only with data that is there (with hard caps). What
  * the Python path might read otherwise (another encapsulation, a string without its NUL or
  * with one inside, text that is not UTF-8, a bool that is neither 0 nor 1, a number out of the
- * protobuf field's range) is left to it (RGB_FALLBACK). */
+ * protobuf field's range) is left to it (RGB_FALLBACK). A sequence's count is checked against
+ * the fewest bytes its elements take before any slot is made for them. */
 #include "encode.h"
 
 #include <math.h>
@@ -69,7 +70,8 @@ enum {
 
 enum { CONV_EXACT = 0, CONV_WRAP = 1 };
 
-#define MAX_SLOTS ((size_t)1 << 24)
+/* Slots of one message at most (40 bytes each): beyond, Python decides. */
+#define MAX_SLOTS ((size_t)1 << 22)
 #define MAX_OUTPUT ((size_t)1 << 30)
 #define MAX_DEPTH 32
 
@@ -239,6 +241,43 @@ static int new_frames(struct reader *r, size_t count, int32_t nslots, size_t *fi
     return 0;
 }
 
+/* The fewest bytes a message read by ops [op, end) takes on the wire (alignment aside): a
+ * lower bound that keeps a count from sizing more slots than the bytes can hold. */
+static size_t min_size(const int32_t *op, const int32_t *end) {
+    size_t size = 0;
+    while (op < end && *op != R_END) {
+        switch (*op++) {
+        case R_NUM:
+            size += ros_size(op[0]);
+            op += 2;
+            break;
+        case R_STR:
+            size += 5; /* the length and the NUL */
+            op += 1;
+            break;
+        case R_ARR:
+            size += ros_size(op[0]) * (size_t)op[1];
+            op += 3;
+            break;
+        case R_SEQ_NUM:
+            size += 4;
+            op += 2;
+            break;
+        case R_SEQ_STR:
+            size += 4;
+            op += 1;
+            break;
+        case R_SEQ_MSG:
+            size += 4;
+            op += 3 + op[2];
+            break;
+        default:
+            return 1;
+        }
+    }
+    return size ? size : 1;
+}
+
 /* Runs read ops [op, end) for the frame at `frame`. */
 static int read_message(struct reader *r, const int32_t *op, const int32_t *end, size_t frame,
                         int depth) {
@@ -287,7 +326,8 @@ static int read_message(struct reader *r, const int32_t *op, const int32_t *end,
             uint32_t count;
             status = cdr_u32(r, &count);
             if (status) return status;
-            if (count > r->n - r->pos) return RGB_UNDECODABLE; /* each element takes a byte */
+            /* the elements must fit the bytes left before any slot is made for them */
+            if (count > (r->n - r->pos) / min_size(body, body + body_len)) return RGB_UNDECODABLE;
             size_t first;
             status = new_frames(r, count, nslots, &first);
             if (status) return status;
