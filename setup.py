@@ -27,6 +27,7 @@ setup(
                 "ros_gz_bridge_py/native/encode.h",
                 "ros_gz_bridge_py/native/pump.h",
                 "ros_gz_bridge_py/native/transcode.h",
+                "ros_gz_bridge_py/native/wire.h",
             ],
             extra_compile_args=["-O2", "-std=gnu11", "-Wall", "-Wextra", "-fvisibility=hidden"],
             libraries=["dl"],

@@ -8,6 +8,7 @@
  * protobuf field's range) is left to it (RGB_FALLBACK). A sequence's count is checked against
  * the fewest bytes its elements take before any slot is made for them. */
 #include "encode.h"
+#include "wire.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -35,44 +36,8 @@ enum {
     W_SEQ_STR = 8,
 };
 
-/* ROS basic types (as in transcode.c). */
-enum {
-    ROS_BOOL = 1,
-    ROS_UINT8 = 2,
-    ROS_INT8 = 3,
-    ROS_INT16 = 4,
-    ROS_UINT16 = 5,
-    ROS_INT32 = 6,
-    ROS_UINT32 = 7,
-    ROS_INT64 = 8,
-    ROS_UINT64 = 9,
-    ROS_FLOAT = 10,
-    ROS_DOUBLE = 11,
-};
-
-/* Protobuf field types (google.protobuf.FieldDescriptor.TYPE_*) written here. */
-enum {
-    PB_DOUBLE = 1,
-    PB_FLOAT = 2,
-    PB_INT64 = 3,
-    PB_UINT64 = 4,
-    PB_INT32 = 5,
-    PB_FIXED64 = 6,
-    PB_FIXED32 = 7,
-    PB_BOOL = 8,
-    PB_UINT32 = 13,
-    PB_ENUM = 14,
-    PB_SFIXED32 = 15,
-    PB_SFIXED64 = 16,
-    PB_SINT32 = 17,
-    PB_SINT64 = 18,
-};
-
-enum { CONV_EXACT = 0, CONV_WRAP = 1 };
-
 /* Slots of one message at most (40 bytes each): beyond, Python decides. */
 #define MAX_SLOTS ((size_t)1 << 22)
-#define MAX_OUTPUT ((size_t)1 << 30)
 #define MAX_DEPTH 32
 
 /* A field kept for the write ops: a number's raw bits, or where the data is. */
@@ -90,28 +55,6 @@ struct reader {
     struct slot *pool;
     size_t used, cap;
 };
-
-static size_t ros_size(int32_t kind) {
-    switch (kind) {
-    case ROS_BOOL:
-    case ROS_UINT8:
-    case ROS_INT8:
-        return 1;
-    case ROS_INT16:
-    case ROS_UINT16:
-        return 2;
-    case ROS_INT32:
-    case ROS_UINT32:
-    case ROS_FLOAT:
-        return 4;
-    case ROS_INT64:
-    case ROS_UINT64:
-    case ROS_DOUBLE:
-        return 8;
-    default:
-        return 0;
-    }
-}
 
 /* ---- reading CDR -------------------------------------------------------------------------- */
 
@@ -138,38 +81,6 @@ static uint64_t load(const uint8_t *b, size_t size) {
     return bits;
 }
 
-/* Whether the bytes are well-formed UTF-8 (as Python's decode requires). */
-static int utf8_ok(const uint8_t *s, size_t n) {
-    size_t i = 0;
-    while (i < n) {
-        uint8_t c = s[i];
-        if (c < 0x80) {
-            i++;
-            continue;
-        }
-        size_t need;
-        uint8_t lo = 0x80, hi = 0xbf;
-        if (c >= 0xc2 && c <= 0xdf) {
-            need = 1;
-        } else if (c >= 0xe0 && c <= 0xef) {
-            need = 2;
-            if (c == 0xe0) lo = 0xa0;
-            if (c == 0xed) hi = 0x9f;
-        } else if (c >= 0xf0 && c <= 0xf4) {
-            need = 3;
-            if (c == 0xf0) lo = 0x90;
-            if (c == 0xf4) hi = 0x8f;
-        } else {
-            return 0;
-        }
-        if (n - i - 1 < need || s[i + 1] < lo || s[i + 1] > hi) return 0;
-        for (size_t k = 2; k <= need; k++)
-            if ((s[i + k] & 0xc0) != 0x80) return 0;
-        i += need + 1;
-    }
-    return 1;
-}
-
 /* A string: its bytes without the NUL, as Python reads them. */
 static int cdr_string(struct reader *r, struct slot *s) {
     uint32_t length;
@@ -179,7 +90,7 @@ static int cdr_string(struct reader *r, struct slot *s) {
     if (length == 0) return RGB_FALLBACK;
     const uint8_t *text = r->p + r->pos;
     if (text[length - 1] != 0 || memchr(text, 0, length - 1) != NULL) return RGB_FALLBACK;
-    if (!utf8_ok(text, length - 1)) return RGB_FALLBACK;
+    if (!rgb_utf8_valid(text, length - 1)) return RGB_FALLBACK;
     if (s != NULL) {
         s->offset = r->pos;
         s->count = length - 1;
@@ -189,7 +100,7 @@ static int cdr_string(struct reader *r, struct slot *s) {
 }
 
 static int cdr_number(struct reader *r, int32_t kind, struct slot *s) {
-    size_t size = ros_size(kind);
+    size_t size = rgb_ros_size(kind);
     int status = cdr_align(r, size);
     if (status) return status;
     if (r->n - r->pos < size) return RGB_UNDECODABLE;
@@ -202,7 +113,7 @@ static int cdr_number(struct reader *r, int32_t kind, struct slot *s) {
 
 /* `count` numbers of `kind` (aligned to their size when there are some). */
 static int cdr_numbers(struct reader *r, int32_t kind, size_t count, struct slot *s) {
-    size_t size = ros_size(kind);
+    size_t size = rgb_ros_size(kind);
     if (count) {
         int status = cdr_align(r, size);
         if (status) return status;
@@ -248,7 +159,7 @@ static size_t min_size(const int32_t *op, const int32_t *end) {
     while (op < end && *op != R_END) {
         switch (*op++) {
         case R_NUM:
-            size += ros_size(op[0]);
+            size += rgb_ros_size(op[0]);
             op += 2;
             break;
         case R_STR:
@@ -256,7 +167,7 @@ static size_t min_size(const int32_t *op, const int32_t *end) {
             op += 1;
             break;
         case R_ARR:
-            size += ros_size(op[0]) * (size_t)op[1];
+            size += rgb_ros_size(op[0]) * (size_t)op[1];
             op += 3;
             break;
         case R_SEQ_NUM:
@@ -351,35 +262,14 @@ static int read_message(struct reader *r, const int32_t *op, const int32_t *end,
 
 /* ---- writing protobuf ------------------------------------------------------------------- */
 
-static int grow(struct rgb_out *out, size_t extra) {
-    if (extra > MAX_OUTPUT - out->len) return RGB_FALLBACK;
-    size_t need = out->len + extra;
-    if (need <= out->cap) return 0;
-    size_t cap = out->cap ? out->cap : 256;
-    while (cap < need) cap = cap > MAX_OUTPUT / 2 ? MAX_OUTPUT : cap * 2;
-    uint8_t *data = realloc(out->data, cap);
-    if (data == NULL) return RGB_FALLBACK;
-    out->data = data;
-    out->cap = cap;
-    return 0;
-}
-
 static int put_varint(struct rgb_out *out, uint64_t value) {
-    int status = grow(out, 10);
+    int status = rgb_grow(out, 10);
     if (status) return status;
     do {
         uint8_t byte = value & 0x7f;
         value >>= 7;
         out->data[out->len++] = byte | (value ? 0x80 : 0);
     } while (value);
-    return 0;
-}
-
-static int put_bytes(struct rgb_out *out, const void *p, size_t n) {
-    int status = grow(out, n);
-    if (status) return status;
-    if (n) memcpy(out->data + out->len, p, n);
-    out->len += n;
     return 0;
 }
 
@@ -390,7 +280,7 @@ static int put_tag(struct rgb_out *out, int32_t field, int wire) {
 static int put_length_delimited(struct rgb_out *out, int32_t field, const uint8_t *p, size_t n) {
     int status = put_tag(out, field, 2);
     if (!status) status = put_varint(out, n);
-    if (!status) status = put_bytes(out, p, n);
+    if (!status) status = rgb_put(out, p, n);
     return status;
 }
 
@@ -509,32 +399,17 @@ static int pb_value(int32_t type, int32_t conv, struct number v, uint64_t *wire,
     return 0;
 }
 
-static int wire_of(int32_t type) {
-    switch (type) {
-    case PB_DOUBLE:
-    case PB_FIXED64:
-    case PB_SFIXED64:
-        return 1;
-    case PB_FLOAT:
-    case PB_FIXED32:
-    case PB_SFIXED32:
-        return 5;
-    default:
-        return 0;
-    }
-}
-
 static int put_value(struct rgb_out *out, int32_t type, uint64_t wire) {
-    switch (wire_of(type)) {
+    switch (rgb_wire_of(type)) {
     case 1: {
         uint8_t b[8];
         for (int k = 0; k < 8; k++) b[k] = (uint8_t)(wire >> (8 * k));
-        return put_bytes(out, b, 8);
+        return rgb_put(out, b, 8);
     }
     case 5: {
         uint8_t b[4];
         for (int k = 0; k < 4; k++) b[k] = (uint8_t)(wire >> (8 * k));
-        return put_bytes(out, b, 4);
+        return rgb_put(out, b, 4);
     }
     default:
         return put_varint(out, wire);
@@ -546,7 +421,7 @@ static int write_message(const struct reader *r, const int32_t *op, const int32_
 
 /* Starts a length-delimited value: room for its length, filled in by close_length. */
 static int open_length(struct rgb_out *out, size_t *mark) {
-    int status = grow(out, 5);
+    int status = rgb_grow(out, 5);
     if (status) return status;
     *mark = out->len;
     out->len += 5;
@@ -584,7 +459,6 @@ static const struct slot *slot_at(const struct reader *r, size_t frame, int32_t 
     return &r->pool[frame + (size_t)index];
 }
 
-static int32_t text_span(int32_t nbytes) { return 1 + (int32_t)(((size_t)nbytes + 3) / 4); }
 
 static int write_message(const struct reader *r, const int32_t *op, const int32_t *end,
                          size_t frame, struct rgb_out *out, int depth) {
@@ -599,7 +473,7 @@ static int write_message(const struct reader *r, const int32_t *op, const int32_
             int zero = 0;
             status = pb_value(op[1], op[3], ros_number(op[2], s->bits), &wire, &zero);
             if (!status && !zero) {
-                status = put_tag(out, op[0], wire_of(op[1]));
+                status = put_tag(out, op[0], rgb_wire_of(op[1]));
                 if (!status) status = put_value(out, op[1], wire);
             }
             op += 5;
@@ -616,7 +490,7 @@ static int write_message(const struct reader *r, const int32_t *op, const int32_
         case W_CONST_STR: /* field, text */
             if (op[1])
                 status = put_length_delimited(out, op[0], (const uint8_t *)(op + 2), (size_t)op[1]);
-            op += 1 + text_span(op[1]);
+            op += 1 + (int32_t)rgb_text_span(op[1]);
             break;
         case W_MSG: { /* field, body length, body */
             const int32_t *body = op + 2;
@@ -635,7 +509,7 @@ static int write_message(const struct reader *r, const int32_t *op, const int32_
         }
         case W_PACKED: { /* field, pb type, ros kind, slot */
             const struct slot *s = slot_at(r, frame, op[3]);
-            size_t size = ros_size(op[2]);
+            size_t size = rgb_ros_size(op[2]);
             if (s->count) {
                 size_t mark;
                 status = put_tag(out, op[0], 2);
@@ -698,7 +572,6 @@ static int pb_ok(int32_t type) {
 /* A protobuf field number (1 to 2^29 - 1: the tag keeps 3 bits for the wire type). */
 static int field_ok(int32_t field) { return field >= 1 && field <= (1 << 29) - 1; }
 
-static int room(size_t n, size_t at, size_t k) { return at <= n && k <= n - at ? 0 : -1; }
 
 /* Checks read ops [0, n) of a frame of `nslots` slots. */
 static int check_read(const int32_t *ops, size_t n, int32_t nslots, int depth) {
@@ -712,23 +585,23 @@ static int check_read(const int32_t *ops, size_t n, int32_t nslots, int depth) {
             return at == n ? 0 : -1;
         case R_NUM:
         case R_SEQ_NUM:
-            if (room(n, at, 2) || !kind_ok(ops[at]) || !SLOT_OK(ops[at + 1])) return -1;
+            if (rgb_room(n, at, 2) || !kind_ok(ops[at]) || !SLOT_OK(ops[at + 1])) return -1;
             at += 2;
             break;
         case R_STR:
         case R_SEQ_STR:
-            if (room(n, at, 1) || !SLOT_OK(ops[at])) return -1;
+            if (rgb_room(n, at, 1) || !SLOT_OK(ops[at])) return -1;
             at += 1;
             break;
         case R_ARR:
-            if (room(n, at, 3) || !kind_ok(ops[at]) || ops[at + 1] < 0 || ops[at + 1] > (1 << 24) ||
+            if (rgb_room(n, at, 3) || !kind_ok(ops[at]) || ops[at + 1] < 0 || ops[at + 1] > (1 << 24) ||
                 !SLOT_OK(ops[at + 2]))
                 return -1;
             at += 3;
             break;
         case R_SEQ_MSG:
-            if (room(n, at, 3) || !SLOT_OK(ops[at]) || ops[at + 1] < 0 || ops[at + 1] > 4096 ||
-                ops[at + 2] < 1 || room(n, at + 3, (size_t)ops[at + 2]) ||
+            if (rgb_room(n, at, 3) || !SLOT_OK(ops[at]) || ops[at + 1] < 0 || ops[at + 1] > 4096 ||
+                ops[at + 2] < 1 || rgb_room(n, at + 3, (size_t)ops[at + 2]) ||
                 check_read(ops + at + 3, (size_t)ops[at + 2], ops[at + 1], depth + 1))
                 return -1;
             at += 3 + (size_t)ops[at + 2];
@@ -821,7 +694,7 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
         case W_END:
             return at == n ? 0 : -1;
         case W_NUM:
-            if (room(n, at, 5) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
+            if (rgb_room(n, at, 5) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
                 !kind_ok(ops[at + 2]) ||
                 (ops[at + 3] != CONV_EXACT && ops[at + 3] != CONV_WRAP) ||
                 !FILLED(ops[at + 4], R_NUM) || f->kinds[ops[at + 4]] != ops[at + 2])
@@ -830,26 +703,26 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
             break;
         case W_STR:
         case W_STR_REP:
-            if (room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_STR)) return -1;
+            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_STR)) return -1;
             at += 2;
             break;
         case W_CONST_STR:
-            if (room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 0 ||
-                room(n, at + 1, (size_t)text_span(ops[at + 1])))
+            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 0 ||
+                rgb_room(n, at + 1, rgb_text_span(ops[at + 1])))
                 return -1;
-            at += 1 + (size_t)text_span(ops[at + 1]);
+            at += 1 + rgb_text_span(ops[at + 1]);
             break;
         case W_MSG:
-            if (room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 1 ||
-                room(n, at + 2, (size_t)ops[at + 1]) ||
+            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 1 ||
+                rgb_room(n, at + 2, (size_t)ops[at + 1]) ||
                 check_write(ops + at + 2, (size_t)ops[at + 1], f, depth + 1))
                 return -1;
             at += 2 + (size_t)ops[at + 1];
             break;
         case W_SEQ_MSG: {
-            if (room(n, at, 4) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_MSG) ||
+            if (rgb_room(n, at, 4) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_MSG) ||
                 ops[at + 2] != f->body_slots[ops[at + 1]] || ops[at + 3] < 1 ||
-                room(n, at + 4, (size_t)ops[at + 3]))
+                rgb_room(n, at + 4, (size_t)ops[at + 3]))
                 return -1;
             struct frame_info element = {0};
             int32_t s = ops[at + 1];
@@ -861,7 +734,7 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
             break;
         }
         case W_PACKED:
-            if (room(n, at, 4) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
+            if (rgb_room(n, at, 4) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
                 !kind_ok(ops[at + 2]) ||
                 !(FILLED(ops[at + 3], R_ARR) || FILLED(ops[at + 3], R_SEQ_NUM)) ||
                 f->kinds[ops[at + 3]] != ops[at + 2])
@@ -869,7 +742,7 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
             at += 4;
             break;
         case W_SEQ_STR:
-            if (room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_STR)) return -1;
+            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_STR)) return -1;
             at += 2;
             break;
         default:

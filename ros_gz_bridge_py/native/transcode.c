@@ -8,6 +8,7 @@
  * the Python path accepts too; anything it is not sure about is left to Python
  * (RGB_FALLBACK). */
 #include "transcode.h"
+#include "wire.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -29,50 +30,8 @@ enum {
     OP_CONST_BLOCK = 11,
 };
 
-/* Protobuf field types (google.protobuf.FieldDescriptor.TYPE_*). */
-enum {
-    PB_DOUBLE = 1,
-    PB_FLOAT = 2,
-    PB_INT64 = 3,
-    PB_UINT64 = 4,
-    PB_INT32 = 5,
-    PB_FIXED64 = 6,
-    PB_FIXED32 = 7,
-    PB_BOOL = 8,
-    PB_STRING = 9,
-    PB_GROUP = 10,
-    PB_MESSAGE = 11,
-    PB_BYTES = 12,
-    PB_UINT32 = 13,
-    PB_ENUM = 14,
-    PB_SFIXED32 = 15,
-    PB_SFIXED64 = 16,
-    PB_SINT32 = 17,
-    PB_SINT64 = 18,
-};
-
-/* ROS basic types as the program names them. */
-enum {
-    ROS_BOOL = 1,
-    ROS_UINT8 = 2,
-    ROS_INT8 = 3,
-    ROS_INT16 = 4,
-    ROS_UINT16 = 5,
-    ROS_INT32 = 6,
-    ROS_UINT32 = 7,
-    ROS_INT64 = 8,
-    ROS_UINT64 = 9,
-    ROS_FLOAT = 10,
-    ROS_DOUBLE = 11,
-};
-
-enum { CONV_EXACT = 0, CONV_WRAP = 1 };
-enum { WIRE_VARINT = 0, WIRE_I64 = 1, WIRE_LEN = 2, WIRE_SGROUP = 3, WIRE_EGROUP = 4, WIRE_I32 = 5 };
-
 /* Deepest nesting validated natively; deeper payloads are left to Python. */
 #define MAX_DEPTH 64
-/* Largest CDR message written natively. */
-#define MAX_OUTPUT ((size_t)1 << 30)
 /* Longest path of field numbers in an op. */
 #define MAX_STEPS 16
 
@@ -175,62 +134,9 @@ static const int32_t *schema_field(const struct rgb_program *pr, int32_t msg, ui
     return NULL;
 }
 
-static int wire_of(int32_t type) {
-    switch (type) {
-    case PB_DOUBLE:
-    case PB_FIXED64:
-    case PB_SFIXED64:
-        return WIRE_I64;
-    case PB_FLOAT:
-    case PB_FIXED32:
-    case PB_SFIXED32:
-        return WIRE_I32;
-    case PB_STRING:
-    case PB_BYTES:
-    case PB_MESSAGE:
-        return WIRE_LEN;
-    default:
-        return WIRE_VARINT;
-    }
-}
-
-/* Whether the bytes are well-formed UTF-8 (no overlong forms, no surrogates, at most
- * U+10FFFF), as the protobuf runtime requires of string fields. */
-static int utf8_valid(struct view s) {
-    size_t i = 0;
-    while (i < s.n) {
-        uint8_t c = s.p[i];
-        if (c < 0x80) {
-            i++;
-            continue;
-        }
-        size_t need;
-        uint8_t lo = 0x80, hi = 0xbf;
-        if (c >= 0xc2 && c <= 0xdf) {
-            need = 1;
-        } else if (c >= 0xe0 && c <= 0xef) {
-            need = 2;
-            if (c == 0xe0) lo = 0xa0;
-            if (c == 0xed) hi = 0x9f;
-        } else if (c >= 0xf0 && c <= 0xf4) {
-            need = 3;
-            if (c == 0xf0) lo = 0x90;
-            if (c == 0xf4) hi = 0x8f;
-        } else {
-            return 0;
-        }
-        if (s.n - i - 1 < need) return 0;
-        if (s.p[i + 1] < lo || s.p[i + 1] > hi) return 0;
-        for (size_t k = 2; k <= need; k++)
-            if ((s.p[i + k] & 0xc0) != 0x80) return 0;
-        i += need + 1;
-    }
-    return 1;
-}
-
 /* Validates a packed run of scalars of `type`. */
 static int validate_packed(struct view run, int32_t type) {
-    int wire = wire_of(type);
+    int wire = rgb_wire_of(type);
     if (wire == WIRE_I64 || wire == WIRE_I32) {
         size_t size = wire == WIRE_I64 ? 8 : 4;
         return run.n % size ? RGB_UNDECODABLE : 0;
@@ -258,7 +164,7 @@ static int validate(const struct rgb_program *pr, struct view v, int32_t msg, in
         const int32_t *sf = schema_field(pr, msg, f.number);
         if (sf == NULL) continue; /* unknown: kept aside by the runtime, never an error */
         int32_t type = sf[1], repeated = sf[2];
-        int wire = wire_of(type);
+        int wire = rgb_wire_of(type);
         if (repeated && wire != WIRE_LEN && f.wire == WIRE_LEN) {
             status = validate_packed(f.payload, type);
             if (status) return status;
@@ -266,7 +172,7 @@ static int validate(const struct rgb_program *pr, struct view v, int32_t msg, in
         }
         if (f.wire != wire) return RGB_FALLBACK; /* parsed as unknown: not followed here */
         if (type == PB_STRING) {
-            if (!utf8_valid(f.payload)) return RGB_UNDECODABLE;
+            if (!rgb_utf8_valid(f.payload.p, f.payload.n)) return RGB_UNDECODABLE;
         } else if (type == PB_MESSAGE) {
             if (!repeated) {
                 int index = (int)(sf - (m + 1)) / 4;
@@ -385,34 +291,13 @@ static uint64_t raw_of(const struct field *f) {
 
 /* ---- writing CDR -------------------------------------------------------------------------- */
 
-static int grow(struct rgb_out *out, size_t extra) {
-    if (extra > MAX_OUTPUT - out->len) return RGB_FALLBACK;
-    size_t need = out->len + extra;
-    if (need <= out->cap) return 0;
-    size_t cap = out->cap ? out->cap : 256;
-    while (cap < need) cap = cap > MAX_OUTPUT / 2 ? MAX_OUTPUT : cap * 2;
-    uint8_t *data = realloc(out->data, cap);
-    if (data == NULL) return RGB_FALLBACK;
-    out->data = data;
-    out->cap = cap;
-    return 0;
-}
-
 /* Pads with zeros to `size`, counted from the end of the 4-byte encapsulation header. */
 static int align(struct rgb_out *out, size_t size) {
     size_t pad = (size - (out->len - 4) % size) % size;
-    int status = grow(out, pad);
+    int status = rgb_grow(out, pad);
     if (status) return status;
     memset(out->data + out->len, 0, pad);
     out->len += pad;
-    return 0;
-}
-
-static int put(struct rgb_out *out, const void *bytes, size_t n) {
-    int status = grow(out, n);
-    if (status) return status;
-    if (n) memcpy(out->data + out->len, bytes, n);
-    out->len += n;
     return 0;
 }
 
@@ -421,35 +306,13 @@ static int put_u32(struct rgb_out *out, uint32_t value) {
     if (status) return status;
     uint8_t b[4] = {(uint8_t)value, (uint8_t)(value >> 8), (uint8_t)(value >> 16),
                     (uint8_t)(value >> 24)};
-    return put(out, b, 4);
-}
-
-static size_t ros_size(int32_t kind) {
-    switch (kind) {
-    case ROS_BOOL:
-    case ROS_UINT8:
-    case ROS_INT8:
-        return 1;
-    case ROS_INT16:
-    case ROS_UINT16:
-        return 2;
-    case ROS_INT32:
-    case ROS_UINT32:
-    case ROS_FLOAT:
-        return 4;
-    case ROS_INT64:
-    case ROS_UINT64:
-    case ROS_DOUBLE:
-        return 8;
-    default:
-        return 0;
-    }
+    return rgb_put(out, b, 4);
 }
 
 /* Writes `val` as ROS `kind` the way the Python path would, or RGB_FALLBACK where Python
  * would not write it this way (a value out of the type's range with `conv` exact). */
 static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct value val) {
-    size_t size = ros_size(kind);
+    size_t size = rgb_ros_size(kind);
     uint8_t b[8];
     int status = align(out, size);
     if (status) return status;
@@ -462,13 +325,13 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct val
             if (isinf(x) && !isinf(val.d)) return RGB_FALLBACK;
             memcpy(b, &x, 4);
         }
-        return put(out, b, size);
+        return rgb_put(out, b, size);
     }
     if (val.is_float) return RGB_FALLBACK;
     uint64_t bits = val.is_unsigned ? val.u : (uint64_t)val.i;
     if (kind == ROS_BOOL) {
         b[0] = val.i != 0;
-        return put(out, b, 1);
+        return rgb_put(out, b, 1);
     }
     if (conv == CONV_EXACT) {
         int ok;
@@ -487,7 +350,7 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct val
         if (!ok) return RGB_FALLBACK;
     }
     for (size_t k = 0; k < size; k++) b[k] = (uint8_t)(bits >> (8 * k));
-    return put(out, b, size);
+    return rgb_put(out, b, size);
 }
 
 /* A CDR string: length with the NUL, the bytes, the NUL. A NUL inside is left to Python. */
@@ -496,10 +359,10 @@ static int put_string(struct rgb_out *out, const uint8_t *p, size_t n) {
     if (n >= UINT32_MAX) return RGB_FALLBACK;
     int status = put_u32(out, (uint32_t)n + 1);
     if (status) return status;
-    status = put(out, p, n);
+    status = rgb_put(out, p, n);
     if (status) return status;
     uint8_t nul = 0;
-    return put(out, &nul, 1);
+    return rgb_put(out, &nul, 1);
 }
 
 /* A Gazebo scoped name as a ROS frame: each "::" (left to right) becomes "/". */
@@ -516,7 +379,7 @@ static int put_frame(struct rgb_out *out, struct view s) {
     if (written >= UINT32_MAX) return RGB_FALLBACK;
     int status = put_u32(out, (uint32_t)written + 1);
     if (status) return status;
-    status = grow(out, written + 1);
+    status = rgb_grow(out, written + 1);
     if (status) return status;
     for (size_t i = 0; i < s.n; i++) {
         if (s.p[i] == ':' && i + 1 < s.n && s.p[i + 1] == ':') {
@@ -548,7 +411,7 @@ static int scalar(struct view v, uint32_t number, int32_t type, struct value *va
     struct field f;
     int found, status = find_last(v, number, &f, &found);
     if (status) return status;
-    if (found && f.wire != wire_of(type)) return RGB_FALLBACK;
+    if (found && f.wire != rgb_wire_of(type)) return RGB_FALLBACK;
     *val = decode_scalar(type, &f, found ? raw_of(&f) : 0);
     return 0;
 }
@@ -579,7 +442,7 @@ struct scalars {
 
 static int scalar_element(void *ctx, const struct field *f) {
     struct scalars *s = ctx;
-    int wire = wire_of(s->type);
+    int wire = rgb_wire_of(s->type);
     if (f->wire == WIRE_LEN && wire != WIRE_LEN) {
         size_t pos = 0;
         while (pos < f->payload.n) {
@@ -704,9 +567,6 @@ static int header_entry(void *ctx, const struct field *f) {
 
 /* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
 static const uint8_t *word_bytes(const int32_t *words) { return (const uint8_t *)(words + 1); }
-/* The words a string takes (nbytes >= 0, as check_text made sure), counted in size_t: a
- * length near INT32_MAX must not overflow. */
-static size_t word_span(int32_t nbytes) { return 1 + ((size_t)nbytes + 3) / 4; }
 
 static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *end,
                struct view v, struct rgb_out *out) {
@@ -727,11 +587,11 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
         }
         case OP_CONST: {
             uint64_t bits = (uint32_t)op[1] | (uint64_t)(uint32_t)op[2] << 32;
-            size_t size = ros_size(op[0]);
+            size_t size = rgb_ros_size(op[0]);
             uint8_t b[8];
             for (size_t k = 0; k < size; k++) b[k] = (uint8_t)(bits >> (8 * k));
             status = align(out, size);
-            if (!status) status = put(out, b, size);
+            if (!status) status = rgb_put(out, b, size);
             op += 3;
             break;
         }
@@ -749,18 +609,18 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
         }
         case OP_CONST_STR:
             status = put_string(out, word_bytes(op), (size_t)op[0]);
-            op += word_span(op[0]);
+            op += rgb_text_span(op[0]);
             break;
         case OP_HEADER_STR: {
             status = path(&op, v, &at);
             if (status) return status;
             struct header_lookup h = {word_bytes(op + 1), (size_t)op[1], op[0], 0, {NULL, 0}};
-            op += 1 + word_span(op[1]);
+            op += 1 + rgb_text_span(op[1]);
             status = for_each(at, 2, header_entry, &h);
             if (status) return status;
             status = h.found ? put_frame(out, h.value)
                              : put_string(out, word_bytes(op), (size_t)op[0]);
-            op += word_span(op[0]);
+            op += rgb_text_span(op[0]);
             break;
         }
         case OP_FIXED_LIST: {
@@ -772,13 +632,13 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
             struct scalars counting = {type, 0, 0, out};
             status = for_each(at, number, scalar_element, &counting);
             if (status) return status;
-            status = align(out, ros_size(kind));
+            status = align(out, rgb_ros_size(kind));
             if (status) return status;
             if (counting.count == (size_t)count) {
                 struct scalars writing = {type, 0, kind, out};
                 status = for_each(at, number, scalar_element, &writing);
             } else {
-                struct value zero = {wire_of(type) != WIRE_VARINT, 0, 0, 0, 0.0};
+                struct value zero = {rgb_wire_of(type) != WIRE_VARINT, 0, 0, 0, 0.0};
                 for (int32_t k = 0; k < count && !status; k++)
                     status = put_value(out, kind, CONV_EXACT, zero);
             }
@@ -816,7 +676,7 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
             size_t count = 0;
             status = for_each(at, number, count_field, &count);
             if (status) return status;
-            status = sequence_start(out, count, code == OP_COLUMN ? ros_size(c.kind) : 0);
+            status = sequence_start(out, count, code == OP_COLUMN ? rgb_ros_size(c.kind) : 0);
             if (status) return status;
             status = for_each(at, number, column_element, &c);
             break;
@@ -845,8 +705,8 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
         }
         case OP_CONST_BLOCK: {
             status = align(out, (size_t)op[0]);
-            if (!status) status = put(out, word_bytes(op + 1), (size_t)op[1]);
-            op += 1 + word_span(op[1]);
+            if (!status) status = rgb_put(out, word_bytes(op + 1), (size_t)op[1]);
+            op += 1 + rgb_text_span(op[1]);
             break;
         }
         default:
@@ -864,7 +724,7 @@ enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *pay
     out->len = 0;
     int status = validate(program, v, program->root, 0);
     if (status) return (enum rgb_status)status;
-    status = put(out, header, 4);
+    status = rgb_put(out, header, 4);
     if (!status) status = run(program, program->ops, program->ops + program->ops_len, v, out);
     return (enum rgb_status)status;
 }
@@ -919,12 +779,11 @@ static int check_path(const int32_t *ops, size_t n, size_t *at) {
 }
 
 /* Checks that `k` more words exist at `at`. */
-static int room(size_t n, size_t at, size_t k) { return at <= n && k <= n - at ? 0 : -1; }
 
 static int check_text(const int32_t *ops, size_t n, size_t *at) {
-    if (room(n, *at, 1) || ops[*at] < 0) return -1;
-    size_t span = word_span(ops[*at]);
-    if (room(n, *at, span)) return -1;
+    if (rgb_room(n, *at, 1) || ops[*at] < 0) return -1;
+    size_t span = rgb_text_span(ops[*at]);
+    if (rgb_room(n, *at, span)) return -1;
     *at += span;
     return 0;
 }
@@ -938,63 +797,63 @@ static int check_ops(const int32_t *ops, size_t n, int depth) {
         case OP_END:
             return at == n ? 0 : -1;
         case OP_NUM:
-            if (check_path(ops, n, &at) || room(n, at, 4) || ops[at] <= 0 ||
+            if (check_path(ops, n, &at) || rgb_room(n, at, 4) || ops[at] <= 0 ||
                 !check_pb_scalar(ops[at + 1]) || !check_ros(ops[at + 2]) ||
                 (ops[at + 3] != CONV_EXACT && ops[at + 3] != CONV_WRAP))
                 return -1;
             at += 4;
             break;
         case OP_CONST:
-            if (room(n, at, 3) || !check_ros(ops[at])) return -1;
+            if (rgb_room(n, at, 3) || !check_ros(ops[at])) return -1;
             at += 3;
             break;
         case OP_STR:
-            if (check_path(ops, n, &at) || room(n, at, 1) || ops[at] <= 0) return -1;
+            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || ops[at] <= 0) return -1;
             at += 1;
             break;
         case OP_CONST_STR:
             if (check_text(ops, n, &at)) return -1;
             break;
         case OP_HEADER_STR:
-            if (check_path(ops, n, &at) || room(n, at, 1) || (ops[at] != 0 && ops[at] != 1))
+            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || (ops[at] != 0 && ops[at] != 1))
                 return -1;
             at += 1;
             if (check_text(ops, n, &at) || check_text(ops, n, &at)) return -1;
             break;
         case OP_FIXED_LIST:
-            if (check_path(ops, n, &at) || room(n, at, 4) || ops[at] <= 0 ||
+            if (check_path(ops, n, &at) || rgb_room(n, at, 4) || ops[at] <= 0 ||
                 !check_pb_scalar(ops[at + 1]) || !check_ros(ops[at + 2]) || ops[at + 3] < 0 ||
                 ops[at + 3] > 1 << 20)
                 return -1;
             at += 4;
             break;
         case OP_SEQ_MSG:
-            if (check_path(ops, n, &at) || room(n, at, 2) || ops[at] <= 0 || ops[at + 1] < 1 ||
-                room(n, at + 2, (size_t)ops[at + 1]) ||
+            if (check_path(ops, n, &at) || rgb_room(n, at, 2) || ops[at] <= 0 || ops[at + 1] < 1 ||
+                rgb_room(n, at + 2, (size_t)ops[at + 1]) ||
                 check_ops(ops + at + 2, (size_t)ops[at + 1], depth + 1))
                 return -1;
             at += 2 + (size_t)ops[at + 1];
             break;
         case OP_COLUMN:
         case OP_COLUMN_STR: {
-            if (check_path(ops, n, &at) || room(n, at, 1) || ops[at] <= 0) return -1;
+            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || ops[at] <= 0) return -1;
             at += 1;
-            if (check_path(ops, n, &at) || room(n, at, 1) || ops[at] <= 0) return -1;
+            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || ops[at] <= 0) return -1;
             at += 1;
             if (code == OP_COLUMN) {
-                if (room(n, at, 2) || !check_pb_scalar(ops[at]) || !check_ros(ops[at + 1]))
+                if (rgb_room(n, at, 2) || !check_pb_scalar(ops[at]) || !check_ros(ops[at + 1]))
                     return -1;
                 at += 2;
             }
             break;
         }
         case OP_CLOCK:
-            if (check_path(ops, n, &at) || room(n, at, 1) || (ops[at] != 0 && ops[at] != 1))
+            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || (ops[at] != 0 && ops[at] != 1))
                 return -1;
             at += 1;
             break;
         case OP_CONST_BLOCK:
-            if (room(n, at, 1) || (ops[at] != 1 && ops[at] != 2 && ops[at] != 4 && ops[at] != 8))
+            if (rgb_room(n, at, 1) || (ops[at] != 1 && ops[at] != 2 && ops[at] != 4 && ops[at] != 8))
                 return -1;
             at += 1;
             if (check_text(ops, n, &at)) return -1;

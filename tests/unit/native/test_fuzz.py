@@ -64,11 +64,11 @@ class Target:
 
 TARGETS = {
     "transcode": Target(
-        "transcode_fuzz.c", ("transcode.c", "transcode.h"), "programs.h", "corpus", "artifacts",
+        "transcode_fuzz.c", ("transcode.c", "transcode.h", "wire.h"), "programs.h", "corpus", "artifacts",
         1 / 2,
     ),
     "encode": Target(
-        "encode_fuzz.c", ("encode.c", "encode.h", "transcode.h"), "encoders.h", "encode-corpus",
+        "encode_fuzz.c", ("encode.c", "encode.h", "transcode.h", "wire.h"), "encoders.h", "encode-corpus",
         "encode-artifacts", 1 / 2,
     ),
 }  # fmt: skip

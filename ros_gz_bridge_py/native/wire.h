@@ -1,0 +1,164 @@
+/* What the two native transcoders share (transcode.c, encode.c; docs/native.md): the numbers
+ * the Python compilers write for protobuf field types and ROS basic types, and the helpers of
+ * both wire formats. Header-only: the extension and the fuzz targets compile it into each. */
+#ifndef RGB_WIRE_H
+#define RGB_WIRE_H
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "transcode.h"
+
+/* Protobuf field types (google.protobuf.FieldDescriptor.TYPE_*). */
+enum {
+    PB_DOUBLE = 1,
+    PB_FLOAT = 2,
+    PB_INT64 = 3,
+    PB_UINT64 = 4,
+    PB_INT32 = 5,
+    PB_FIXED64 = 6,
+    PB_FIXED32 = 7,
+    PB_BOOL = 8,
+    PB_STRING = 9,
+    PB_GROUP = 10,
+    PB_MESSAGE = 11,
+    PB_BYTES = 12,
+    PB_UINT32 = 13,
+    PB_ENUM = 14,
+    PB_SFIXED32 = 15,
+    PB_SFIXED64 = 16,
+    PB_SINT32 = 17,
+    PB_SINT64 = 18,
+};
+
+/* ROS basic types as the programs name them (program.py ROS_KINDS). */
+enum {
+    ROS_BOOL = 1,
+    ROS_UINT8 = 2,
+    ROS_INT8 = 3,
+    ROS_INT16 = 4,
+    ROS_UINT16 = 5,
+    ROS_INT32 = 6,
+    ROS_UINT32 = 7,
+    ROS_INT64 = 8,
+    ROS_UINT64 = 9,
+    ROS_FLOAT = 10,
+    ROS_DOUBLE = 11,
+};
+
+/* How a number changes type: exactly (out of range: Python decides), or narrowed as C++. */
+enum { CONV_EXACT = 0, CONV_WRAP = 1 };
+/* Protobuf wire types. */
+enum { WIRE_VARINT = 0, WIRE_I64 = 1, WIRE_LEN = 2, WIRE_SGROUP = 3, WIRE_EGROUP = 4, WIRE_I32 = 5 };
+
+/* Largest message either transcoder writes. */
+#define RGB_MAX_OUTPUT ((size_t)1 << 30)
+
+/* The wire size of a ROS basic type (0: not one). */
+static inline size_t rgb_ros_size(int32_t kind) {
+    switch (kind) {
+    case ROS_BOOL:
+    case ROS_UINT8:
+    case ROS_INT8:
+        return 1;
+    case ROS_INT16:
+    case ROS_UINT16:
+        return 2;
+    case ROS_INT32:
+    case ROS_UINT32:
+    case ROS_FLOAT:
+        return 4;
+    case ROS_INT64:
+    case ROS_UINT64:
+    case ROS_DOUBLE:
+        return 8;
+    default:
+        return 0;
+    }
+}
+
+/* The wire type of a protobuf field type. */
+static inline int rgb_wire_of(int32_t type) {
+    switch (type) {
+    case PB_DOUBLE:
+    case PB_FIXED64:
+    case PB_SFIXED64:
+        return WIRE_I64;
+    case PB_FLOAT:
+    case PB_FIXED32:
+    case PB_SFIXED32:
+        return WIRE_I32;
+    case PB_STRING:
+    case PB_BYTES:
+    case PB_MESSAGE:
+        return WIRE_LEN;
+    default:
+        return WIRE_VARINT;
+    }
+}
+
+/* Whether the bytes are well-formed UTF-8 (no overlong forms, no surrogates, at most
+ * U+10FFFF), as the protobuf runtime requires of string fields and Python's decode of text. */
+static inline int rgb_utf8_valid(const uint8_t *s, size_t n) {
+    size_t i = 0;
+    while (i < n) {
+        uint8_t c = s[i];
+        if (c < 0x80) {
+            i++;
+            continue;
+        }
+        size_t need;
+        uint8_t lo = 0x80, hi = 0xbf;
+        if (c >= 0xc2 && c <= 0xdf) {
+            need = 1;
+        } else if (c >= 0xe0 && c <= 0xef) {
+            need = 2;
+            if (c == 0xe0) lo = 0xa0;
+            if (c == 0xed) hi = 0x9f;
+        } else if (c >= 0xf0 && c <= 0xf4) {
+            need = 3;
+            if (c == 0xf0) lo = 0x90;
+            if (c == 0xf4) hi = 0x8f;
+        } else {
+            return 0;
+        }
+        if (n - i - 1 < need || s[i + 1] < lo || s[i + 1] > hi) return 0;
+        for (size_t k = 2; k <= need; k++)
+            if ((s[i + k] & 0xc0) != 0x80) return 0;
+        i += need + 1;
+    }
+    return 1;
+}
+
+/* Makes room for `extra` more bytes; RGB_FALLBACK past RGB_MAX_OUTPUT or without memory. */
+static inline int rgb_grow(struct rgb_out *out, size_t extra) {
+    if (extra > RGB_MAX_OUTPUT - out->len) return RGB_FALLBACK;
+    size_t need = out->len + extra;
+    if (need <= out->cap) return 0;
+    size_t cap = out->cap ? out->cap : 256;
+    while (cap < need) cap = cap > RGB_MAX_OUTPUT / 2 ? RGB_MAX_OUTPUT : cap * 2;
+    uint8_t *data = realloc(out->data, cap);
+    if (data == NULL) return RGB_FALLBACK;
+    out->data = data;
+    out->cap = cap;
+    return 0;
+}
+
+/* Appends `n` bytes. */
+static inline int rgb_put(struct rgb_out *out, const void *bytes, size_t n) {
+    int status = rgb_grow(out, n);
+    if (status) return status;
+    if (n) memcpy(out->data + out->len, bytes, n);
+    out->len += n;
+    return 0;
+}
+
+/* The words a string takes in a program (its length, then the bytes four to a word); counted
+ * in size_t, so a damaged length near INT32_MAX cannot overflow. */
+static inline size_t rgb_text_span(int32_t nbytes) { return 1 + ((size_t)nbytes + 3) / 4; }
+
+/* 0 when `k` more words exist at `at` of `n`, else -1. */
+static inline int rgb_room(size_t n, size_t at, size_t k) { return at <= n && k <= n - at ? 0 : -1; }
+
+#endif
