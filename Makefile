@@ -16,7 +16,7 @@ WITH_LOOPBACK := if [ -f $(LOOPBACK) ]; then source $(LOOPBACK); else source too
 
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml tools/setup_peer.sh tools/setup_fuzz.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
+$(STAMP): pyproject.toml tools/apt_ensure.sh tools/setup_peer.sh tools/setup_fuzz.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[ros,dev]'
@@ -54,7 +54,7 @@ soak: setup
 	$(WITH_LOOPBACK) $(PY) -m benchmarks.soak --seconds $${SOAK_SECONDS:-600}
 	$(MAKE) --no-print-directory fuzz
 
-# The native transcoder under libFuzzer with ASan and UBSan, then MSan, for FUZZ_SECONDS in all
+# The native transcoders under libFuzzer with ASan and UBSan, then MSan, for FUZZ_SECONDS in all
 # (600 by default; `make test` runs 60): tests/unit/native/test_fuzz.py, corpus in .build/fuzz.
 fuzz: setup
 	FUZZ_SECONDS=$${FUZZ_SECONDS:-600} $(PY) -m pytest -q tests/unit/native/test_fuzz.py
