@@ -6,6 +6,7 @@ does); it is imported only inside the functions that draw, so nothing else needs
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -137,6 +138,27 @@ def _bridge_segments(
         ]
         for group in SPLIT_GROUPS
     }
+
+
+def native_overload_plot(series: Mapping[str, Sequence[tuple[float, float]]], relative: str) -> str:
+    """Delivered against offered rate (kHz) of ``benchmarks.native_plane``'s overload sweep
+    (``series``: label -> points), with the delivered = offered line."""
+    _agg()
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    figure, axes = plt.subplots(figsize=(7, 4.5))
+    top = max((offered for points in series.values() for offered, _ in points), default=1.0)
+    # Delivered (solid) then published (dashed), one colour per path.
+    styles = (("o-", "tab:blue"), ("s-", "tab:orange"), ("o--", "tab:blue"), ("s--", "tab:orange"))
+    for (label, points), (style, colour) in zip(series.items(), styles, strict=False):
+        axes.plot([p[0] for p in points], [p[1] for p in points], style, color=colour, label=label)
+    axes.plot([0, top], [0, top], ":", color="grey", label="delivered = offered")
+    axes.set_xlabel("offered rate, kHz (Odometry, Gazebo -> ROS)")
+    axes.set_ylabel("kHz")
+    axes.set_title("The native data plane under overload")
+    axes.grid(alpha=0.3)
+    axes.legend(fontsize=8)
+    return _save(figure, relative)
 
 
 def _save(figure: Figure, relative: str) -> str:

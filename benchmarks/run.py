@@ -1,7 +1,7 @@
 """``make bench``: every benchmark in one go, each bounded, rewriting BENCHMARKS.md.
 
 Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
-about 16 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
+about 20 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
 Each module writes its own section; a module that fails is reported and the others still run.
 Last, the headline is rewritten from the figures stored by ``sustained``, ``costs`` and
 ``starvation`` (this run's, or their last run's when they were not run), and its plots drawn.
@@ -26,6 +26,7 @@ from benchmarks import (
     headline,
     images,
     memory,
+    native_plane,
     small_messages,
     startup,
     starvation,
@@ -54,6 +55,13 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
         "small_messages": lambda: small_messages.main(["--seconds", str(flow)]),
         "costs": lambda: costs.main(["--seconds", "1.5" if quick else "3"]),
         "starvation": lambda: starvation.main(["--seconds", "3" if quick else "5"]),
+        "native_plane": lambda: native_plane.main(
+            [
+                *("--seconds", "1" if quick else "2"),
+                *("--workload-seconds", "3" if quick else "10"),
+                *("--clock-seconds", "2" if quick else "5"),
+            ]
+        ),
         "discovery": lambda: discovery.main(
             ["--idle", "5" if quick else "10"] + (["--counts", "10", "100"] if quick else [])
         ),
