@@ -753,9 +753,9 @@ Command: `.venv/bin/python -m benchmarks.native_plane{flags}`
 Every phase runs twice, each time in a fresh bridge process: with the native data plane (on
 by default where the extension is built, docs/native.md) and with `ROS_GZ_BRIDGE_NATIVE=off`
 in the bridge's environment (the Python path). The PATH column is the bridge's own status
-table (SIGUSR1), as are its in / out / dropped counters over the row; "in" counts on the
-native path every message taken from the socket, dropped ones included, and on the Python
-path those its queue kept. Bridge CPU is % of one core over the publishing window
+table (SIGUSR1), as are its in / out / dropped counters over the row; on both paths "in"
+counts the messages the channel took from its queue, "dropped" those the queue let go,
+oldest first, before any work on them. Bridge CPU is % of one core over the publishing window
 (/proc/<pid>/stat), split by thread (/proc/<pid>/task/<tid>/schedstat): the Python threads
 (on the native path also the C loop, which runs on the channel's reader thread with the GIL
 released), libzmq's I/O thread, Fast DDS's threads. Machine CPU: all {os.cpu_count()} cores'
