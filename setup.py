@@ -3,9 +3,9 @@
 colcon's ament_python build runs this file too. To learn the package's name and data files,
 colcon reads ``setup.cfg`` instead of running this file when it finds the text ``setup()`` in
 it (as it does here, in this sentence): running it would fail there, since colcon cannot read
-back the ``python_requires`` that pyproject.toml gives. The extension is optional: where no C compiler
-or Python headers exist, or the build fails, the package installs without it and the bridge
-runs on the Python path (``ros_gz_bridge_py.native`` logs once why; docs/native.md §1).
+back the ``python_requires`` that pyproject.toml gives. The extension is optional: where no C
+compiler or Python headers exist, or the build fails, the package installs without it and the
+bridge runs on the Python path (``ros_gz_bridge_py.native`` logs once why; docs/native.md §1).
 """
 
 from setuptools import Extension, setup

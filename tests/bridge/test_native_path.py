@@ -6,7 +6,8 @@ to a Fortress subscriber (``cmd_vel``, as DiffDrive takes it). The same run is m
 native path (where the extension is built), with ``ROS_GZ_BRIDGE_NATIVE=off``, and with the
 extension absent (an import blocker in the bridge process's ``sitecustomize``): the values must
 arrive alike, the SIGUSR1 table must name the path each channel took, and a bridge without the
-extension says once why. The core tests also run in a process where the extension cannot be imported.
+extension says once why. The core tests also run in a process where the extension cannot be
+imported.
 """
 
 from __future__ import annotations

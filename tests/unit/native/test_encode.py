@@ -5,10 +5,10 @@ not decide (docs/native.md §6).
 The agreement rule (:meth:`Encoding.check`): native OK means Python writes the same payload;
 native UNDECODABLE means Python refuses the message (any error of the light reader or the
 converter); native FALLBACK leaves the decision to Python and is always allowed, but not for
-a well-formed message (rclpy's or the CDR writer's). Messages: random ones, one with every field distinct
-(tools/native_fuzz_programs.py), and what an attacker could send instead: cut or bit-flipped
-messages, huge counts and string lengths, strings without their NUL or with one inside, bad
-UTF-8, bool bytes other than 0 and 1, other encapsulations, floats of every class.
+a well-formed message (rclpy's or the CDR writer's). Messages: random ones, one with every
+field distinct (tools/native_fuzz_programs.py), and what an attacker could send instead: cut
+or bit-flipped messages, huge counts and string lengths, strings without their NUL or with one
+inside, bad UTF-8, bool bytes other than 0 and 1, other encapsulations, floats of every class.
 fuzz/encode_fuzz.c runs the same encoders under the sanitizers (test_fuzz.py).
 """
 

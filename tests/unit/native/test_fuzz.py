@@ -64,12 +64,12 @@ class Target:
 
 TARGETS = {
     "transcode": Target(
-        "transcode_fuzz.c", ("transcode.c", "transcode.h", "wire.h"), "programs.h", "corpus", "artifacts",
-        1 / 2,
+        "transcode_fuzz.c", ("transcode.c", "transcode.h", "wire.h"), "programs.h", "corpus",
+        "artifacts", 1 / 2,
     ),
     "encode": Target(
-        "encode_fuzz.c", ("encode.c", "encode.h", "transcode.h", "wire.h"), "encoders.h", "encode-corpus",
-        "encode-artifacts", 1 / 2,
+        "encode_fuzz.c", ("encode.c", "encode.h", "transcode.h", "wire.h"), "encoders.h",
+        "encode-corpus", "encode-artifacts", 1 / 2,
     ),
 }  # fmt: skip
 
