@@ -94,7 +94,11 @@ def _struct_reader(msg_class: type[Any]) -> Reader:
     return read_struct
 
 
-def _empty_reader(_buf: bytes, pos: int) -> tuple[Any, int]:
+def _empty_reader(buf: bytes, pos: int) -> tuple[Any, int]:
+    """A message with no field: its one byte on the wire (docs/cdr.md §2) must be there."""
+    if pos >= len(buf):
+        msg = "the message's one byte is missing"
+        raise IndexError(msg)
     return SimpleNamespace(), pos + 1
 
 
