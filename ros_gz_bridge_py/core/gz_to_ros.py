@@ -64,8 +64,13 @@ class GzToRosChannel(Channel):
         self._finish = self._make_finisher()
         #: The native programs of the wire spellings, where this channel takes the native path.
         self._programs = (
-            native_programs(layouts, ctx.options, ctx.gz_node)
-            if self._finish is None and self.bulk is None
+            native_programs(
+                layouts,
+                ctx.options,
+                ctx.gz_node,
+                frame_id=spec.frame_id or ctx.options.override_frame_id,
+            )
+            if self.bulk is None
             else {}
         )
         self._pump: ChannelPump | None = None

@@ -42,16 +42,19 @@ def expressible(pairs: Iterable[Pair]) -> tuple[Reasons, Reasons]:
     return to_ros, to_gz
 
 
-def native_programs(layouts: dict[str, Pair], options: Any, gz_node: Any) -> dict[str, Any]:
-    """The program of each wire spelling a channel of ``layouts`` runs natively; empty when
-    the channel takes the Python path."""
+def native_programs(
+    layouts: dict[str, Pair], options: Any, gz_node: Any, *, frame_id: str = ""
+) -> dict[str, Any]:
+    """The program of each wire spelling a channel of ``layouts`` runs natively (``frame_id``:
+    the channel's header rewrite); empty when the channel takes the Python path."""
     if not (options.native and options.cdr_write and options.rcl_serialized_publish):
         return {}
     if not gz_node.runs_native_loops or not native_path_available():
         return {}
     programs = {}
+    stamp = bool(options.override_timestamps_with_wall_time)
     for wire_type, pair in layouts.items():
-        program = program_of(pair)
+        program = program_of(pair, frame_id, stamp)
         if program is not None:
             programs[wire_type] = program
     return programs
@@ -70,13 +73,14 @@ def native_path_available() -> bool:
 
 
 @functools.cache
-def program_of(pair: Pair) -> Any | None:
-    """The loaded program of ``pair`` (compiled once), or None where it stays on Python."""
+def program_of(pair: Pair, frame_id: str = "", wall_stamp: bool = False) -> Any | None:
+    """The loaded program of ``pair`` with a header rewrite (compiled once), or None where it
+    stays on Python."""
     native = extension()
     if native is None:
         return None
     try:
-        compiled = compile_to_ros(pair)
+        compiled = compile_to_ros(pair, frame_id=frame_id, wall_stamp=wall_stamp)
     except NotExpressibleError:
         return None
     return native.Program(compiled.schema, compiled.ops)

@@ -36,6 +36,7 @@ from ros_gz_bridge_py.ros import cdr_types as cdr
 # Ops (transcode.c).
 OP_END, OP_NUM, OP_CONST, OP_STR, OP_CONST_STR, OP_HEADER_STR = 0, 1, 2, 3, 4, 5
 OP_FIXED_LIST, OP_SEQ_MSG, OP_COLUMN, OP_COLUMN_STR, OP_CLOCK, OP_CONST_BLOCK = 6, 7, 8, 9, 10, 11
+OP_WALL_STAMP = 12
 CONV_EXACT, CONV_WRAP = 0, 1
 #: ROS basic types as the program numbers them, with their struct codes.
 ROS_KINDS: dict[str, tuple[int, str]] = {
@@ -116,7 +117,22 @@ class ClockPart:
     part: int
 
 
-Source = Copy | HeaderText | FixedList | Sequence | Column | ClockPart
+@dataclass(frozen=True)
+class FixedText:
+    """A constant string: the channel's ``frame_id`` (the header rewrite of ``gz_to_ros.py``)."""
+
+    value: str
+
+
+@dataclass(frozen=True)
+class WallStamp:
+    """The wall clock when the message is written: seconds (part 0, which writes both parts,
+    as ``override_timestamps_with_wall_time`` reads the clock once) or nanoseconds (1)."""
+
+    part: int
+
+
+Source = Copy | HeaderText | FixedList | Sequence | Column | ClockPart | FixedText | WallStamp
 Assignments = dict[Path, Source]
 
 
@@ -418,6 +434,10 @@ class _Emitter:
         if isinstance(source, ClockPart) and cdr.basic_of(slot) is not None:
             steps, _time_type = _descend(gz, source.gz)
             return [OP_CLOCK, len(steps), *steps, source.part]
+        if isinstance(source, FixedText) and kind in cdr.STRING_TYPES:
+            return [OP_CONST_STR, *text_words(_plain(source.value))]
+        if isinstance(source, WallStamp) and cdr.basic_of(slot) in ("int32", "uint32"):
+            return [OP_WALL_STAMP] if source.part == 0 else []
         msg = f"{type(source).__name__} into a ROS {kind}"
         raise NotExpressibleError(msg)
 
@@ -455,8 +475,12 @@ class Compiled:
     ops: bytes
 
 
-def compile_to_ros(pair: Pair) -> Compiled:
+def compile_to_ros(pair: Pair, *, frame_id: str = "", wall_stamp: bool = False) -> Compiled:
     """The program converting ``pair``'s Gazebo messages to its ROS messages' CDR.
+
+    ``frame_id`` and ``wall_stamp``: the header rewrite a channel applies to a message with a
+    top-level ``std_msgs/Header`` (``frame_id``, ``override_timestamps_with_wall_time``);
+    nothing for other messages, as in ``gz_to_ros.py``.
 
     Raises:
         NotExpressibleError: the pair stays on the Python path (the reason says why).
@@ -476,6 +500,12 @@ def compile_to_ros(pair: Pair) -> Compiled:
     else:
         msg = f"a hand-written converter ({pair.to_ros.__qualname__})"
         raise NotExpressibleError(msg)
+    if pair.ros_class.get_fields_and_field_types().get("header") == "std_msgs/Header":
+        if frame_id:
+            given[("header", "frame_id")] = FixedText(frame_id)
+        if wall_stamp:
+            given[("header", "stamp", "sec")] = WallStamp(0)
+            given[("header", "stamp", "nanosec")] = WallStamp(1)
     root = message_class(pair.gz_type).DESCRIPTOR
     schema = _Schema(root)
     ops = _Emitter(schema).message(pair.ros_class, (), given, default, root)

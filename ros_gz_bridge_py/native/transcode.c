@@ -11,6 +11,7 @@
 #include "wire.h"
 
 #include <math.h>
+#include <time.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -28,6 +29,7 @@ enum {
     OP_COLUMN_STR = 9,
     OP_CLOCK = 10,
     OP_CONST_BLOCK = 11,
+    OP_WALL_STAMP = 12,
 };
 
 /* Deepest nesting validated natively; deeper payloads are left to Python. */
@@ -703,6 +705,16 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
             }
             break;
         }
+        case OP_WALL_STAMP: { /* a Time of the wall clock now: int32 sec, uint32 nanosec */
+            struct timespec now;
+            clock_gettime(CLOCK_REALTIME, &now);
+            if (now.tv_sec < 0 || now.tv_sec > INT32_MAX) return RGB_FALLBACK;
+            struct value sec = {0, 0, (int64_t)now.tv_sec, 0, 0.0};
+            struct value nsec = {0, 0, (int64_t)now.tv_nsec, 0, 0.0};
+            status = put_value(out, ROS_INT32, CONV_EXACT, sec);
+            if (!status) status = put_value(out, ROS_UINT32, CONV_EXACT, nsec);
+            break;
+        }
         case OP_CONST_BLOCK: {
             status = align(out, (size_t)op[0]);
             if (!status) status = rgb_put(out, word_bytes(op + 1), (size_t)op[1]);
@@ -851,6 +863,8 @@ static int check_ops(const int32_t *ops, size_t n, int depth) {
             if (check_path(ops, n, &at) || rgb_room(n, at, 1) || (ops[at] != 0 && ops[at] != 1))
                 return -1;
             at += 1;
+            break;
+        case OP_WALL_STAMP:
             break;
         case OP_CONST_BLOCK:
             if (rgb_room(n, at, 1) || (ops[at] != 1 && ops[at] != 2 && ops[at] != 4 && ops[at] != 8))
