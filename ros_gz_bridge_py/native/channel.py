@@ -61,10 +61,18 @@ def native_programs(
 
 
 @functools.cache
-def native_path_available() -> bool:
-    """Whether the extension and the functions it calls are there; logged once where not."""
+def _extension_available() -> bool:
+    """Whether the extension is built; logged once where not."""
     if extension() is None:
         _LOG.warning("Every channel takes the Python path: %s", unavailable_reason())
+        return False
+    return True
+
+
+@functools.cache
+def native_path_available() -> bool:
+    """Whether the extension and the functions it calls are there; logged once where not."""
+    if not _extension_available():
         return False
     if foreign_functions() is None:
         _LOG.warning("Every channel takes the Python path: %s", why_no_functions())
@@ -89,7 +97,7 @@ def program_of(pair: Pair, frame_id: str = "", wall_stamp: bool = False) -> Any 
 def native_encoders(layouts: dict[str, Pair], options: Any) -> dict[str, Any]:
     """The encoder of each wire spelling a ROS -> Gazebo channel of ``layouts`` runs natively
     (docs/native.md §6); empty where the channel converts in Python."""
-    if not (options.native and options.light_read) or extension() is None:
+    if not (options.native and options.light_read) or not _extension_available():
         return {}
     encoders = {wire_type: encoder_of(pair) for wire_type, pair in layouts.items()}
     if any(encoder is None for encoder in encoders.values()):

@@ -23,12 +23,9 @@ from ros_gz_bridge_py.converters._fields import (
     Table,
     Value,
     gz_declaration_of,
-    same,
 )
 from ros_gz_bridge_py.converters.builtin_interfaces import (
     fill_gz_present_time,
-    to_int32,
-    to_uint32,
 )
 from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_covariance
 from ros_gz_bridge_py.converters.registry import Pair
@@ -41,6 +38,7 @@ from ros_gz_bridge_py.converters.std_msgs import (
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.native.program import (
     ROS_KINDS,
+    VALUES,
     NotExpressibleError,
     Path,
     gz_field,
@@ -151,7 +149,6 @@ _LEAVES: dict[Callable[[Any, Any], None], Callable[[Path, Path, Node], None]] = 
     FRAMES.to_gz: _frames,
     fill_gz_covariance: _covariance,
 }
-_VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint32: True}
 
 
 def _assign(fill: Fill, ros: Path, gz: Path, out: Node) -> None:
@@ -177,8 +174,8 @@ def _entry(ros: Path, gz: Path, how: Fill | Value | None, out: Node) -> None:
         _assign(how, ros, gz, out)
     elif how.to_gz is None:
         return
-    elif how.to_gz in _VALUES:
-        out.set(gz, Copy(ros, wrap=_VALUES[how.to_gz]))
+    elif how.to_gz in VALUES:
+        out.set(gz, Copy(ros, wrap=VALUES[how.to_gz]))
     else:
         msg = f"a Value of {how.to_gz.__qualname__}"
         raise NotExpressibleError(msg)

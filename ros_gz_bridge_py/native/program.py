@@ -170,7 +170,9 @@ _LEAVES: dict[Callable[[Any, Any], None], Callable[[Path, Path, Assignments], No
     fill_ros_covariance: _covariance,
 }
 #: Value functions and whether they narrow (C integer semantics) on the way.
-_VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint32: True}
+#: The Value functions programs express, and whether each narrows as C++ does (both
+#: directions: ``encoder.py`` reads it too).
+VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint32: True}
 
 
 def _joint_state(out: Assignments) -> None:
@@ -240,8 +242,8 @@ def _entry(ros: Path, gz: Path, how: Fill | Value | None, out: Assignments) -> N
         _assign(how, ros, gz, out)
     elif how.to_ros is None:
         return
-    elif how.to_ros in _VALUES:
-        out[ros] = Copy(gz, wrap=_VALUES[how.to_ros])
+    elif how.to_ros in VALUES:
+        out[ros] = Copy(gz, wrap=VALUES[how.to_ros])
     else:
         msg = f"a Value of {how.to_ros.__qualname__}"
         raise NotExpressibleError(msg)

@@ -80,7 +80,6 @@ struct queued {
 struct handed {
     int kind; /* 0 unrouted frames, 1 payload of route `route` refused with `status` */
     int route, status, nframes;
-    PyObject *frames[MAX_FRAMES]; /* made when the GIL is back */
     uint8_t *data[MAX_FRAMES];
     size_t size[MAX_FRAMES];
 };
