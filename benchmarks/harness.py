@@ -348,6 +348,8 @@ class Flow:
     qos_profile: str | None = None
     #: A second stream from the same publisher process (see :class:`Flood`).
     flood: Flood | None = None
+    #: The ROS subscriber takes the messages serialized (``workers.ros_sub``'s ``raw``).
+    raw: bool = False
 
 
 def run_flow(
@@ -372,6 +374,8 @@ def run_flow(
     if flow.qos_profile is not None:
         extra += ("--qos-profile", flow.qos_profile)
     sub_extra = (*extra, *depth) if flow.subscriber == "ros-sub" else extra
+    if flow.raw and flow.subscriber == "ros-sub":
+        sub_extra += ("--raw",)
     pub_extra = ("--hz", str(flow.hz), *(depth if flow.publisher == "ros-pub" else ()))
     pub_extra += tuple(flood_options(flood, flow.publisher == "gz-pub" and uses_ign_peer(pub_env)))
     lead = 0.0 if flood is None else flood.lead + MATCH_WAIT

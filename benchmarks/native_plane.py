@@ -61,6 +61,11 @@ from tests.gzpeer import PeerProcess, peer_binary, start_process, wait_for_line
 
 #: The bridge environment of each path, over :func:`~benchmarks.harness.bench_env`'s.
 PATHS = {"native": {}, "Python": {NATIVE_ENV: "off"}}
+#: The ROS ends of the overload phase: whether each takes the messages serialized. "rclpy"
+#: deserializes every message as an application does and so tops out at its own rate on these
+#: cores; "serialized" reads only the stamp (rclpy's ``raw=True``), so what it misses is what
+#: the bridge did not carry.
+SUBSCRIBERS = {"rclpy": False, "serialized": True}
 OVERLOAD_RATES = (1000.0, 2000.0, 5000.0, 10000.0, 20000.0, 40000.0)
 #: The history depth of the ROS subscriber and the channel's queues in the overload phase.
 QUEUE = PACED_DEPTH
@@ -228,6 +233,12 @@ class Point:
     counted: Counters | None
     #: The whole machine's CPU, % of all its cores, while publishing.
     machine: float | None = None
+    #: The ROS end (a key of :data:`SUBSCRIBERS`).
+    subscriber: str = "rclpy"
+
+    @property
+    def series(self) -> str:
+        return f"{self.path} path, {self.subscriber} subscriber"
 
     @property
     def offered(self) -> float:
@@ -250,25 +261,26 @@ class Point:
         return self.result.cpu / 100 / self.delivered * 1e6
 
 
-def sweep(path: str, seconds: float, rates: Sequence[float]) -> list[Point]:
-    """Odometry at each of ``rates`` through one fresh bridge on ``path``."""
+def sweep(path: str, subscriber: str, seconds: float, rates: Sequence[float]) -> list[Point]:
+    """Odometry at each of ``rates`` through one fresh bridge on ``path`` to ``subscriber``."""
     which = path_backend(path)
-    topic = topic_name(f"native_overload_{path}")
+    topic = topic_name(f"native_overload_{path}_{subscriber}")
     arguments = bridge_config([(topic, "odometry", "gz2ros")], QUEUE)
+    raw = SUBSCRIBERS[subscriber]
     points = []
     with bridge_process(arguments, which.bridge_env, channels=1) as bridge:
         for hz in rates:
-            flow = Flow("gz-pub", "ros-sub", "odometry", seconds, hz, depth=QUEUE)
+            flow = Flow("gz-pub", "ros-sub", "odometry", seconds, hz, depth=QUEUE, raw=raw)
             before, machine = counters(bridge, [topic]), MachineWindow(seconds)
             result = flow_through(flow, topic, which, bridge, machine.begin)
             counted = counted_since(before, counters(bridge, [topic]), topic)
-            points.append(Point(path, hz, seconds, result, counted, machine.percent))
+            points.append(Point(path, hz, seconds, result, counted, machine.percent, subscriber))
     return points
 
 
 def _point_row(point: Point) -> str:
     r = point.result
-    what = f"| {point.path} | {point.hz / 1000:g} kHz"
+    what = f"| {point.path} | {point.subscriber} | {point.hz / 1000:g} kHz"
     if r.error:
         return f"{what} | failed: {r.error} |||||||||||||"
     per = point.cpu_per_message_us()
@@ -286,11 +298,11 @@ def _point_row(point: Point) -> str:
 
 
 OVERLOAD_HEADER = (
-    "| path | offered | sent, kHz | delivered/sent | delivered, kHz | share "
+    "| path | ROS subscriber | offered | sent, kHz | delivered/sent | delivered, kHz | share "
     "| bridge published, kHz | bridge in / out / dropped | PATH column | bridge CPU "
     f"| bridge CPU per delivered message, µs | of which {SPLIT} threads "
-    "| rclpy subscriber CPU | machine CPU | median ms | p99 ms |\n"
-    "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    "| subscriber CPU | machine CPU | median ms | p99 ms |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 )
 
 
@@ -321,7 +333,7 @@ def where_lost(point: Point) -> str:
     text = (
         f"of {r.sent} sent the bridge published {counted.published} (it dropped "
         f"{counted.dropped} in its queue; {max(bridge_lost - counted.dropped, 0)} never reached "
-        f"it) and the rclpy subscriber took {r.received} of those "
+        f"it) and the {point.subscriber} subscriber took {r.received} of those "
         f"({r.received / max(counted.published, 1):.1%}), itself busy {_cpu(r.sub_cpu)} of a "
         f"core; the bridge {_cpu(r.cpu)} ({SPLIT} threads: {_threads(r.bridge_threads)}); "
         f"the machine's {os.cpu_count()} cores {_cpu(point.machine)} busy"
@@ -335,35 +347,44 @@ def where_lost(point: Point) -> str:
 
 
 def overload_goals(points: list[Point]) -> list[str]:
-    native = {p.hz: p for p in points if p.path == "native"}
     lines = []
-    at = native.get(GOAL_SHARE_HZ)
-    if at is None or at.result.error:
-        lines.append(f"- Native >= {GOAL_SHARE:.0%} at {GOAL_SHARE_HZ / 1000:g} kHz: not measured")
-    else:
+    for subscriber in SUBSCRIBERS:
+        native = {p.hz: p for p in points if p.path == "native" and p.subscriber == subscriber}
+        what = (
+            f"- Native delivers >= {GOAL_SHARE:.0%} at {GOAL_SHARE_HZ / 1000:g} kHz to the "
+            f"{subscriber} subscriber"
+        )
+        at = native.get(GOAL_SHARE_HZ)
+        if at is None or at.result.error:
+            lines.append(f"{what}: not measured")
+            continue
         share = at.result.share
         gap = f"{(GOAL_SHARE - share) * 100:.1f} percentage points"
         bound = "" if share >= GOAL_SHARE else f"; {where_lost(at)}"
         lines.append(
-            f"- Native delivers >= {GOAL_SHARE:.0%} at {GOAL_SHARE_HZ / 1000:g} kHz: "
-            f"{at.result.received}/{at.result.sent} = {share:.1%} — "
+            f"{what}: {at.result.received}/{at.result.sent} = {share:.1%} — "
             f"{verdict(share >= GOAL_SHARE, gap)}{bound}"
         )
-    for path in PATHS:
-        mine = [p for p in points if p.path == path]
+    for path, subscriber in itertools.product(PATHS, SUBSCRIBERS):
+        mine = sorted(
+            (p for p in points if p.path == path and p.subscriber == subscriber),
+            key=lambda p: p.hz,
+        )
+        if not mine:
+            continue
         fell = falls(mine)
-        rates = ", ".join(f"{p.delivered / 1000:.2f}" for p in sorted(mine, key=lambda p: p.hz))
+        rates = ", ".join(f"{p.delivered / 1000:.2f}" for p in mine)
         what = "the goal" if path == "native" else "for comparison"
-        published = [(p.hz, p.published) for p in sorted(mine, key=lambda p: p.hz)]
+        published = [p.published for p in mine]
         rising = all(
             (later or 0) >= (earlier or 0) * (1 - FALL_TOLERANCE)
-            for (_, earlier), (_, later) in itertools.pairwise(published)
+            for earlier, later in itertools.pairwise(published)
         )
         lines.append(
-            f"- {path}: the delivered rate never falls as the offered rate rises ({what}; "
-            f"falls within {FALL_TOLERANCE:.0%} count as noise): {rates} kHz — "
+            f"- {mine[0].series}: the delivered rate never falls as the offered rate rises "
+            f"({what}; falls within {FALL_TOLERANCE:.0%} count as noise): {rates} kHz — "
             f"{verdict(not fell, '; '.join(fell))}. What the bridge itself published: "
-            + ", ".join("-" if rate is None else f"{rate / 1000:.2f}" for _, rate in published)
+            + ", ".join("-" if rate is None else f"{rate / 1000:.2f}" for rate in published)
             + f" kHz ({'never falls' if rising else 'falls'})"
         )
     return lines
@@ -716,19 +737,20 @@ def proxy_lines() -> list[str]:
 
 
 def _plot(points: list[Point]) -> str:
+    names = dict.fromkeys(p.series for p in points)
     series = {
-        f"{path} path, delivered": [
-            (p.hz / 1000, p.delivered / 1000) for p in points if p.path == path
+        f"{name}, delivered": [
+            (p.hz / 1000, p.delivered / 1000) for p in points if p.series == name
         ]
-        for path in PATHS
+        for name in names
     }
-    series |= {
-        f"{path} path, published by the bridge": [
+    series |= {  # what the bridge published does not depend on the subscriber: one line a path
+        f"{path} path, published by the bridge ({subscriber} subscriber)": [
             (p.hz / 1000, p.published / 1000)
             for p in points
-            if p.path == path and p.published is not None
+            if p.path == path and p.subscriber == subscriber and p.published is not None
         ]
-        for path in PATHS
+        for path, subscriber in ((path, list(SUBSCRIBERS)[-1]) for path in PATHS)
     }
     try:
         drawn = plots.native_overload_plot(series, OVERLOAD_PNG)
@@ -766,9 +788,12 @@ other work on the machine included). {GZ_ENDS}
 
 The C++ peer offers Odometry at {rates} kHz for {args.seconds:g} s each (paced, serialized
 anew each time) through one channel with queues of {QUEUE} (YAML `publisher_queue` /
-`subscriber_queue`, as `costs`' rows) to an rclpy subscriber of depth {QUEUE}. Delivered =
-what that subscriber received per second of publishing; CPU per delivered message = bridge
-CPU / delivered rate.
+`subscriber_queue`, as `costs`' rows) to an rclpy subscriber of depth {QUEUE}, a fresh bridge
+for each path and subscriber: the *rclpy* subscriber deserializes every message (as an
+application does, and so tops out at its own rate on these cores); the *serialized* one takes
+them serialized (`raw=True`) and reads only the stamp, so what it misses is what the bridge did
+not carry. Delivered = what the subscriber received per second of publishing; CPU per
+delivered message = bridge CPU / delivered rate.
 
 {OVERLOAD_HEADER}
 {chr(10).join(_point_row(point) for point in points)}
@@ -818,7 +843,7 @@ def _stored(
     points: list[Point], runs: list[Workload], clocks: list[ClockRun]
 ) -> tuple[dict[str, FlowResult], dict[str, float]]:
     """The flows and figures kept in ``benchmarks/results.json``."""
-    flows = {f"overload {p.path} {p.hz:g}": p.result for p in points}
+    flows = {f"overload {p.path} {p.subscriber} {p.hz:g}": p.result for p in points}
     flows |= {f"clock {run.path}": run.result for run in clocks}
     numbers = {f"workload {run.path} cpu": run.cpu for run in runs if run.cpu is not None}
     for run in runs:
@@ -840,7 +865,11 @@ def main(argv: list[str] | None = None) -> int:
         subscriber()
         return 0
     load_before = os.getloadavg()[0]
-    points = [p for path in PATHS for p in sweep(path, args.seconds, sorted(args.rates))]
+    points = [
+        point
+        for path, subscriber in itertools.product(PATHS, SUBSCRIBERS)
+        for point in sweep(path, subscriber, args.seconds, sorted(args.rates))
+    ]
     runs = [workload(path, args.workload_seconds) for path in PATHS]
     clocks = [clock_under_flood(path, args.clock_seconds) for path in PATHS]
     write_section("native_plane", section(points, runs, clocks, args))

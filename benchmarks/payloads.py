@@ -9,6 +9,7 @@ Gazebo messages are built with the registry's own ``to_gz`` from the ROS message
 from __future__ import annotations
 
 import math
+import struct
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -210,6 +211,17 @@ def ros_stamp(kind: Kind, msg: Any) -> int:
         return round(seconds * NS)
     time_msg = _ros_time(kind, msg)
     return int(time_msg.sec) * NS + int(time_msg.nanosec)
+
+
+def ros_stamp_cdr(kind: Kind, data: bytes) -> int:
+    """The stamp of a serialized ROS message of ``kind``, read without deserializing it: a
+    header or a clock is the message's first field, right after the 4-byte encapsulation
+    (whose second byte says the byte order)."""
+    if kind.stamp_at not in ("header", "clock"):
+        msg = f"{kind.name}: the stamp is not the message's first field"
+        raise ValueError(msg)
+    sec, nanosec = struct.unpack_from("<iI" if data[1] & 1 else ">iI", data, 4)
+    return int(sec) * NS + int(nanosec)
 
 
 def stamp_gz(kind: Kind, msg: Any, stamp_ns: int) -> None:

@@ -148,9 +148,10 @@ def native_overload_plot(series: Mapping[str, Sequence[tuple[float, float]]], re
 
     figure, axes = plt.subplots(figsize=(7, 4.5))
     top = max((offered for points in series.values() for offered, _ in points), default=1.0)
-    # Delivered (solid) then published (dashed), one colour per path.
-    styles = (("o-", "tab:blue"), ("s-", "tab:orange"), ("o--", "tab:blue"), ("s--", "tab:orange"))
-    for (label, points), (style, colour) in zip(series.items(), styles, strict=False):
+    # One colour per path, one marker per subscriber; delivered solid, published dashed.
+    for label, points in series.items():
+        colour = "tab:blue" if label.startswith("native") else "tab:orange"
+        style = ("^" if "serialized" in label else "o") + ("--" if "published" in label else "-")
         axes.plot([p[0] for p in points], [p[1] for p in points], style, color=colour, label=label)
     axes.plot([0, top], [0, top], ":", color="grey", label="delivered = offered")
     axes.set_xlabel("offered rate, kHz (Odometry, Gazebo -> ROS)")

@@ -23,7 +23,16 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from benchmarks.payloads import KINDS, GzPayloads, Kind, gz_stamp, now_ns, ros_stamp, stamp_ros
+from benchmarks.payloads import (
+    KINDS,
+    GzPayloads,
+    Kind,
+    gz_stamp,
+    now_ns,
+    ros_stamp,
+    ros_stamp_cdr,
+    stamp_ros,
+)
 from benchmarks.transport import stats_line
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros.speed import apply_fastdds_profile
@@ -206,10 +215,19 @@ def ros_pub(
 
 
 def ros_sub(
-    topic: str, kind: Kind, seconds: float, slow_s: float, depth: int | None, *, profile: str | None
+    topic: str,
+    kind: Kind,
+    seconds: float,
+    slow_s: float,
+    depth: int | None,
+    *,
+    profile: str | None,
+    raw: bool = False,
 ) -> None:
     """Spin on a daemon thread; the main thread waits for SIGTERM or ``seconds`` and reports,
-    so the STATS line never depends on the executor shutting down cleanly under load."""
+    so the STATS line never depends on the executor shutting down cleanly under load.
+    ``raw``: take the messages serialized (rclpy's ``raw=True``) and read only their stamp, so
+    the subscriber's own cost is not rclpy's deserialization."""
     rclpy = _ros_start()
     from rclpy.task import Future  # noqa: PLC0415
 
@@ -220,9 +238,10 @@ def ros_sub(
     recorder = Recorder(slow_s)
 
     def on_message(msg: Any) -> None:
-        recorder.record(ros_stamp(kind, msg), 0)
+        recorder.record(ros_stamp_cdr(kind, msg) if raw else ros_stamp(kind, msg), 0)
 
-    node.create_subscription(kind.pair.ros_class, topic, on_message, _ros_qos(depth, profile))
+    qos = _ros_qos(depth, profile)
+    node.create_subscription(kind.pair.ros_class, topic, on_message, qos, raw=raw)
     say("READY")
     _announce_match(lambda: node.count_publishers(topic) > 0)
     stop = threading.Event()
@@ -322,6 +341,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--slow-ms", type=float, default=0.0, help="subscribers: work per message")
     parser.add_argument("--depth", type=int, default=None, help="ros ends: history depth")
     parser.add_argument("--qos-profile", help="ros-sub: a named profile (e.g. CLOCK)")
+    parser.add_argument("--raw", action="store_true", help="ros-sub: take messages serialized")
     parser.add_argument("--flood", help="publishers: topic of a second stream (see Flood)")
     parser.add_argument("--flood-kind", choices=sorted(KINDS), default="image1080")
     parser.add_argument("--flood-hz", type=float, default=0.0, help="0: back to back")
@@ -341,6 +361,7 @@ def main(argv: list[str] | None = None) -> int:
             args.slow_ms / 1000,
             args.depth,
             profile=args.qos_profile,
+            raw=args.raw,
         )
     elif args.role == "gz-pub":
         gz_pub(args.topic, kind, args.seconds, args.hz, flood)

@@ -15,6 +15,8 @@
 #define PY_SSIZE_T_CLEAN
 #include "pump.h"
 
+#include <errno.h>
+#include <poll.h>
 #include <pthread.h>
 #include <stdint.h>
 #include <string.h>
@@ -29,23 +31,15 @@ typedef union {
 } zmq_msg;
 
 typedef struct {
-    void *socket;
-    int fd;
-    short events;
-    short revents;
-} zmq_pollitem;
-
-typedef struct {
     uint8_t *buffer;
     size_t buffer_length;
     size_t buffer_capacity;
     void *allocator[5];
 } rcl_serialized;
 
-enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_EVENTS_ = 15 };
+enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_FD_ = 14, ZMQ_EVENTS_ = 15 };
 
 struct foreign {
-    int (*poll)(zmq_pollitem *items, int count, long timeout);
     int (*msg_init)(zmq_msg *msg);
     int (*msg_recv)(zmq_msg *msg, void *socket, int flags);
     int (*msg_close)(zmq_msg *msg);
@@ -193,12 +187,9 @@ static void keep(PumpObject *self, zmq_msg *payload, int route) {
     self->count++;
 }
 
-/* Reads one message; 0 when none was waiting. */
+/* Reads one message; 0 when none was waiting. The socket's own ZMQ_EVENTS is never asked: a
+ * SUB socket answers it by prefetching a message (see pump_loop). */
 static int read_message(PumpObject *self, void *sock) {
-    int events = 0;
-    size_t size = sizeof events;
-    if (self->f.getsockopt(sock, ZMQ_EVENTS_, &events, &size) != 0 || !(events & ZMQ_POLLIN_))
-        return 0;
     zmq_msg frames[MAX_FRAMES];
     int n = 0, more = 1, extra = 0;
     while (more) {
@@ -293,10 +284,34 @@ static void deliver(PumpObject *self, struct queued *q) {
 
 enum { EVENT_WAKE = 1, EVENT_MONITOR = 2, EVENT_HANDED = 4 };
 
+/* The descriptor libzmq signals when `sock` has commands to process, or -1. */
+static int zmq_fd(PumpObject *self, void *sock) {
+    int fd = -1;
+    size_t size = sizeof fd;
+    return self->f.getsockopt(sock, ZMQ_FD_, &fd, &size) == 0 ? fd : -1;
+}
+
+/* Whether the monitor (a PAIR socket: asking ZMQ_EVENTS prefetches nothing) has an event. */
+static int monitor_ready(PumpObject *self, void *monitor) {
+    int events = 0;
+    size_t size = sizeof events;
+    return self->f.getsockopt(monitor, ZMQ_EVENTS_, &events, &size) == 0 &&
+           (events & ZMQ_POLLIN_);
+}
+
+/* Sleeps in poll(2) on the sockets' ZMQ_FD descriptors rather than in zmq_poll: zmq_poll asks
+ * every socket's ZMQ_EVENTS before and after it sleeps, two more rounds of libzmq's command
+ * processing (getpid, poll) per message. The descriptor is edge-like: it is readable while
+ * commands wait, so it is slept on only after a read found the socket empty (a recv that
+ * returns EAGAIN has processed every command). */
 static int pump_loop(PumpObject *self, void *sock, int wake_fd, void *monitor, long timeout_ms) {
     int64_t deadline = now_ns(CLOCK_MONOTONIC) + (int64_t)timeout_ms * 1000000LL;
+    int sock_fd = zmq_fd(self, sock), monitor_fd = monitor ? zmq_fd(self, monitor) : -1;
+    if (sock_fd < 0 || (monitor && monitor_fd < 0)) return 0; /* a closed socket: Python looks */
+    if (monitor && monitor_ready(self, monitor)) return EVENT_MONITOR; /* left from a run */
     for (;;) {
-        for (int i = 0; i < READ_BATCH && read_message(self, sock); i++) {
+        int empty = 0;
+        for (int i = 0; i < READ_BATCH && !(empty = !read_message(self, sock)); i++) {
         }
         int64_t slice_end = now_ns(CLOCK_MONOTONIC) + SLICE_NS;
         while (self->count) {
@@ -310,16 +325,16 @@ static int pump_loop(PumpObject *self, void *sock, int wake_fd, void *monitor, l
         if (self->nhanded) return EVENT_HANDED;
         int64_t left = deadline - now_ns(CLOCK_MONOTONIC);
         if (left <= 0) return 0; /* also under a flood: Python's share is due */
-        if (self->count) continue;
-        zmq_pollitem items[3] = {
-            {sock, 0, ZMQ_POLLIN_, 0},
-            {NULL, wake_fd, ZMQ_POLLIN_, 0},
-            {monitor, 0, ZMQ_POLLIN_, 0},
+        if (self->count || !empty) continue;
+        struct pollfd fds[3] = {
+            {sock_fd, POLLIN, 0},
+            {wake_fd, POLLIN, 0},
+            {monitor_fd, POLLIN, 0},
         };
-        int ready = self->f.poll(items, monitor ? 3 : 2, (long)((left + 999999) / 1000000));
-        if (ready < 0) return 0; /* EINTR or a closed context: Python looks */
-        int events = (items[1].revents ? EVENT_WAKE : 0) |
-                     (monitor && items[2].revents ? EVENT_MONITOR : 0);
+        int ready = poll(fds, monitor ? 3 : 2, (int)((left + 999999) / 1000000));
+        if (ready < 0 && errno != EINTR) return 0;
+        int events = (fds[1].revents ? EVENT_WAKE : 0) |
+                     (monitor && fds[2].revents && monitor_ready(self, monitor) ? EVENT_MONITOR : 0);
         if (events) return events;
     }
 }
@@ -376,7 +391,7 @@ static PyObject *pump_new(PyTypeObject *type, PyObject *args, PyObject *kwds) {
 }
 
 /* Pump(topic, functions, publisher, programs, capacity, max_rate)
- * functions: 10 addresses (zmq_poll, zmq_msg_init, zmq_msg_recv, zmq_msg_close, zmq_msg_data,
+ * functions: 9 addresses (zmq_msg_init, zmq_msg_recv, zmq_msg_close, zmq_msg_data,
  * zmq_msg_size, zmq_msg_more, zmq_getsockopt, rcl_publish_serialized_message,
  * rcutils_reset_error); programs: {wire type (bytes): Program}. */
 static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
@@ -395,15 +410,15 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
                                      &publisher, &PyDict_Type, &programs, &capacity, &max_rate))
         return -1;
     int result = -1;
-    void *addresses[10];
+    void *addresses[9];
     PyObject *sequence = PySequence_Fast(functions, "functions must be a sequence");
     if (sequence == NULL) goto done;
-    if (PySequence_Fast_GET_SIZE(sequence) != 10) {
-        PyErr_SetString(PyExc_ValueError, "functions: 10 addresses expected");
+    if (PySequence_Fast_GET_SIZE(sequence) != 9) {
+        PyErr_SetString(PyExc_ValueError, "functions: 9 addresses expected");
         Py_DECREF(sequence);
         goto done;
     }
-    for (int i = 0; i < 10; i++) {
+    for (int i = 0; i < 9; i++) {
         addresses[i] = PyLong_AsVoidPtr(PySequence_Fast_GET_ITEM(sequence, i));
         if (addresses[i] == NULL) {
             if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "a null function address");
@@ -416,16 +431,15 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
         PyErr_SetString(PyExc_ValueError, "publisher, capacity or max_rate out of range");
         goto done;
     }
-    memcpy(&self->f.poll, &addresses[0], sizeof(void *));
-    memcpy(&self->f.msg_init, &addresses[1], sizeof(void *));
-    memcpy(&self->f.msg_recv, &addresses[2], sizeof(void *));
-    memcpy(&self->f.msg_close, &addresses[3], sizeof(void *));
-    memcpy(&self->f.msg_data, &addresses[4], sizeof(void *));
-    memcpy(&self->f.msg_size, &addresses[5], sizeof(void *));
-    memcpy(&self->f.msg_more, &addresses[6], sizeof(void *));
-    memcpy(&self->f.getsockopt, &addresses[7], sizeof(void *));
-    memcpy(&self->f.publish, &addresses[8], sizeof(void *));
-    memcpy(&self->f.reset_error, &addresses[9], sizeof(void *));
+    memcpy(&self->f.msg_init, &addresses[0], sizeof(void *));
+    memcpy(&self->f.msg_recv, &addresses[1], sizeof(void *));
+    memcpy(&self->f.msg_close, &addresses[2], sizeof(void *));
+    memcpy(&self->f.msg_data, &addresses[3], sizeof(void *));
+    memcpy(&self->f.msg_size, &addresses[4], sizeof(void *));
+    memcpy(&self->f.msg_more, &addresses[5], sizeof(void *));
+    memcpy(&self->f.getsockopt, &addresses[6], sizeof(void *));
+    memcpy(&self->f.publish, &addresses[7], sizeof(void *));
+    memcpy(&self->f.reset_error, &addresses[8], sizeof(void *));
     self->publisher = (void *)(uintptr_t)publisher;
     Py_ssize_t n = PyDict_Size(programs);
     self->programs = calloc((size_t)n + 1, sizeof *self->programs);

@@ -28,7 +28,6 @@ from ros_gz_bridge_py.transport import MessageInfo
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 _ZMQ_FUNCTIONS = (
-    "zmq_poll",
     "zmq_msg_init",
     "zmq_msg_recv",
     "zmq_msg_close",
