@@ -168,6 +168,9 @@ def _build(build: Path) -> None:
     """Build in one persistent tree (ninja rebuilds only what changed), then keep a copy of
     the binary under the source hash so each version is built once."""
     tree = BUILD_ROOT / "tree"
+    cache = tree / "CMakeCache.txt"
+    if cache.exists() and f"CMAKE_HOME_DIRECTORY:INTERNAL={PEER_SOURCE}\n" not in cache.read_text():
+        shutil.rmtree(tree)  # configured from another checkout: cmake refuses to reuse it
     steps = (
         ["cmake", "-S", str(PEER_SOURCE), "-B", str(tree), "-G", "Ninja"],
         ["cmake", "--build", str(tree)],

@@ -46,6 +46,7 @@ from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import Spelling
+from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.ros.side_node import (
     SideNode,
     native_node_name,
@@ -103,7 +104,7 @@ class Bridge:
             ),
             options=self.options,
         )
-        self._logger = ros_node.get_logger()
+        self._logger = quick_logger(ros_node.get_logger())
         self._lock = threading.RLock()
         self._handles: list[BridgeHandle] = []
         self._closed = False

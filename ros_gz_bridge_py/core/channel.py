@@ -46,6 +46,7 @@ from ros_gz_bridge_py.core.loop_guard import OwnPublications
 from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.rate_limit import rate_limiter
 from ros_gz_bridge_py.errors import SizeMismatchError, UndecodableError
+from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.transport import GzNode, Rejection
 from ros_gz_bridge_py.transport.throttle import Throttle
 
@@ -182,7 +183,7 @@ class Channel(abc.ABC):
         self.flow: Flow | None = None
         self.findings: list[Finding] = []
         self.ros_topic = ctx.resolve(spec.ros_topic)
-        self._logger = ctx.ros_node.get_logger()
+        self._logger = quick_logger(ctx.ros_node.get_logger())
         # Error counting: from the transport's thread and the delivery thread.
         self._error_lock = threading.Lock()
         self._error_log = Throttle(ERROR_LOG_PERIOD)

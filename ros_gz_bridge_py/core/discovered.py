@@ -34,6 +34,7 @@ from ros_gz_bridge_py.core.discovery_plan import (
 )
 from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.transport.api import PUBLISHER, GraphEndpoint
 
 #: Seconds between two scans of the graph (a new topic is bridged within about this long
@@ -59,7 +60,7 @@ class DiscoveredBridges:
         self._bridge = bridge
         self._patterns = tuple(patterns)
         self._rules = rules or AutoBridgeRules()
-        self._logger = bridge.ros_node.get_logger()
+        self._logger = quick_logger(bridge.ros_node.get_logger())
         #: Gazebo topic -> the handle of the bridge made for it.
         self.current: dict[str, BridgeHandle] = {}
         self._failed: dict[str, TopicBridgeSpec] = {}

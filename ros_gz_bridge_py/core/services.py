@@ -24,6 +24,7 @@ from ros_gz_bridge_py.converters.registry import ServicePair
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import same_message
+from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.ros.side_node import SideNode
 from ros_gz_bridge_py.transport import GzNode
 
@@ -82,7 +83,7 @@ class ServiceBridge:
         self._host = host
         self._ros_node = host.node
         self._gz_node = gz_node
-        self._logger = host.node.get_logger()
+        self._logger = quick_logger(host.node.get_logger())
         self.calls = 0
         self.failures = 0
         self.waiting = 0

@@ -17,6 +17,7 @@ constexpr char kUsage[] =
     "usage: ign_peer MODE ...\n"
     "  pub TOPIC TYPE HZ COUNT [TEXTPROTO] [--bytes N] [--wait S] [--settle S] [--linger S]\n"
     "      [--wire-type WIRETYPE] [--field 'NUMBER TYPE TEXTPROTO']...\n"
+    "  pub-many TYPE HZ TEXTPROTO TOPIC... [--wire-type WIRETYPE]\n"
     "  echo TOPIC TYPE SECONDS [--count N] [--sha | --hex] [--wire-type WIRETYPE]\n"
     "  relay IN OUT TYPE SECONDS\n"
     "  reply SERVICE REQTYPE REPTYPE SECONDS [--fail] [--response TEXTPROTO] [--sha]\n"
@@ -32,7 +33,8 @@ constexpr char kUsage[] =
 
 int main(int argc, char **argv) {
   const std::map<std::string, int (*)(const peer::Args &)> modes = {
-      {"pub", peer::RunPub},         {"echo", peer::RunEcho},
+      {"pub", peer::RunPub},         {"pub-many", peer::RunPubMany},
+      {"echo", peer::RunEcho},
       {"relay", peer::RunRelay},     {"reply", peer::RunReply},
       {"call", peer::RunCall},       {"bench-pub", peer::RunBenchPub},
       {"bench-sub", peer::RunBenchSub},   {"kind-pub", peer::RunKindPub},

@@ -6,6 +6,7 @@
 namespace peer {
 
 int RunPub(const Args &args);
+int RunPubMany(const Args &args);
 int RunEcho(const Args &args);
 int RunRelay(const Args &args);
 int RunReply(const Args &args);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "messages.hh"
 #include "modes.hh"
@@ -67,6 +68,42 @@ int RunPub(const Args &args) {
   }
   Line("SENT " + std::to_string(sent));
   SleepFor(args.Number("linger", 0.5));
+  return 0;
+}
+
+// pub-many TYPE HZ TEXTPROTO TOPIC... [--wire-type WIRETYPE]
+// One node advertising every TOPIC and publishing the same message on each, all of them once
+// per round at HZ rounds a second until stopped, as upstream ros_gz_bridge's test_gz_publisher
+// does from one process. Prints READY once all are advertised, then `SENT n` (per topic).
+int RunPubMany(const Args &args) {
+  const std::string type = args.Word(1, "TYPE");
+  const double hz = ToNumber(args.Word(2, "HZ"), "HZ");
+  if (hz <= 0) throw UsageError("pub-many needs HZ > 0");
+  auto msg = MakeMessage(type, args.Word(3, "TEXTPROTO"));
+  std::string payload;
+  msg->SerializeToString(&payload);
+  const std::string wireType = args.Text("wire-type", type);
+  ignition::transport::Node node;
+  std::vector<ignition::transport::Node::Publisher> pubs;
+  for (std::size_t i = 4; i < args.WordCount(); ++i) {
+    pubs.push_back(node.Advertise(args.Word(i, "TOPIC"), wireType));
+    if (!pubs.back()) {
+      Line("ERROR advertise failed for " + args.Word(i, "TOPIC"));
+      return 1;
+    }
+  }
+  if (pubs.empty()) throw UsageError("pub-many needs at least one TOPIC");
+  Line("READY");
+  const auto period = static_cast<std::int64_t>(1e9 / hz);
+  std::int64_t next = MonotonicNs();
+  long rounds = 0;
+  for (; !StopRequested(); ++rounds) {
+    for (auto &pub : pubs) pub.PublishRaw(payload, wireType);
+    next += period;
+    const std::int64_t wait = next - MonotonicNs();
+    if (wait > 0) SleepFor(static_cast<double>(wait) / 1e9);
+  }
+  Line("SENT " + std::to_string(rounds));
   return 0;
 }
 

@@ -166,6 +166,15 @@ class ZmqGzNode(GzNode):
         self._commands.append(command)
         self._io.wake()
 
+    def _soon(self, command: Callable[[], None]) -> None:
+        """Run ``command`` on the I/O thread without waiting for it: a new publisher's
+        announcements need no answer, and a caller that waited for an I/O thread busy with
+        traffic made every channel's creation wait a scheduling round (issue 23)."""
+        if threading.current_thread() is self._io_thread:
+            command()
+        else:
+            self._post(command)
+
     def _call(self, function: Callable[[], T]) -> T:
         """Run ``function`` on the I/O thread and return its result."""
         if threading.current_thread() is self._io_thread:
@@ -216,7 +225,7 @@ class ZmqGzNode(GzNode):
             for record in records:
                 self._datagrams(self._io.msg_udp, self._msg.advertise(record))
 
-        self._call(command)
+        self._soon(command)
         return publisher
 
     def _close_publisher(self, publisher: Publisher) -> None:
@@ -260,6 +269,8 @@ class ZmqGzNode(GzNode):
         return self._intake.open_reader(sub, size, on_start)
 
     def _open_subscription(self, sub: Subscription) -> None:
+        # Waited for: whether the shared socket subscribes to the topic depends on the topic's
+        # other subscriptions as they stand when this one starts.
         self._call(lambda: self._start_subscription(cast(ZmqSubscription, sub)))
 
     def _start_subscription(self, sub: ZmqSubscription) -> None:
