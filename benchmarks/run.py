@@ -59,6 +59,7 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
             [
                 *("--seconds", "1" if quick else "2"),
                 *("--workload-seconds", "3" if quick else "10"),
+                *("--workload-rounds", "1" if quick else "3"),
                 *("--clock-seconds", "2" if quick else "5"),
             ]
         ),

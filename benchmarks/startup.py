@@ -117,7 +117,7 @@ def bridge_rounds(count: int, rounds: int, hz: float | None, *, spread: bool = F
     if hz is None:
         label += ", no traffic"
     else:
-        label += f", {count} Gazebo topics at {hz:g} Hz"
+        label += f", {count} Gazebo topic{'' if count == 1 else 's'} at {hz:g} Hz"
         label += f" from {count} processes" if spread else " from one process"
     return Row(label, tuple(t[0] for t in times), tuple(t[1] for t in times))
 
