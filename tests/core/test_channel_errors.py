@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import uuid
 from collections.abc import Iterator
-from typing import Any
+from typing import Any, cast
 
 import pytest
 import rclpy
@@ -56,7 +56,7 @@ class Setup:
             direction=Direction.GZ_TO_ROS,
         )
         channel = self.bridge.add(spec).channels[0]
-        channel._logger = self  # collect its warnings
+        channel._logger = cast(Any, self)  # collect its warnings
         return channel
 
     def warning(self, text: str) -> None:

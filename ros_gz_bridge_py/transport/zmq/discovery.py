@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import collections
 import logging
+import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
 
@@ -34,7 +35,8 @@ _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 # Timers in seconds, §2.5 (gz-transport Discovery.hh constants).
 #: Send HEARTBEAT and re-ADVERTISE every local record this often.
 HEARTBEAT_INTERVAL = 1.0
-#: Check peers for silence this often.
+#: gz-transport checks peers for silence this often; a silent peer is forgotten within this
+#: long after SILENCE_INTERVAL. We check when the first one can have gone silent, no sooner.
 ACTIVITY_INTERVAL = 0.1
 #: Forget a peer process not heard from for longer than this.
 SILENCE_INTERVAL = 3.0
@@ -120,7 +122,7 @@ class DiscoveryEngine:
         #: What each peer process calls its message types (docs/protocol.md §9).
         self.spellings = PeerSpellings(legacy_spelling)
         self._next_heartbeat = now
-        self._next_activity = now + ACTIVITY_INTERVAL
+        self._next_activity = math.inf  # no peer yet
 
     # --- queries -------------------------------------------------------------------------
 
@@ -248,8 +250,15 @@ class DiscoveryEngine:
                     self.counts["peers_expired"] += 1
                     _LOG.debug("discovery: peer %s silent for %.1f s", process, now - seen)
                     events += self._forget_process(process)
-            self._next_activity = now + ACTIVITY_INTERVAL
+            self._next_activity = self._first_silence()
         return out, events
+
+    def _first_silence(self) -> float:
+        """When the peer heard from longest ago will have been silent too long (an idle I/O
+        thread then wakes for heartbeats only, not ten times a second)."""
+        if not self._activity:
+            return math.inf
+        return min(self._activity.values()) + SILENCE_INTERVAL + ACTIVITY_INTERVAL
 
     def datagram_received(self, data: bytes, source_ip: str, now: float) -> Result:
         """Handle one datagram from ``source_ip``; never raises on bad input."""
@@ -280,6 +289,7 @@ class DiscoveryEngine:
             relayed = encode_discovery(replace(message, relay=True))
             out += [Outgoing(relayed, ip) for ip in self._relays]
         self._activity[message.process_uuid] = now
+        self._next_activity = min(self._next_activity, now + SILENCE_INTERVAL + ACTIVITY_INTERVAL)
         try:
             more, events = self._dispatch(message, source_ip, now)
         except RemoteProtocolError as error:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber
 from ros_gz_bridge_py.transport.zmq.discovery import (
+    ACTIVITY_INTERVAL,
     HEARTBEAT_INTERVAL,
     SILENCE_INTERVAL,
     DiscoveryEngine,
@@ -57,6 +58,35 @@ def test_heartbeat_schedule_and_readvertise() -> None:
     assert engine.next_deadline() <= 100.0 + HEARTBEAT_INTERVAL
     out, _ = engine.tick(101.0)
     assert [m.type for m in sent(out)] == [DiscoveryType.HEARTBEAT, DiscoveryType.ADVERTISE]
+
+
+def test_an_idle_engine_wakes_for_heartbeats_and_rarely_else_yet_expires_in_time() -> None:
+    """The silence check is due when the peer heard from longest ago can have gone silent (about
+    once per SILENCE_INTERVAL while it beats), not every ACTIVITY_INTERVAL; a silent peer is
+    still forgotten within ACTIVITY_INTERVAL after SILENCE_INTERVAL, as gz-transport's check
+    every 100 ms forgets it."""
+    engine = DiscoveryEngine(ME, 0.0)
+    engine.tick(0.0)  # the first heartbeat
+    assert engine.next_deadline() == HEARTBEAT_INTERVAL  # no peer: nothing else is due
+    engine.datagram_received(datagram(DiscoveryType.ADVERTISE, pub=record()), "127.0.0.1", 0.5)
+    heartbeat = datagram(DiscoveryType.HEARTBEAT)
+    wakes, beats, now = 0, [1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5, 8.5], 0.0
+    while beats:  # an I/O loop: the peer's beats arrive between the engine's deadlines
+        now = min(engine.next_deadline(), beats[0])
+        if now == beats[0]:
+            engine.datagram_received(heartbeat, "127.0.0.1", beats.pop(0))
+            continue
+        wakes += 1
+        assert engine.tick(now)[1] == []
+    assert wakes <= 8 + 3  # our 8 heartbeats and a silence check per 3 s (was 80 checks)
+    last, expired = 8.5, list[object]()  # the peer's last beat; it falls silent
+    while not expired:
+        now = engine.next_deadline()
+        assert now <= last + SILENCE_INTERVAL + ACTIVITY_INTERVAL + 1e-9
+        expired = list(engine.tick(now)[1])
+    assert expired == [PublisherRemoved(record())]
+    assert now > last + SILENCE_INTERVAL
+    assert engine.next_deadline() - now <= HEARTBEAT_INTERVAL  # heartbeats only again
 
 
 def test_advertise_adds_once_and_silence_expires() -> None:
