@@ -180,6 +180,25 @@ struct rgb_program *native_program_of(PyObject *object) {
     return program->words == NULL ? NULL : &program->program;
 }
 
+int native_addresses(PyObject *functions, void **out, Py_ssize_t count) {
+    PyObject *sequence = PySequence_Fast(functions, "functions must be a sequence");
+    if (sequence == NULL) return -1;
+    int result = 0;
+    if (PySequence_Fast_GET_SIZE(sequence) != count) {
+        PyErr_Format(PyExc_ValueError, "functions: %zd addresses expected", count);
+        result = -1;
+    }
+    for (Py_ssize_t i = 0; result == 0 && i < count; i++) {
+        out[i] = PyLong_AsVoidPtr(PySequence_Fast_GET_ITEM(sequence, i));
+        if (out[i] == NULL) {
+            if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "a null function address");
+            result = -1;
+        }
+    }
+    Py_DECREF(sequence);
+    return result;
+}
+
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, .m_name = "_native",
     .m_doc = "The native data plane of ros_gz_bridge_py (docs/native.md).", .m_size = -1,

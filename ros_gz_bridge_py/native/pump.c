@@ -310,9 +310,8 @@ static int pump_loop(PumpObject *self, void *sock, int wake_fd, void *monitor, l
     if (sock_fd < 0 || (monitor && monitor_fd < 0)) return 0; /* a closed socket: Python looks */
     if (monitor && monitor_ready(self, monitor)) return EVENT_MONITOR; /* left from a run */
     for (;;) {
-        int empty = 0;
-        for (int i = 0; i < READ_BATCH && !(empty = !read_message(self, sock)); i++) {
-        }
+        int empty = 0; /* a read found the socket empty: its descriptor may be slept on */
+        for (int i = 0; i < READ_BATCH && !empty; i++) empty = !read_message(self, sock);
         int64_t slice_end = now_ns(CLOCK_MONOTONIC) + SLICE_NS;
         while (self->count) {
             struct queued *q = &self->ring[self->head];
@@ -411,22 +410,8 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
         return -1;
     int result = -1;
     void *addresses[9];
-    PyObject *sequence = PySequence_Fast(functions, "functions must be a sequence");
-    if (sequence == NULL) goto done;
-    if (PySequence_Fast_GET_SIZE(sequence) != 9) {
-        PyErr_SetString(PyExc_ValueError, "functions: 9 addresses expected");
-        Py_DECREF(sequence);
+    if (native_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0)
         goto done;
-    }
-    for (int i = 0; i < 9; i++) {
-        addresses[i] = PyLong_AsVoidPtr(PySequence_Fast_GET_ITEM(sequence, i));
-        if (addresses[i] == NULL) {
-            if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "a null function address");
-            Py_DECREF(sequence);
-            goto done;
-        }
-    }
-    Py_DECREF(sequence);
     if (publisher == 0 || capacity < 1 || capacity > (1 << 24) || !(max_rate >= 0)) {
         PyErr_SetString(PyExc_ValueError, "publisher, capacity or max_rate out of range");
         goto done;

@@ -19,4 +19,8 @@ struct rgb_encoder *native_encoder_of(PyObject *object);
 /* The loaded program of a Program object, or NULL when `object` is not one. */
 struct rgb_program *native_program_of(PyObject *object);
 
+/* Reads the `count` function addresses of the sequence `functions` (pump.py, ros_pump.py
+ * resolve them) into `out`; -1 with a Python error unless it holds exactly that many, none null. */
+int native_addresses(PyObject *functions, void **out, Py_ssize_t count);
+
 #endif

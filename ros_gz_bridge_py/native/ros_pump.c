@@ -302,20 +302,12 @@ static int ros_pump_init(RosPumpObject *self, PyObject *args, PyObject *kwds) {
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "OKKO!d", keywords, &functions, &subscription,
                                      &sock, &PyList_Type, &spellings, &max_rate))
         return -1;
-    PyObject *sequence = PySequence_Fast(functions, "functions must be a sequence");
-    if (sequence == NULL) return -1;
     void *addresses[7];
-    int bad = PySequence_Fast_GET_SIZE(sequence) != 7;
-    for (int i = 0; !bad && i < 7; i++) {
-        addresses[i] = PyLong_AsVoidPtr(PySequence_Fast_GET_ITEM(sequence, i));
-        bad = addresses[i] == NULL;
-    }
-    Py_DECREF(sequence);
+    if (native_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0)
+        return -1;
     Py_ssize_t n = PyList_GET_SIZE(spellings);
-    if (bad || PyErr_Occurred() || subscription == 0 || sock == 0 || n < 1 || n > MAX_SPELLINGS ||
-        !(max_rate >= 0)) {
-        if (!PyErr_Occurred())
-            PyErr_SetString(PyExc_ValueError, "bad functions, handles, spellings or max_rate");
+    if (subscription == 0 || sock == 0 || n < 1 || n > MAX_SPELLINGS || !(max_rate >= 0)) {
+        PyErr_SetString(PyExc_ValueError, "bad handles, spellings or max_rate");
         return -1;
     }
     memcpy(&self->f.take, &addresses[0], sizeof(void *));
