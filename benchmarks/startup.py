@@ -142,7 +142,8 @@ def goal_line(rows: Sequence[Row], hz: float) -> str:
     return (
         f"- Issue 22: with {row.label.split(',')[0]} and traffic already flowing ({hz:g} Hz a "
         f"topic), the last channel exists within {GOAL_SPAN_S:g} s of the first: "
-        f"{span:.3f} s (median) — " + ("**met**" if met else f"**missed** by {span - 1:.3f} s")
+        f"{span:.3f} s (median) — "
+        + ("**met**" if met else f"**missed** by {span - GOAL_SPAN_S:.3f} s")
     )
 
 

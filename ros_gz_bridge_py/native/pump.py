@@ -121,6 +121,8 @@ class ChannelPump:
         self._counted = counted
         self._partition = partition
         self._name = name
+        #: Messages the last run took from the socket (delivered here, or handed back).
+        self.took = 0
         self._infos: dict[tuple[bytes, bytes], MessageInfo] = {}
         self._seen = (0, 0, 0, 0, 0)
 
@@ -151,6 +153,7 @@ class ChannelPump:
             else:
                 _kind, sender, msg_type, payload, _status = item
                 self._refused(payload, self._info(sender, msg_type))
+        self.took = received + len(unrouted)
         return events, unrouted
 
     def _info(self, sender: bytes, msg_type: bytes) -> MessageInfo:

@@ -175,6 +175,11 @@ class NativeLoop(Protocol):
         ...
 
     @property
+    def took(self) -> int:
+        """Messages its last run took from the socket (delivered, or handed back)."""
+        ...
+
+    @property
     def dropped(self) -> int:
         """Messages it dropped, oldest first."""
         ...

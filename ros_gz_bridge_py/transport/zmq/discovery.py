@@ -44,6 +44,11 @@ SILENCE_INTERVAL = 3.0
 INIT_DELAY = 2 * HEARTBEAT_INTERVAL
 
 
+def _silent_after(seen: float) -> float:
+    """When a peer last heard from at ``seen`` is checked for silence."""
+    return seen + SILENCE_INTERVAL + ACTIVITY_INTERVAL
+
+
 @dataclass(frozen=True, slots=True)
 class Outgoing:
     """A datagram to send: to the multicast group (``relay_ip`` None) or to one relay."""
@@ -256,9 +261,7 @@ class DiscoveryEngine:
     def _first_silence(self) -> float:
         """When the peer heard from longest ago will have been silent too long (an idle I/O
         thread then wakes for heartbeats only, not ten times a second)."""
-        if not self._activity:
-            return math.inf
-        return min(self._activity.values()) + SILENCE_INTERVAL + ACTIVITY_INTERVAL
+        return _silent_after(min(self._activity.values(), default=math.inf))
 
     def datagram_received(self, data: bytes, source_ip: str, now: float) -> Result:
         """Handle one datagram from ``source_ip``; never raises on bad input."""
@@ -289,7 +292,7 @@ class DiscoveryEngine:
             relayed = encode_discovery(replace(message, relay=True))
             out += [Outgoing(relayed, ip) for ip in self._relays]
         self._activity[message.process_uuid] = now
-        self._next_activity = min(self._next_activity, now + SILENCE_INTERVAL + ACTIVITY_INTERVAL)
+        self._next_activity = min(self._next_activity, _silent_after(now))
         try:
             more, events = self._dispatch(message, source_ip, now)
         except RemoteProtocolError as error:

@@ -218,9 +218,8 @@ class SubscriptionReader:
         address = monitor.underlying
 
         def poll(timeout: int) -> dict[Any, int]:
-            before = native.received
             events, unrouted = native.run(sock, self._wake_fd, address, timeout)
-            self._quiet = native.received == before and not unrouted
+            self._quiet = not native.took
             for frames in unrouted:
                 self._judge_for(native, frames)
             dropped = native.dropped - self._native_dropped

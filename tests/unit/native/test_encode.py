@@ -26,7 +26,6 @@ import pytest
 from rclpy.serialization import serialize_message
 
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.ros import cdr_types as cdr
 from ros_gz_bridge_py.ros import light_reader
 from ros_gz_bridge_py.ros.cdr_writer import writer_for
@@ -100,14 +99,6 @@ _HUGE = (0xFFFFFFFF, 0x80000000, 0x7FFFFFFF, 0x10000, 0)
 
 COMPILED = compiled_encoders()
 IDS = [f"{pair.ros_type}-{pair.gz_type}" for pair, _ in COMPILED]
-
-
-@pytest.fixture(scope="module")
-def native() -> Any:
-    module = extension()
-    if module is None:
-        pytest.skip("the native extension is not built (test_native_path.py requires it in CI)")
-    return module
 
 
 def _python(pair: Pair, data: bytes) -> bytes | Exception:

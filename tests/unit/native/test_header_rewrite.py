@@ -13,7 +13,6 @@ import pytest
 
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
 from ros_gz_bridge_py.ros.cdr_writer import writer_for
 from tools.native_fuzz_programs import distinctive
@@ -38,14 +37,6 @@ def _with_header() -> list[Pair]:
 
 
 PAIRS = _with_header()
-
-
-@pytest.fixture(scope="module")
-def native() -> Any:
-    module = extension()
-    if module is None:
-        pytest.skip("the native extension is not built (test_native_path.py requires it in CI)")
-    return module
 
 
 def _program(native: Any, pair: Pair, *, frame_id: str = "", wall_stamp: bool = False) -> Any:
