@@ -48,10 +48,11 @@ PARTITION = f"bench-{os.getpid()}-{uuid.uuid4().hex[:6]}"
 FlowFailure = (Exception, pytest.fail.Exception)
 
 
-def bench_env(backend: str = "zeromq") -> dict[str, str]:
+def bench_env(backend: str = "zeromq", base: Mapping[str, str] | None = None) -> dict[str, str]:
     """The environment of every benchmark process: loopback only, our own partition/domain,
-    the bridge executables' Fast DDS profile (so the ceiling uses the same settings)."""
-    env = dict(os.environ)
+    the bridge executables' Fast DDS profile (so the ceiling uses the same settings); made
+    from ``base`` (default: this process's environment)."""
+    env = dict(os.environ if base is None else base)
     partition = PARTITION
     env.update(
         {

@@ -1,6 +1,6 @@
 """Start-up (issue 23): from the bridge process's start to its first and last ``Creating`` line.
 
-Usage: ``.venv/bin/python -m benchmarks.startup [--counts 1 8 66] [--rounds 5] [--hz 100]``.
+Usage: ``.venv/bin/python -m benchmarks.startup [--counts 1 3 8 66] [--rounds 5] [--hz 100]``.
 
 Per count N: ``parameter_bridge`` with N inline entries ``/t<i>@std_msgs/msg/String@
 gz.msgs.StringMsg`` (both directions, as in the issue), started ``--rounds`` times without
@@ -25,7 +25,7 @@ import statistics
 import subprocess
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from benchmarks.harness import BIN, ROOT, bench_env, topic_name
@@ -44,16 +44,27 @@ LOG_ENV = {
     "RCUTILS_LOGGING_SEVERITY_THRESHOLD": "INFO",
     "RCUTILS_CONSOLE_OUTPUT_FORMAT": LOG_FORMAT,
 }
-#: A process that only does what every rclpy node must before it publishes.
+#: A process that only does what every rclpy node must before it publishes; ``{node}`` is
+#: rclpy's node, or one whose own services are held back as the bridge's are.
 FLOOR_SCRIPT = (
     "import rclpy\n"
     "from rclpy.node import Node\n"
+    "from rclpy.parameter import Parameter\n"
     "from std_msgs.msg import String\n"
     "rclpy.init()\n"
-    "node = Node('startup_floor')\n"
+    "node = {node}\n"
     "node.create_publisher(String, '/startup_floor', 10)\n"
     "node.get_logger().info('Creating a publisher')\n"
 )
+PLAIN_NODE = "Node('startup_floor')"
+HELD_NODE = (
+    "Node('startup_floor', start_parameter_services=False, parameter_overrides="
+    "[Parameter('start_type_description_service', value=False)])"
+)
+#: Fast DDS without the executables' profile (its 64 MB shared-memory segment).
+PROFILE_OFF = {"ROS_GZ_BRIDGE_FASTDDS_PROFILE": "off"}
+#: Issue 23: entries of the C++ figure (its last ``Creating`` line).
+QUOTED_CPP_ENTRIES = 3
 TIMEOUT = 60.0
 
 
@@ -64,10 +75,13 @@ class Row:
     last_s: tuple[float, ...]
 
 
-def creating_times(command: Sequence[str], count: int) -> tuple[float, float]:
+def creating_times(
+    command: Sequence[str], count: int, extra_env: Mapping[str, str] | None = None
+) -> tuple[float, float]:
     """Seconds from the start of ``command`` to its first and its ``count``-th ``Creating``
-    line; the process is then stopped."""
-    env = bench_env() | LOG_ENV
+    line; the process is then stopped. ``extra_env`` is applied before the Fast DDS profile
+    is chosen."""
+    env = bench_env(base={**os.environ, **(extra_env or {})}) | LOG_ENV
     started = time.time()
     proc = subprocess.Popen(
         list(command), env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
@@ -94,11 +108,20 @@ def creating_times(command: Sequence[str], count: int) -> tuple[float, float]:
             proc.wait()
 
 
-def bridge_rounds(count: int, rounds: int, hz: float | None, *, spread: bool = False) -> Row:
+def bridge_rounds(
+    count: int,
+    rounds: int,
+    hz: float | None,
+    *,
+    spread: bool = False,
+    extra_env: Mapping[str, str] | None = None,
+    note: str = "",
+) -> Row:
     """``rounds`` start-ups of a bridge of ``count`` entries; with ``hz``, while the C++ peer
     publishes on each of its Gazebo topics, from one process, or with ``spread`` from one
     process per topic (a heavier machine: every process has its threads and answers every
-    discovery datagram)."""
+    discovery datagram). ``extra_env``: the bridge's environment beside the benchmark's,
+    ``note`` says so in the row's label."""
     topics = [topic_name(f"startup{count}_{i}") for i in range(count)]
     command = [str(BIN / "parameter_bridge")]
     command += [f"{topic}@std_msgs/msg/String@gz.msgs.StringMsg" for topic in topics]
@@ -110,7 +133,7 @@ def bridge_rounds(count: int, rounds: int, hz: float | None, *, spread: bool = F
             for peer in peers:
                 wait_for_line(peer, "^READY", timeout=30)
             time.sleep(1.0)  # flowing before the bridge starts
-        times = [creating_times(command, 2 * count) for _ in range(rounds)]
+        times = [creating_times(command, 2 * count, extra_env) for _ in range(rounds)]
     finally:
         stop_processes()
     label = f"{count} {'entry' if count == 1 else 'entries'}"
@@ -119,12 +142,25 @@ def bridge_rounds(count: int, rounds: int, hz: float | None, *, spread: bool = F
     else:
         label += f", {count} Gazebo topic{'' if count == 1 else 's'} at {hz:g} Hz"
         label += f" from {count} processes" if spread else " from one process"
-    return Row(label, tuple(t[0] for t in times), tuple(t[1] for t in times))
+    return Row(label + note, tuple(t[0] for t in times), tuple(t[1] for t in times))
 
 
-def floor_rounds(rounds: int) -> Row:
-    times = [creating_times([sys.executable, "-c", FLOOR_SCRIPT], 1) for _ in range(rounds)]
-    return Row("rclpy floor: a node and one publisher", tuple(t[0] for t in times), ())
+def floor_rounds(
+    rounds: int, node: str, label: str, extra_env: Mapping[str, str] | None = None
+) -> Row:
+    command = [sys.executable, "-c", FLOOR_SCRIPT.format(node=node)]
+    times = [creating_times(command, 1, extra_env) for _ in range(rounds)]
+    return Row(label, tuple(t[0] for t in times), ())
+
+
+def floor_rows(rounds: int) -> list[Row]:
+    """The rclpy floor: rclpy's node, one whose services are held back as the bridge's are,
+    and that one without the Fast DDS profile."""
+    return [
+        floor_rounds(rounds, PLAIN_NODE, "rclpy floor: a node and one publisher"),
+        floor_rounds(rounds, HELD_NODE, "rclpy floor, the node's services held back"),
+        floor_rounds(rounds, HELD_NODE, "the same, Fast DDS profile off", extra_env=PROFILE_OFF),
+    ]
 
 
 def _spans(row: Row) -> tuple[float, ...]:
@@ -145,6 +181,22 @@ def goal_line(rows: Sequence[Row], hz: float) -> str:
         f"{span:.3f} s (median) — "
         + ("**met**" if met else f"**missed** by {span - GOAL_SPAN_S:.3f} s")
     )
+
+
+def cpp_line(rows: Sequence[Row]) -> str:
+    """Issue 23's start-up goal: the last ``Creating`` line of the C++ figure's entries."""
+    lines = []
+    for row in rows:
+        if row.label.startswith(f"{QUOTED_CPP_ENTRIES} entries, no traffic"):
+            last = statistics.median(row.last_s)
+            verdict = (
+                "**met**" if last <= QUOTED_CPP_S else f"**missed**, {last / QUOTED_CPP_S:.1f}x"
+            )
+            lines.append(
+                f"- Issue 23: {row.label}, the last channel {last:.3f} s after start (median); "
+                f"the C++ bridge {QUOTED_CPP_S:g} s — {verdict}"
+            )
+    return "\n".join(lines) or "- Issue 23: not measured"
 
 
 def _cell(values: tuple[float, ...]) -> str:
@@ -169,8 +221,15 @@ def report(rows: Sequence[Row], args: argparse.Namespace, load: float) -> str:
         "each, a heavier machine (every process has its threads and answers every discovery "
         "datagram). The rclpy floor is "
         "a script that only imports rclpy, makes a node and one publisher and logs: what any "
-        f"rclpy process spends first. The C++ bridge: {QUOTED_CPP_S:g} s to its last line with 3 "
-        "entries (quoted from issue 23, measured elsewhere). Bytecode compiled beforehand. "
+        "rclpy process spends first; then the same with the node's parameter and type "
+        "description services held back, as the bridge holds them until its channels exist "
+        "(creating a service imports numpy); then that without the executables' Fast DDS "
+        "profile, whose 64 MB shared-memory segment Fast DDS allocates and clears when the "
+        "participant is made (the bridge applies it; `ROS_GZ_BRIDGE_FASTDDS_PROFILE=off` in "
+        "the profile-off rows). "
+        f"The C++ bridge: {QUOTED_CPP_S:g} s to its last line with {QUOTED_CPP_ENTRIES} "
+        "entries (quoted from issue 23, measured elsewhere, with Fast DDS's built-in profile). "
+        "Bytecode compiled beforehand. "
         f"1-minute load average before the run: {load:.2f} (the machine, 2 cores, is shared).",
         "",
         "| bridge | first `Creating` s | last `Creating` s | last - first s |",
@@ -180,24 +239,31 @@ def report(rows: Sequence[Row], args: argparse.Namespace, load: float) -> str:
         f"| {row.label} | {_cell(row.first_s)} | {_cell(row.last_s)} | {_cell(_spans(row))} |"
         for row in rows
     ]
-    lines += ["", goal_line(rows, args.hz)]
+    lines += ["", cpp_line(rows), goal_line(rows, args.hz)]
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--counts", type=int, nargs="+", default=[1, 8, 66])
+    parser.add_argument("--counts", type=int, nargs="+", default=[1, 3, 8, 66])
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--hz", type=float, default=100.0)
     args = parser.parse_args(argv)
     compileall.compile_dir(ROOT / "ros_gz_bridge_py", quiet=1)
     load = os.getloadavg()[0]
-    rows = [floor_rounds(args.rounds)]
+    rows = floor_rows(args.rounds)
     for hz in (None, args.hz):
         for count in args.counts:
             print(f"== {count} entries, hz {hz}", file=sys.stderr, flush=True)
             rows.append(bridge_rounds(count, args.rounds, hz))
             print(rows[-1], file=sys.stderr, flush=True)
+        if hz is None and QUOTED_CPP_ENTRIES in args.counts:
+            off = ", Fast DDS profile off"
+            rows.append(
+                bridge_rounds(
+                    QUOTED_CPP_ENTRIES, args.rounds, None, extra_env=PROFILE_OFF, note=off
+                )
+            )
     rows.append(bridge_rounds(max(args.counts), args.rounds, args.hz, spread=True))
     write_section("startup", report(rows, args, load))
     return 0

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import sys
 
+from ros_gz_bridge_py.app.startup import pause_collector
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 
 def parameter_bridge_main() -> None:
+    pause_collector()
     with StopSignal() as stop:
         from ros_gz_bridge_py.app import parameter_bridge  # noqa: PLC0415 - imports rclpy
 
@@ -21,6 +23,7 @@ def bridge_types_main() -> None:
 
 
 def image_bridge_main() -> None:
+    pause_collector()
     with StopSignal() as stop:
         from ros_gz_bridge_py.app import image_bridge  # noqa: PLC0415 - imports rclpy
 

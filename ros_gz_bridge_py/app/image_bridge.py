@@ -47,6 +47,7 @@ from ros_gz_bridge_py.app.settings import (
     declare_image_bridge_parameters,
     read_switches,
 )
+from ros_gz_bridge_py.app.startup import resume_collector
 from ros_gz_bridge_py.config import (
     TopicBridgeSpec,
     UsageError,
@@ -57,6 +58,7 @@ from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.status import serve
 from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
@@ -130,7 +132,7 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -
 
 def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> int:
     """Bridge until ``stop`` or rclpy shutdown; the node and bridge are closed on the way out."""
-    node = Node(NODE_NAME)
+    node = BridgeNode(NODE_NAME)
     bridge: Bridge | None = None
     try:
         bridge = build_bridge(node, topics, switches)
@@ -138,6 +140,8 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
             return USAGE_EXIT
         if stop.requested:
             return 0
+        node.start_services()  # after the channels: see ros/bridge_node.py
+        resume_collector()
         serve(
             node,
             bridge,

@@ -35,6 +35,7 @@ from ros_gz_bridge_py.app.settings import (
     declare_parameter_bridge_parameters,
     read_switches,
 )
+from ros_gz_bridge_py.app.startup import resume_collector
 from ros_gz_bridge_py.config import (
     USAGE,
     BridgeSpec,
@@ -64,6 +65,7 @@ from ros_gz_bridge_py.core.discovery_plan import (
 from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, create_gz_node
@@ -161,7 +163,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
     with contextlib.ExitStack() as scope:
         if stop is None:
             stop = scope.enter_context(StopSignal())
-        node = Node(NODE_NAME)
+        node = BridgeNode(NODE_NAME)
         bridge: Bridge | None = None
         diagnostics: DiagnosticsPublisher | None = None
         discovered: DiscoveredBridges | None = None
@@ -176,12 +178,17 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 return USAGE_EXIT
             if stop.requested:
                 return 0
+            if check_seconds is not None or discover_seconds is not None:
+                node.start_services()
+                resume_collector()
             if check_seconds is not None:
                 return check(node, cli, params, switches, check_seconds, values=values)
             if discover_seconds is not None:
                 return discover_yaml(node, cli, params, discover_seconds, values)
             bridge, discovered = build_bridge(node, cli, params, switches, values)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
+            node.start_services()  # after the channels: see ros/bridge_node.py
+            resume_collector()
             serve(
                 node,
                 bridge,

@@ -8,9 +8,6 @@ normalised, and a gz orientation without ``w`` reads as (0, 0, 0, 0), as in the 
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from typing import Any
-
 from geometry_msgs.msg import (
     Point,
     Pose,
@@ -30,27 +27,13 @@ from geometry_msgs.msg import (
     WrenchStamped,
 )
 
-from ros_gz_bridge_py.converters._fields import WHOLE, Fill, each, fields, fill_pair
+from ros_gz_bridge_py.converters._fields import WHOLE, each, fields, fill_pair
+from ros_gz_bridge_py.converters.covariance import COVARIANCE
 from ros_gz_bridge_py.converters.std_msgs import FRAMES, HEADER
-
-
-def fill_gz_covariance(values: Iterable[float], gz_float_v: Any) -> None:
-    """Append every ROS covariance value to a gz Float_V (float64 -> float32, lossy)."""
-    gz_float_v.SetInParent()
-    gz_float_v.data.extend(values)
-
-
-def fill_ros_covariance(gz_float_v: Any, ros: Any) -> None:
-    """The gz Float_V values into the ROS array when there are exactly as many, else zeros."""
-    data = gz_float_v.data
-    ros[:] = list(data) if len(data) == len(ros) else [0.0] * len(ros)
-
 
 #: ROS Vector3 or Point <-> gz Vector3d (writing a field marks the gz submessage present).
 VECTOR3 = fields("x", "y", "z")
 QUATERNION = fields("x", "y", "z", "w")
-#: A fixed-size ROS covariance array <-> a gz Float_V; a gz one of another size reads as zeros.
-COVARIANCE = Fill(fill_gz_covariance, fill_ros_covariance)
 
 #: ROS Pose -> gz Pose position/orientation; gz header, name, id stay unset.
 POSE = fields(("position", VECTOR3), ("orientation", QUATERNION))

@@ -33,7 +33,8 @@ from sensor_msgs.msg import (
 )
 
 from ros_gz_bridge_py.converters._fields import TO_GZ_ONLY, Value, converters, fields, numbers
-from ros_gz_bridge_py.converters.geometry_msgs import COVARIANCE, QUATERNION, VECTOR3
+from ros_gz_bridge_py.converters.covariance import COVARIANCE
+from ros_gz_bridge_py.converters.geometry_msgs import QUATERNION, VECTOR3
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.converters.sensor_msgs_image import (
     IMAGE_BULK,

@@ -25,7 +25,7 @@ from typing import Any
 from sensor_msgs.msg import NavSatFix, NavSatStatus
 
 from ros_gz_bridge_py.converters._fields import Value, fields, same
-from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_covariance
+from ros_gz_bridge_py.converters.covariance import fill_gz_covariance
 from ros_gz_bridge_py.converters.std_msgs import HEADER, gz_to_ros_frame
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class

@@ -9,8 +9,6 @@ so even a killed demo leaves nothing behind.
 from __future__ import annotations
 
 import contextlib
-import ctypes
-import ctypes.util
 import os
 import signal
 import subprocess
@@ -18,15 +16,17 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
+from ros_gz_bridge_py.libc import libc_function
+
 PR_SET_PDEATHSIG = 1
 GRACE_SECONDS = 5.0
 
 
 def _die_with_parent() -> None:
     """Runs in the child between fork and exec."""
-    name = ctypes.util.find_library("c")
-    if name is not None:
-        ctypes.CDLL(name).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+    prctl = libc_function("prctl")
+    if prctl is not None:
+        prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 class Child:

@@ -27,7 +27,7 @@ from ros_gz_bridge_py.converters._fields import (
 from ros_gz_bridge_py.converters.builtin_interfaces import (
     fill_gz_present_time,
 )
-from ros_gz_bridge_py.converters.geometry_msgs import fill_gz_covariance
+from ros_gz_bridge_py.converters.covariance import fill_gz_covariance
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.converters.std_msgs import (
     CHILD_FRAME_ID_KEY,

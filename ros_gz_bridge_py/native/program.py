@@ -22,7 +22,7 @@ from typing import Any, TypeVar
 
 from ros_gz_bridge_py.converters._fields import Each, Fill, Table, Value, declaration_of, same
 from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time, to_int32, to_uint32
-from ros_gz_bridge_py.converters.geometry_msgs import fill_ros_covariance
+from ros_gz_bridge_py.converters.covariance import fill_ros_covariance
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.converters.std_msgs import (
     CHILD_FRAME_ID_KEY,

@@ -20,8 +20,6 @@ measured on the project machines):
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import os
 import sys
 from pathlib import Path
@@ -30,6 +28,7 @@ from typing import Any
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import get_default_context
 
+from ros_gz_bridge_py.libc import libc_function
 from ros_gz_bridge_py.ros.speed import apply_fastdds_profile, remove_zombie_segments
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
@@ -66,13 +65,8 @@ def tune_allocator() -> bool:
     """Raise glibc's mmap/trim thresholds unless the user chose them. True when applied."""
     if "MALLOC_MMAP_THRESHOLD_" in os.environ or "MALLOC_TRIM_THRESHOLD_" in os.environ:
         return False
-    name = ctypes.util.find_library("c")
-    if name is None:
-        return False
-    try:
-        libc = ctypes.CDLL(name)
-        mallopt = libc.mallopt
-    except (OSError, AttributeError):
+    mallopt = libc_function("mallopt")
+    if mallopt is None:
         return False
     ok_mmap = mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES)
     ok_trim = mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES)

@@ -21,7 +21,9 @@ from typing import Any
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node as RosNode
+from rclpy.parameter import Parameter
 from rclpy.task import Future
+from rclpy.type_description_service import START_TYPE_DESCRIPTION_SERVICE_PARAM
 
 SUFFIX = "_side"
 #: The suffix of the bridge's node that no executor spins.
@@ -40,11 +42,26 @@ def unspun_node(owner: Any) -> Any:
     """A node beside ``owner`` (same context and namespace) that no executor spins: the
     subscriptions of native ROS -> Gazebo loops live there, so that only those loops take
     their messages (docs/native.md §7)."""
+    return _helper_node(native_node_name(owner), owner)
+
+
+def _helper_node(name: str, owner: Any) -> RosNode:
+    """A node of the bridge's own beside ``owner``, without the services users' tools ask of
+    the bridge's node (parameters, type descriptions): that node offers them. Creating a
+    service imports numpy (``ros/bridge_node.py``), which a channel created with this node
+    would wait for.
+
+    Its own ``__node`` remapping keeps its name when the user renames the bridge's node with
+    ``--ros-args -r __node:=NAME``, which otherwise renames every node of the process; other
+    remappings apply to it as to the bridge's node.
+    """
     return RosNode(
-        native_node_name(owner),
+        name,
         namespace=owner.get_namespace(),
         context=owner.context,
+        cli_args=["--ros-args", "-r", f"__node:={name}"],
         start_parameter_services=False,
+        parameter_overrides=[Parameter(START_TYPE_DESCRIPTION_SERVICE_PARAM, value=False)],
     )
 
 
@@ -54,12 +71,7 @@ class SideNode:
     THREADS = 4
 
     def __init__(self, owner: Any) -> None:
-        self.node = RosNode(
-            side_node_name(owner),
-            namespace=owner.get_namespace(),
-            context=owner.context,
-            start_parameter_services=False,
-        )
+        self.node = _helper_node(side_node_name(owner), owner)
         self.reentrant = ReentrantCallbackGroup()
         self._executor = MultiThreadedExecutor(num_threads=self.THREADS, context=owner.context)
         self._executor.add_node(self.node)

@@ -12,11 +12,10 @@ buffers; a burst's memory goes back. Elsewhere than glibc it does nothing.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
-import functools
 import time
 from collections.abc import Callable
+
+from ros_gz_bridge_py.libc import libc_function
 
 #: Bytes received since the last trim that make an idle pause worth a trim.
 TRIM_AFTER_BYTES = 64 * 1024 * 1024
@@ -24,19 +23,9 @@ TRIM_AFTER_BYTES = 64 * 1024 * 1024
 IDLE_BEFORE_TRIM = 1.0
 
 
-@functools.cache
-def _malloc_trim() -> Callable[[int], int] | None:
-    name = ctypes.util.find_library("c")
-    try:
-        trim: Callable[[int], int] = ctypes.CDLL(name).malloc_trim
-    except (OSError, AttributeError, TypeError):
-        return None
-    return trim
-
-
 def trim_heap() -> bool:
     """``malloc_trim(0)``: free heap pages of every arena back to the system (glibc only)."""
-    trim = _malloc_trim()
+    trim = libc_function("malloc_trim")
     return trim is not None and bool(trim(0))
 
 

@@ -25,14 +25,30 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import struct
 import time
 from collections.abc import Callable
 from typing import Any
 
 import zmq
-from zmq.utils.monitor import parse_monitor_message
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
+
+#: A monitor message's first frame: the event (16 bits) and its value (32 bits), native order.
+_MONITOR_EVENT = struct.Struct("=HI")
+
+
+def monitor_event(frames: list[bytes]) -> tuple[int, str] | None:
+    """(event, endpoint) of a message of libzmq's socket monitor; None if it is not one.
+
+    pyzmq's ``zmq.utils.monitor`` does the same, but importing it imports asyncio, a tenth of
+    the Gazebo node's start-up (docs/environment.md §3).
+    """
+    if len(frames) != 2 or len(frames[0]) != _MONITOR_EVENT.size:
+        return None
+    kind, _value = _MONITOR_EVENT.unpack(frames[0])
+    return kind, frames[1].decode(errors="replace")
+
 
 #: The monitor events we follow.
 EVENTS = (
@@ -153,10 +169,9 @@ class SubConnections:
                 frames = self.monitor.recv_multipart(zmq.NOBLOCK)
             except zmq.Again:
                 return
-            event = parse_monitor_message(frames)
-            address = event["endpoint"].decode(errors="replace")
-            if address in self.connected:
-                self._on_event(event["event"], address, now)
+            event = monitor_event(frames)
+            if event is not None and event[1] in self.connected:
+                self._on_event(*event, now)
 
     def _on_event(self, kind: int, address: str, now: float) -> None:
         if kind == zmq.EVENT_HANDSHAKE_SUCCEEDED:

@@ -1,0 +1,36 @@
+"""Python's cyclic garbage collector during the executables' start-up.
+
+Loading the modules and creating the channels makes some 100 000 objects, and the collector
+ran about 90 times over them before the first channel existed (about 0.01 s of a 0.2 s start,
+docs/environment.md §3). The entry points pause it (:func:`pause_collector`); once the
+channels exist the apps call :func:`resume_collector`, which collects start-up's garbage once
+and freezes what survives: those objects live as long as the process, and later collections no
+longer walk them. A bridge
+embedded in a program of its own (``main()`` called directly) never pauses the collector, and
+resuming it then does nothing.
+"""
+
+from __future__ import annotations
+
+import gc
+
+_paused = False
+
+
+def pause_collector() -> None:
+    """Pause the collector until :func:`resume_collector` (entry points only)."""
+    global _paused  # noqa: PLW0603 - one process-wide switch, as the collector is
+    if gc.isenabled():
+        gc.disable()
+        _paused = True
+
+
+def resume_collector() -> None:
+    """Collect once, freeze the objects that survive and run the collector again, if
+    :func:`pause_collector` paused it; otherwise nothing."""
+    global _paused  # noqa: PLW0603
+    if _paused:
+        _paused = False
+        gc.collect()
+        gc.freeze()
+        gc.enable()
