@@ -45,18 +45,37 @@ class OwnPublications:
         #: The rcl publishers (addresses) the bridge has on the topic: a native ROS -> Gazebo
         #: loop skips their samples by publisher GID (``native/ros_pump.py``).
         self._rcl_publishers: frozenset[int] = frozenset()
+        self._rcl_watchers: tuple[Callable[[], None], ...] = ()
 
     def add_rcl_publisher(self, pointer: int) -> None:
         with self._lock:
             self._rcl_publishers = self._rcl_publishers | {pointer}
+            watchers = self._rcl_watchers
+        for changed in watchers:
+            changed()
 
     def remove_rcl_publisher(self, pointer: int) -> None:
         with self._lock:
             self._rcl_publishers = self._rcl_publishers - {pointer}
+            watchers = self._rcl_watchers
+        for changed in watchers:
+            changed()
 
     def rcl_publishers(self) -> frozenset[int]:
         """The rcl publishers of the bridge on this topic now."""
         return self._rcl_publishers
+
+    def watch_rcl_publishers(self, changed: Callable[[], None]) -> Callable[[], None]:
+        """Call ``changed()`` (quick, on the caller's thread) after each change of
+        :meth:`rcl_publishers`; returns the function that stops it."""
+        with self._lock:
+            self._rcl_watchers = (*self._rcl_watchers, changed)
+
+        def unwatch() -> None:
+            with self._lock:
+                self._rcl_watchers = tuple(w for w in self._rcl_watchers if w is not changed)
+
+        return unwatch
 
     def add_numbered(self, publisher: NumberedPublisher) -> None:
         """Also ask ``publisher`` whether a sample is ours (until :meth:`remove_numbered`)."""

@@ -141,6 +141,7 @@ class RosToGzChannel(Channel):
             refused=self._convert_and_publish,
             counted=self._counted,
             own_publishers=own.rcl_publishers,
+            watch_own_publishers=own.watch_rcl_publishers,
             name=self.spec.gz_topic,
         )
 

@@ -4,9 +4,12 @@
 subscription it takes from (on a node no executor spins, so nothing else takes its messages),
 the channel's Gazebo publisher with a PUB socket of its own (only this thread sends on it), and
 the encoder of each spelling. Its thread runs the C loop with the GIL released and, between
-runs (at least every :data:`TURN` seconds), does in Python what changes slowly: the spellings
-Gazebo subscribers take now, the bridge's own publishers on the topic (the loop guard), the
-counters, and the messages an encoder left to the Python path.
+runs, does in Python what changes slowly: the spellings Gazebo subscribers take now, the
+bridge's own publishers on the topic (the loop guard), the counters, and the messages an
+encoder left to the Python path. A run returns with the messages left to Python, when
+:meth:`RosChannelPump.wake` is called (the channel calls it when the spellings or its own
+publishers change), and otherwise after :data:`TURN` seconds, or :data:`QUIET_TURN` after a
+run that took no message (nothing to count).
 """
 
 from __future__ import annotations
@@ -25,8 +28,12 @@ from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.pump import libzmq_path, loaded_libraries
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
-#: Longest time (s) between two turns of the Python side of the loop.
+#: Longest time (s) between two turns of the Python side of the loop while messages come.
 TURN = 0.25
+#: The same after a run that took no message. Changes are pushed (:meth:`RosChannelPump.wake`),
+#: so this is only a safety net; 66 idle loops turning every :data:`TURN` cost an idle bridge
+#: of 66 bidirectional entries 2.5 points of a core (docs/native.md §7).
+QUIET_TURN = 2.0
 
 
 @functools.cache
@@ -79,7 +86,10 @@ class RosChannelPump:
 
     ``refused(cdr)``: the channel's Python path for one admitted message;
     ``counted(received, own_skipped, rate_limited, published)``: what the loop did since it
-    last said; ``own_publishers()``: the rcl publishers of the bridge on the topic.
+    last said; ``own_publishers()``: the rcl publishers of the bridge on the topic, and
+    ``watch_own_publishers(changed)`` calls ``changed()`` when they change (it returns the
+    function that stops it). The publisher's ``watch_wire_types`` does the same for the
+    spellings.
     """
 
     def __init__(
@@ -92,6 +102,7 @@ class RosChannelPump:
         refused: Callable[[bytes], None],
         counted: Callable[[int, int, int, int], None],
         own_publishers: Callable[[], frozenset[int]],
+        watch_own_publishers: Callable[[Callable[[], None]], Callable[[], None]],
         name: str,
     ) -> None:
         native, functions = extension(), ros_functions()
@@ -119,16 +130,24 @@ class RosChannelPump:
         self._wake_r.setblocking(False)
         self._wake_w.setblocking(False)
         self._pump.start()
+        self._unwatch = (publisher.watch_wire_types(self.wake), watch_own_publishers(self.wake))
         self._thread = threading.Thread(target=self._run, name=f"ros-pub {name}", daemon=True)
         self._thread.start()
+
+    def wake(self) -> None:
+        """End the current run soon, so the loop reads the spellings and own publishers again
+        (any thread; quick; nothing after :meth:`close`)."""
+        with contextlib.suppress(OSError):  # a wake already pending, or closed
+            self._wake_w.send(b"\0")
 
     def close(self) -> None:
         """Stop the thread and rcl's callback; idempotent. The subscription may go after."""
         if self._closed:
             return
         self._closed = True
-        with contextlib.suppress(OSError):
-            self._wake_w.send(b"\0")
+        for unwatch in self._unwatch:
+            unwatch()
+        self.wake()
         if self._thread is not threading.current_thread():
             self._thread.join()
         self._pump.stop()
@@ -136,17 +155,18 @@ class RosChannelPump:
         self._wake_w.close()
 
     def _run(self) -> None:
-        timeout = int(TURN * 1000)
+        took = True
         while not self._closed:
             try:
                 self._sync()
+                timeout = int((TURN if took else QUIET_TURN) * 1000)
                 with self._subscription.handle:
                     _events, refused = self._pump.run(self._wake_r.fileno(), timeout)
                 with contextlib.suppress(BlockingIOError):
                     self._wake_r.recv(4096)
                 for cdr in refused:
                     self._refused(cdr)
-                self._count()
+                took = self._count()
             except Exception:  # the loop must outlive anything, as the readers do
                 _LOG.exception("unexpected error in the native loop of %s", self._publisher.topic)
                 time.sleep(TURN)  # and not spin on an error that stays
@@ -162,9 +182,11 @@ class RosChannelPump:
             self._pump.ignore(sorted(ignored))
             self._ignored = ignored
 
-    def _count(self) -> None:
+    def _count(self) -> bool:
+        """Tell the channel what the loop did since the last turn; True if it took a message."""
         now = self._pump.counts()[:4]
         before, self._seen = self._seen, now
         deltas = tuple(a - b for a, b in zip(now, before, strict=True))
         if any(deltas):
             self._counted(*deltas)
+        return bool(deltas[0])

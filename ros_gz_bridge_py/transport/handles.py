@@ -48,6 +48,11 @@ class Publisher:
         """The spellings remote subscribers need now (empty: nobody remote listens)."""
         return self._wire_types.get()
 
+    def watch_wire_types(self, changed: Callable[[], None]) -> Callable[[], None]:
+        """Call ``changed()`` (quick, on the node's thread) whenever :meth:`wire_types` may
+        have changed; returns the function that stops it."""
+        return self._node.subscriber_book.watch(self.fqn, changed)
+
     def publish(self, msg: Any) -> None:
         """Serialize ``msg`` once and send it (see :meth:`publish_raw`)."""
         self.publish_raw(msg.SerializeToString())

@@ -115,7 +115,8 @@ class SubscriberBook:
     The node's discovery thread replaces whole entries (never mutates them) and bumps
     ``version``; publishing threads read without a lock and cache what they computed per
     version (:class:`WireTypeCache`). ``default_spelling`` is assumed for processes whose
-    spelling is unknown (None: the publisher's own spelling).
+    spelling is unknown (None: the publisher's own spelling). Those that cannot ask at every
+    message are called after each change (:meth:`watch`).
     """
 
     def __init__(self, default_spelling: Spelling | None = None) -> None:
@@ -123,6 +124,34 @@ class SubscriberBook:
         self._default = default_spelling
         self._subscribers: dict[str, tuple[RemoteSubscriber, ...]] = {}
         self._spellings: dict[str, Spelling] = {}
+        #: fqn -> what to call when its subscribers or the spellings change (replaced whole).
+        self._watchers: dict[str, tuple[Callable[[], None], ...]] = {}
+
+    def watch(self, fqn: str, changed: Callable[[], None]) -> Callable[[], None]:
+        """Call ``changed()`` after each change of ``fqn``'s subscribers or of the spellings,
+        on the thread that made it (it must be quick and must not raise); returns the function
+        that stops it."""
+        watchers = dict(self._watchers)
+        watchers[fqn] = (*watchers.get(fqn, ()), changed)
+        self._watchers = watchers
+
+        def unwatch() -> None:
+            remaining = dict(self._watchers)
+            kept = tuple(w for w in remaining.get(fqn, ()) if w is not changed)
+            if kept:
+                remaining[fqn] = kept
+            else:
+                remaining.pop(fqn, None)
+            self._watchers = remaining
+
+        return unwatch
+
+    def _changed(self, fqn: str | None) -> None:
+        """Bump the version and call the watchers of ``fqn`` (None: of every topic)."""
+        self.version += 1
+        watchers = self._watchers
+        for changed in watchers.get(fqn, ()) if fqn is not None else _every(watchers):
+            changed()
 
     def set_subscribers(self, fqn: str, subscribers: tuple[RemoteSubscriber, ...]) -> None:
         """Replace the remote subscribers of ``fqn``."""
@@ -132,12 +161,12 @@ class SubscriberBook:
         else:
             entries.pop(fqn, None)
         self._subscribers = entries
-        self.version += 1
+        self._changed(fqn)
 
     def set_spellings(self, spellings: dict[str, Spelling]) -> None:
         """Replace the known spellings of peer processes."""
         self._spellings = spellings
-        self.version += 1
+        self._changed(None)
 
     def subscribers(self, fqn: str) -> tuple[RemoteSubscriber, ...]:
         return self._subscribers.get(fqn, ())
@@ -153,6 +182,10 @@ class SubscriberBook:
         return wire_types(
             names, self._subscribers.get(fqn, ()), lambda process: spellings.get(process, default)
         )
+
+
+def _every(watchers: dict[str, tuple[Callable[[], None], ...]]) -> Iterable[Callable[[], None]]:
+    return (changed for per_topic in watchers.values() for changed in per_topic)
 
 
 class WireTypeCache:

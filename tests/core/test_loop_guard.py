@@ -122,3 +122,16 @@ def test_a_publish_that_raises_uses_no_sequence_number() -> None:
     (sample,) = publisher.samples
     assert own.is_own(sample)
     assert not own.is_own({**sample, "publication_sequence_number": 2})
+
+
+def test_watchers_hear_each_change_of_the_rcl_publishers() -> None:
+    own = OwnPublications()
+    heard: list[frozenset[int]] = []
+    stop = own.watch_rcl_publishers(lambda: heard.append(own.rcl_publishers()))
+    own.add_rcl_publisher(0x10)
+    own.add_rcl_publisher(0x20)
+    own.remove_rcl_publisher(0x10)
+    stop()
+    own.remove_rcl_publisher(0x20)
+    assert heard == [frozenset({0x10}), frozenset({0x10, 0x20}), frozenset({0x20})]
+    assert own.rcl_publishers() == frozenset()

@@ -81,3 +81,21 @@ def test_cache_recomputes_only_when_the_book_changes() -> None:
     assert cache.get() == {IGN}
     book.set_subscribers("@/p@/cmd", ())
     assert cache.get() == frozenset()
+
+
+def test_watchers_hear_their_topics_changes_and_every_spelling_change() -> None:
+    book = SubscriberBook()
+    heard: list[str] = []
+    stop_cmd = book.watch("@/p@/cmd", lambda: heard.append("cmd"))
+    book.watch("@/p@/odom", lambda: heard.append("odom"))
+    book.set_subscribers("@/p@/cmd", (sub("fortress", IGN),))
+    book.set_subscribers("@/p@/scan", (sub("fortress", IGN),))  # nobody watches it
+    assert heard == ["cmd"]
+    book.set_spellings({"fortress": Spelling.IGNITION})
+    assert sorted(heard) == ["cmd", "cmd", "odom"]
+    stop_cmd()
+    stop_cmd()  # twice is harmless
+    heard.clear()
+    book.set_subscribers("@/p@/cmd", ())
+    book.set_spellings({})
+    assert heard == ["odom"]
