@@ -25,17 +25,21 @@ from rclpy.parameter import Parameter
 from rclpy.task import Future
 from rclpy.type_description_service import START_TYPE_DESCRIPTION_SERVICE_PARAM
 
+#: The bridge's helper nodes are named ``_<bridge node>_side`` and ``_<bridge node>_native``
+#: (the node no executor spins). The leading underscore makes them hidden nodes, which ROS
+#: tools leave out (``ros2 node list`` without ``--all``): users see the one node they started,
+#: as with the C++ bridge.
+HIDDEN = "_"
 SUFFIX = "_side"
-#: The suffix of the bridge's node that no executor spins.
 NATIVE_SUFFIX = "_native"
 
 
 def side_node_name(owner: Any) -> str:
-    return f"{owner.get_name()}{SUFFIX}"
+    return f"{HIDDEN}{owner.get_name()}{SUFFIX}"
 
 
 def native_node_name(owner: Any) -> str:
-    return f"{owner.get_name()}{NATIVE_SUFFIX}"
+    return f"{HIDDEN}{owner.get_name()}{NATIVE_SUFFIX}"
 
 
 def unspun_node(owner: Any) -> Any:

@@ -2,7 +2,8 @@
 
 A real ``parameter_bridge`` process holds its node's parameter and type description services
 until its channels exist; they then answer as rclpy's own do. Its helper nodes offer neither.
-Renaming the bridge's node (``-r __node:=``) leaves the helper nodes their own names.
+Renaming the bridge's node (``-r __node:=``) leaves the helper nodes their own names, which
+are hidden (they start with ``_``), so that ROS tools list one node, as with the C++ bridge.
 Loading the bridge for String entries imports neither numpy nor asyncio, the two largest
 imports a run of such entries does not need; the collector paused during start-up runs again.
 """
@@ -76,11 +77,13 @@ def test_the_bridge_offers_rclpys_node_services_once_its_channels_exist(
     helpers = {
         name: services
         for name, services in services_by_node(ros_side).items()
-        if name.startswith(f"{node_name}_")
+        if name.startswith(f"_{node_name}_")
     }
     assert helpers, "a bidirectional entry makes helper nodes (side, native), named apart"
     names = ros_side.run(ros_side.node.get_node_names)
     assert names.count(node_name) == 1, names
+    # What `ros2 node list` shows (it leaves out names that start with "_"): one node, as C++.
+    assert [name for name in names if node_name in name and not name.startswith("_")] == [node_name]
     assert all(not services & PARAMETER_SERVICES for services in helpers.values()), helpers
 
     client = ros_side.run(
