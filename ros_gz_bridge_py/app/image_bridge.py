@@ -47,7 +47,7 @@ from ros_gz_bridge_py.app.settings import (
     declare_image_bridge_parameters,
     read_switches,
 )
-from ros_gz_bridge_py.app.startup import resume_collector
+from ros_gz_bridge_py.app.startup import finish_start_up
 from ros_gz_bridge_py.config import (
     TopicBridgeSpec,
     UsageError,
@@ -140,8 +140,7 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
             return USAGE_EXIT
         if stop.requested:
             return 0
-        node.start_services()  # after the channels: see ros/bridge_node.py
-        resume_collector()
+        finish_start_up(node)
         serve(
             node,
             bridge,

@@ -35,7 +35,7 @@ from ros_gz_bridge_py.app.settings import (
     declare_parameter_bridge_parameters,
     read_switches,
 )
-from ros_gz_bridge_py.app.startup import resume_collector
+from ros_gz_bridge_py.app.startup import finish_start_up
 from ros_gz_bridge_py.config import (
     USAGE,
     BridgeSpec,
@@ -179,16 +179,14 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             if stop.requested:
                 return 0
             if check_seconds is not None or discover_seconds is not None:
-                node.start_services()
-                resume_collector()
+                finish_start_up(node)
             if check_seconds is not None:
                 return check(node, cli, params, switches, check_seconds, values=values)
             if discover_seconds is not None:
                 return discover_yaml(node, cli, params, discover_seconds, values)
             bridge, discovered = build_bridge(node, cli, params, switches, values)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
-            node.start_services()  # after the channels: see ros/bridge_node.py
-            resume_collector()
+            finish_start_up(node)
             serve(
                 node,
                 bridge,

@@ -1,20 +1,32 @@
-"""Python's cyclic garbage collector during the executables' start-up.
+"""The executables' start-up: what waits until the channels exist.
+
+The bridge's node holds its own services back until then (``ros/bridge_node.py``), and so is
+Python's cyclic garbage collector: :func:`finish_start_up` releases both.
 
 Loading the modules and creating the channels makes some 100 000 objects, and the collector
 ran about 90 times over them before the first channel existed (about 0.01 s of a 0.2 s start,
-docs/environment.md §3). The entry points pause it (:func:`pause_collector`); once the
-channels exist the apps call :func:`resume_collector`, which collects start-up's garbage once
-and freezes what survives: those objects live as long as the process, and later collections no
-longer walk them. A bridge
-embedded in a program of its own (``main()`` called directly) never pauses the collector, and
-resuming it then does nothing.
+docs/environment.md §3). The entry points pause it (:func:`pause_collector`, imported before
+rclpy); once the channels exist, :func:`resume_collector` collects start-up's garbage once and
+freezes what survives: those objects live as long as the process, and later collections no
+longer walk them. A bridge embedded in a program of its own (``main()`` called directly) never
+pauses the collector, and resuming it then does nothing.
 """
 
 from __future__ import annotations
 
 import gc
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the entry points import this module before rclpy
+    from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 
 _paused = False
+
+
+def finish_start_up(node: BridgeNode) -> None:
+    """The channels exist: start ``node``'s own services and resume the collector."""
+    node.start_services()
+    resume_collector()
 
 
 def pause_collector() -> None:
