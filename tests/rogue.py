@@ -80,6 +80,12 @@ class FakePeer:
                     time.sleep(0.002)  # let receivers drain instead of overflowing
             self._stop.wait(1.0)
 
+    def unadvertise(self) -> None:
+        """Withdraw every record, as a publisher that exits does (it heartbeats on)."""
+        for record in self.records:
+            self._send(DiscoveryType.UNADVERTISE, record)
+        self.records = []
+
     def go_silent(self) -> None:
         self._stop.set()
         self._thread.join()

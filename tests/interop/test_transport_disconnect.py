@@ -8,9 +8,10 @@ disconnected. Our node now disconnects from publishers that are gone, reading wh
 first. Each case runs in a child process (``one_shot_child.py``), since the abort kills it.
 
 The peer rather than ``ign topic -p``: the CLI publishes 800 ms after advertising whether or
-not anyone is connected, and under load ign-transport 11 then often sends nothing (4 of 6
-one-shots here); the peer publishes once its subscribers are connected, then settles 1 s so
-that the child's plain SUB socket, connected just after the node's, is up too.
+not anyone is connected, and it exits as it publishes, so that about one message in four
+never reaches the wire (docs/protocol.md §2.8.7); the peer publishes once its subscribers are
+connected, then settles 1 s so that the child's plain SUB socket, connected just after the
+node's, is up too.
 """
 
 from __future__ import annotations

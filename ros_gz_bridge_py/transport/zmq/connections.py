@@ -19,6 +19,13 @@ Three things libzmq does on its own that a SUB socket's owner must follow (docs/
   (``Assertion failed: !_more (src/fq.cpp)``, libzmq issue #2163). :meth:`SubConnections.
   disconnect` therefore first reads whole messages until the socket is empty (``drain``), on the
   socket's own thread, so no poll comes between the last read and the disconnect.
+* ``zmq_disconnect`` also discards what the connection delivers after it. A publisher that
+  sends its last message and exits announces its leaving (UNADVERTISE) as it exits, and that
+  datagram can come before the message is on the wire: ``ign topic -p`` sent its one message
+  0.4 ms after its UNADVERTISE (``strace``), and disconnecting at once lost two one-shots of
+  three where not disconnecting lost one of four, as a C++ subscriber does. An address whose
+  publishers are gone is therefore disconnected :data:`LEAVE_AFTER` later
+  (:meth:`SubConnections.leave`), unless a publisher comes back there first.
 """
 
 from __future__ import annotations
@@ -71,6 +78,8 @@ BACKOFF_RESET = 30.0
 FAILURES_BEFORE_BACKOFF = 2
 #: Monitor events read per turn.
 READ_BATCH = 256
+#: How long an address stays connected after its last publisher is gone (s; see above).
+LEAVE_AFTER = 0.5
 
 
 class SubConnections:
@@ -106,10 +115,14 @@ class SubConnections:
         # address -> when to reconnect; address -> (delay, time of the last refusal)
         self._due: dict[str, float] = {}
         self._backoff: dict[str, tuple[float, float]] = {}
+        # address -> when to disconnect it (its publishers are gone)
+        self._leaving: dict[str, float] = {}
 
     def connect(self, address: str) -> bool:
-        """Connect once per address; False (counted, logged) if libzmq refuses it."""
+        """Connect once per address; False (counted, logged) if libzmq refuses it. An address
+        that is :meth:`leave`-ing stays."""
         if address in self.connected:
+            self._leaving.pop(address, None)
             return True
         try:
             self._sock.connect(address)
@@ -120,8 +133,15 @@ class SubConnections:
         self.connected.add(address)
         return True
 
+    def leave(self, address: str, now: float | None = None) -> None:
+        """Disconnect ``address`` :data:`LEAVE_AFTER` from ``now``: its publishers are gone, and
+        what they sent last may still be on its way (see the module docstring)."""
+        if address in self.connected and address not in self._leaving:
+            now = time.monotonic() if now is None else now
+            self._leaving[address] = now + LEAVE_AFTER
+
     def disconnect(self, address: str) -> None:
-        """Stop connecting to ``address`` (safely, see the module docstring)."""
+        """Stop connecting to ``address`` now (safely, see the module docstring)."""
         if address not in self.connected:
             return
         self._forget(address)
@@ -133,10 +153,10 @@ class SubConnections:
 
     def next_deadline(self) -> float | None:
         """When :meth:`turn` next has something to do (None: only on a monitor event)."""
-        if not self._dropped and not self._due:
+        if not self._dropped and not self._due and not self._leaving:
             return None
-        times = [t + CONFIRM_AFTER for t in self._dropped.values()] + list(self._due.values())
-        return min(times) if times else None
+        times = [t + CONFIRM_AFTER for t in self._dropped.values()]
+        return min([*times, *self._due.values(), *self._leaving.values()])
 
     def is_due(self, now: float) -> bool:
         """True when :meth:`turn` has something to do at ``now`` besides monitor events."""
@@ -144,13 +164,18 @@ class SubConnections:
         return deadline is not None and deadline <= now
 
     def turn(self, now: float | None = None) -> None:
-        """Read the monitor, confirm drops libzmq does not retry, reconnect what is due."""
+        """Read the monitor, disconnect what is leaving, confirm drops libzmq does not retry,
+        reconnect what is due."""
         now = time.monotonic() if now is None else now
         self._read_events(now)
+        for address, when in list(self._leaving.items()):
+            if now >= when:
+                self.disconnect(address)
         for address, when in list(self._dropped.items()):
             if now - when >= CONFIRM_AFTER:
                 del self._dropped[address]
-                self._given_up(address, now)
+                if address not in self._leaving:  # else it went with its publishers
+                    self._given_up(address, now)
         for address, when in list(self._due.items()):
             if now >= when:
                 del self._due[address]
@@ -228,7 +253,7 @@ class SubConnections:
             _LOG.debug("cannot reconnect %s to %r: %s", self._what, address, error)
 
     def _forget(self, address: str) -> None:
-        for table in (self._dropped, self._due, self._backoff, self._failures):
+        for table in (self._dropped, self._due, self._backoff, self._failures, self._leaving):
             table.pop(address, None)
         for names in (self._handshaken, self._auth_failed, self._told_auth):
             names.discard(address)

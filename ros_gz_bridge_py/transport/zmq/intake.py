@@ -4,9 +4,10 @@ readers, connected to publishers as discovery learns them and disconnected when 
 §2.8.1 step 4 connects a SUB socket once per publisher address. We also disconnect: when
 the last remote record at an address goes away for a topic (UNADVERTISE, BYE, a process
 silent for 3 s, §2.5), the readers of that topic disconnect from it, and the shared socket
-does once no record at all is left there. gz never disconnects; without it, addresses of a
-peer that is gone are retried for ever (docs/protocol.md §2.8.7). Everything here runs on the
-I/O thread; readers do their part on their own threads.
+does once no record at all is left there, each a moment later (``connections.LEAVE_AFTER``),
+so that what the publisher sent last still arrives. gz never disconnects; without it,
+addresses of a peer that is gone are retried for ever (docs/protocol.md §2.8.7). Everything
+here runs on the I/O thread; readers do their part on their own threads.
 """
 
 from __future__ import annotations
@@ -83,8 +84,8 @@ class DataIntake:
     def publisher_gone(self, record: PublisherRecord, remaining: Sequence[PublisherRecord]) -> None:
         """``record`` went away; ``remaining`` are the remote records still known (all topics).
 
-        Readers of its topic disconnect when no record of the topic is left at its address;
-        the shared socket when no record at all is.
+        Readers of its topic leave the address when no record of the topic is left there; the
+        shared socket when no record at all is.
         """
         address = record.address
         if any(r.address == address and r.topic == record.topic for r in remaining):
@@ -92,9 +93,9 @@ class DataIntake:
         for sub in self._node.subscriptions(record.topic):
             sub.forget(address)
             if sub.delivery is not None:
-                cast(SubscriptionReader, sub.delivery).disconnect(address)
+                cast(SubscriptionReader, sub.delivery).leave(address)
         if address in self.shared.connected and not any(r.address == address for r in remaining):
-            self.shared.disconnect(address)
+            self.shared.leave(address)
 
     def _refused_shared(self, address: str) -> None:
         """A message refused on the shared socket: its topic is unknown, so the node counts it."""

@@ -139,9 +139,10 @@ class SubscriptionReader:
         """Connect to a publisher of the topic (once per address)."""
         self._post(lambda: self._connections.connect(address))
 
-    def disconnect(self, address: str) -> None:
-        """Stop connecting to ``address`` (no publisher of the topic is there any more)."""
-        self._post(lambda: self._connections.disconnect(address))
+    def leave(self, address: str) -> None:
+        """Stop connecting to ``address`` soon: no publisher of the topic is there any more
+        (``SubConnections.leave``)."""
+        self._post(lambda: self._connections.leave(address))
 
     @property
     def received(self) -> int:

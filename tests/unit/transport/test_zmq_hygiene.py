@@ -118,6 +118,30 @@ def test_malformed_frames_and_another_type_are_told_to_the_subscription(node: Zm
         rogue.close()
 
 
+def test_what_a_publisher_sends_after_its_goodbye_still_arrives(node: ZmqGzNode) -> None:
+    """A one-shot publisher (``ign topic -p``) can announce its leaving (UNADVERTISE) before
+    its last message is on the wire. Both subscriptions still get that message, then leave
+    the address (``connections.LEAVE_AFTER``)."""
+    topic = unique("goodbye")
+    queued, direct = Sink(), Sink()
+    node.subscribe(topic, queued, STRING, queue_size=10)
+    node.subscribe(topic, direct, STRING)
+    rogue = RoguePublisher(node.fqn(topic), STRING)
+    try:
+        while rogue.subscriptions < 2:
+            assert rogue.wait_subscribed(10), "both sockets subscribe"
+        assert node.topic_info(topic), "listings answer at once from now on (discovery is up)"
+        rogue.peer.unadvertise()
+        assert wait_until(lambda: node.topic_info(topic) == []), "the goodbye was heard"
+        time.sleep(0.05)  # the message comes after it
+        rogue.send(StringMsg(data="last words").SerializeToString())
+        assert wait_until(lambda: bool(queued.texts and direct.texts))
+        assert queued.texts == direct.texts == ["last words"]
+        assert wait_until(lambda: node.stats.publishers_disconnected == 2)
+    finally:
+        rogue.close()
+
+
 def test_publishers_that_fall_silent_are_disconnected_and_never_retried(node: ZmqGzNode) -> None:
     """A fake peer advertises 20 addresses that fail at once (libzmq retries them); once it
     is silent for 3 s its records expire and every address is disconnected: no connection
