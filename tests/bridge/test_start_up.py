@@ -27,20 +27,11 @@ from tests.bridge.behaviour_harness import (
     started,
 )
 from tests.gzpeer import PeerProcess, unique_name, wait_until
+from tests.ros.test_bridge_node import PARAMETER_SERVICES as NODE_SERVICES
 
 __all__ = ["ros_side", "started"]
 
-PARAMETER_SERVICES = frozenset(
-    {
-        "describe_parameters",
-        "get_parameter_types",
-        "get_parameters",
-        "get_type_description",
-        "list_parameters",
-        "set_parameters",
-        "set_parameters_atomically",
-    }
-)
+PARAMETER_SERVICES = frozenset(NODE_SERVICES)
 
 
 def services_by_node(ros: RosSide) -> dict[str, set[str]]:
