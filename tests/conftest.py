@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import os
 import uuid
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
 
 _PARTITION = f"rgbp-test-{os.getpid()}-{uuid.uuid4().hex[:6]}"
 
@@ -27,3 +31,18 @@ os.environ.update(
 os.environ.pop("GZ_RELAY", None)
 os.environ.pop("IGN_RELAY", None)
 os.environ.pop("GZ_TRANSPORT_IMPLEMENTATION", None)
+
+
+@pytest.fixture
+def ros_context() -> Iterator[Any]:
+    """An rclpy context of the test's own (the environment above applies), shut down after it.
+    rclpy is imported here, so only the tests that ask for a context load it."""
+    import rclpy  # noqa: PLC0415
+    from rclpy.context import Context  # noqa: PLC0415
+
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        yield context
+    finally:
+        rclpy.try_shutdown(context=context)

@@ -5,7 +5,7 @@ executables' use of it is in tests/bridge/test_start_up.py)."""
 from __future__ import annotations
 
 import uuid
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import pytest
@@ -30,16 +30,6 @@ PARAMETER_SERVICES = (
 )
 
 
-@pytest.fixture
-def context() -> Iterator[Context]:
-    context = Context()
-    rclpy.init(context=context)
-    try:
-        yield context
-    finally:
-        rclpy.try_shutdown(context=context)
-
-
 def unique(stem: str) -> str:
     return f"{stem}_{uuid.uuid4().hex[:8]}"
 
@@ -50,9 +40,9 @@ def own_services(node: Any) -> set[str]:
     return {service.srv_name.removeprefix(prefix) for service in node.services}
 
 
-def test_the_services_wait_for_start_services_then_are_rclpys(context: Context) -> None:
-    plain = rclpy.create_node(unique("plain"), context=context)
-    node = BridgeNode(unique("held"), context=context)
+def test_the_services_wait_for_start_services_then_are_rclpys(ros_context: Context) -> None:
+    plain = rclpy.create_node(unique("plain"), context=ros_context)
+    node = BridgeNode(unique("held"), context=ros_context)
     try:
         assert own_services(node) == set()
         assert node.get_parameter("start_type_description_service").value is True
@@ -65,10 +55,10 @@ def test_the_services_wait_for_start_services_then_are_rclpys(context: Context) 
         plain.destroy_node()
 
 
-def test_the_users_start_type_description_service_false_is_kept(context: Context) -> None:
+def test_the_users_start_type_description_service_false_is_kept(ros_context: Context) -> None:
     node = BridgeNode(
         unique("no_types"),
-        context=context,
+        context=ros_context,
         parameter_overrides=[Parameter("start_type_description_service", value=False)],
     )
     try:
@@ -93,14 +83,14 @@ def call(context: Context, nodes: Sequence[Any], client: Any, request: Any) -> A
         executor.shutdown()
 
 
-def test_started_parameter_services_answer_with_the_nodes_parameters(context: Context) -> None:
-    node = BridgeNode(unique("answers"), context=context)
-    asker = rclpy.create_node(unique("asker"), context=context)
+def test_started_parameter_services_answer_with_the_nodes_parameters(ros_context: Context) -> None:
+    node = BridgeNode(unique("answers"), context=ros_context)
+    asker = rclpy.create_node(unique("asker"), context=ros_context)
     try:
         node.declare_parameter("config_file", "bridge.yaml")
         node.start_services()
         client = asker.create_client(ListParameters, f"/{node.get_name()}/list_parameters")
-        names = call(context, [node, asker], client, ListParameters.Request()).result.names
+        names = call(ros_context, [node, asker], client, ListParameters.Request()).result.names
         assert {"config_file", "start_type_description_service", "use_sim_time"} <= set(names)
     finally:
         asker.destroy_node()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import uuid
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import pytest
@@ -186,16 +186,6 @@ def test_gz_node_options(value: str, implementation: str | None) -> None:
 # The node parameters, declared on a real rclpy node.
 
 
-@pytest.fixture
-def context() -> Iterator[Context]:
-    context = Context()
-    rclpy.init(context=context)
-    try:
-        yield context
-    finally:
-        rclpy.try_shutdown(context=context)
-
-
 def make_node(context: Context, overrides: Sequence[Parameter] = ()) -> Any:
     return rclpy.create_node(
         f"settings_{uuid.uuid4().hex[:8]}", context=context, parameter_overrides=list(overrides)
@@ -203,8 +193,8 @@ def make_node(context: Context, overrides: Sequence[Parameter] = ()) -> Any:
 
 
 @pytest.mark.ros
-def test_parameter_bridge_defaults(context: Context) -> None:
-    node = make_node(context)
+def test_parameter_bridge_defaults(ros_context: Context) -> None:
+    node = make_node(ros_context)
     try:
         params = declare_parameter_bridge_parameters(node, {})
     finally:
@@ -232,9 +222,9 @@ def test_parameter_bridge_defaults(context: Context) -> None:
 
 
 @pytest.mark.ros
-def test_parameter_bridge_values(context: Context) -> None:
+def test_parameter_bridge_values(ros_context: Context) -> None:
     node = make_node(
-        context,
+        ros_context,
         [
             Parameter("config_file", value="/b.yaml"),
             Parameter("lazy", value=True),
@@ -285,9 +275,9 @@ def test_max_rate_parameter_is_checked(value: object, expected: tuple[float, str
 
 
 @pytest.mark.ros
-def test_status_period_takes_any_type(context: Context) -> None:
+def test_status_period_takes_any_type(ros_context: Context) -> None:
     """Checked and reported by start_diagnostics, not refused at declaration."""
-    node = make_node(context, [Parameter("status_period", value="often")])
+    node = make_node(ros_context, [Parameter("status_period", value="often")])
     try:
         assert declare_parameter_bridge_parameters(node, {}).status_period == "often"
     finally:
@@ -295,8 +285,8 @@ def test_status_period_takes_any_type(context: Context) -> None:
 
 
 @pytest.mark.ros
-def test_image_bridge_defaults_share_the_parameter_bridge_pieces(context: Context) -> None:
-    node = make_node(context)
+def test_image_bridge_defaults_share_the_parameter_bridge_pieces(ros_context: Context) -> None:
+    node = make_node(ros_context)
     try:
         params = declare_image_bridge_parameters(node, {"GZ_VERSION": "garden"})
     finally:
@@ -310,9 +300,9 @@ def test_image_bridge_defaults_share_the_parameter_bridge_pieces(context: Contex
 
 
 @pytest.mark.ros
-def test_image_bridge_values(context: Context) -> None:
+def test_image_bridge_values(ros_context: Context) -> None:
     node = make_node(
-        context,
+        ros_context,
         [
             Parameter("qos", value="sensor_data"),
             Parameter("camera_info", value=True),
@@ -336,10 +326,10 @@ def test_image_bridge_values(context: Context) -> None:
 
 @pytest.mark.ros
 def test_gz_version_defaults_to_the_process_environment(
-    context: Context, monkeypatch: pytest.MonkeyPatch
+    ros_context: Context, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("GZ_VERSION", "harmonic")
-    node = make_node(context)
+    node = make_node(ros_context)
     try:
         assert declare_image_bridge_parameters(node).shared.gz_version == "harmonic"
     finally:
