@@ -20,6 +20,8 @@ from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from typing import Any, Protocol
 
+from ros_gz_bridge_py.watchers import Watchers
+
 #: How many recent publications per ROS topic are remembered (covers bursts and slow executors).
 HISTORY = 1024
 #: The end of the window of a publish call that has not returned yet.
@@ -45,21 +47,17 @@ class OwnPublications:
         #: The rcl publishers (addresses) the bridge has on the topic: a native ROS -> Gazebo
         #: loop skips their samples by publisher GID (``native/ros_pump.py``).
         self._rcl_publishers: frozenset[int] = frozenset()
-        self._rcl_watchers: tuple[Callable[[], None], ...] = ()
+        self._rcl_watchers = Watchers()
 
     def add_rcl_publisher(self, pointer: int) -> None:
         with self._lock:
             self._rcl_publishers = self._rcl_publishers | {pointer}
-            watchers = self._rcl_watchers
-        for changed in watchers:
-            changed()
+        self._rcl_watchers.notify()
 
     def remove_rcl_publisher(self, pointer: int) -> None:
         with self._lock:
             self._rcl_publishers = self._rcl_publishers - {pointer}
-            watchers = self._rcl_watchers
-        for changed in watchers:
-            changed()
+        self._rcl_watchers.notify()
 
     def rcl_publishers(self) -> frozenset[int]:
         """The rcl publishers of the bridge on this topic now."""
@@ -68,14 +66,7 @@ class OwnPublications:
     def watch_rcl_publishers(self, changed: Callable[[], None]) -> Callable[[], None]:
         """Call ``changed()`` (quick, on the caller's thread) after each change of
         :meth:`rcl_publishers`; returns the function that stops it."""
-        with self._lock:
-            self._rcl_watchers = (*self._rcl_watchers, changed)
-
-        def unwatch() -> None:
-            with self._lock:
-                self._rcl_watchers = tuple(w for w in self._rcl_watchers if w is not changed)
-
-        return unwatch
+        return self._rcl_watchers.add(changed)
 
     def add_numbered(self, publisher: NumberedPublisher) -> None:
         """Also ask ``publisher`` whether a sample is ours (until :meth:`remove_numbered`)."""

@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling, respell, spelling_of
+from ros_gz_bridge_py.watchers import Watchers
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,34 +125,23 @@ class SubscriberBook:
         self._default = default_spelling
         self._subscribers: dict[str, tuple[RemoteSubscriber, ...]] = {}
         self._spellings: dict[str, Spelling] = {}
-        #: fqn -> what to call when its subscribers or the spellings change (replaced whole).
-        self._watchers: dict[str, tuple[Callable[[], None], ...]] = {}
+        #: fqn -> what to call when its subscribers or the spellings change.
+        self._watchers: dict[str, Watchers] = {}
 
     def watch(self, fqn: str, changed: Callable[[], None]) -> Callable[[], None]:
         """Call ``changed()`` after each change of ``fqn``'s subscribers or of the spellings,
         on the thread that made it (it must be quick and must not raise); returns the function
         that stops it."""
-        watchers = dict(self._watchers)
-        watchers[fqn] = (*watchers.get(fqn, ()), changed)
-        self._watchers = watchers
-
-        def unwatch() -> None:
-            remaining = dict(self._watchers)
-            kept = tuple(w for w in remaining.get(fqn, ()) if w is not changed)
-            if kept:
-                remaining[fqn] = kept
-            else:
-                remaining.pop(fqn, None)
-            self._watchers = remaining
-
-        return unwatch
+        return self._watchers.setdefault(fqn, Watchers()).add(changed)
 
     def _changed(self, fqn: str | None) -> None:
-        """Bump the version and call the watchers of ``fqn`` (None: of every topic)."""
+        """Bump the version and tell the watchers of ``fqn`` (None: of every topic)."""
         self.version += 1
-        watchers = self._watchers
-        for changed in watchers.get(fqn, ()) if fqn is not None else _every(watchers):
-            changed()
+        if fqn is None:
+            for watchers in list(self._watchers.values()):
+                watchers.notify()
+        elif (topic_watchers := self._watchers.get(fqn)) is not None:
+            topic_watchers.notify()
 
     def set_subscribers(self, fqn: str, subscribers: tuple[RemoteSubscriber, ...]) -> None:
         """Replace the remote subscribers of ``fqn``."""
@@ -182,10 +172,6 @@ class SubscriberBook:
         return wire_types(
             names, self._subscribers.get(fqn, ()), lambda process: spellings.get(process, default)
         )
-
-
-def _every(watchers: dict[str, tuple[Callable[[], None], ...]]) -> Iterable[Callable[[], None]]:
-    return (changed for per_topic in watchers.values() for changed in per_topic)
 
 
 class WireTypeCache:

@@ -12,7 +12,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[2] / "ros_gz_bridge_py"
 #: Bottom up; a part may import its own layer and those below.
 LAYERS: tuple[frozenset[str], ...] = (
-    frozenset({"errors", "libc", "msgs"}),
+    frozenset({"errors", "libc", "msgs", "watchers"}),
     frozenset({"config", "transport"}),
     frozenset({"ros"}),
     frozenset({"bulk"}),
