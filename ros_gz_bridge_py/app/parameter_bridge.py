@@ -178,11 +178,11 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 return USAGE_EXIT
             if stop.requested:
                 return 0
-            if check_seconds is not None or discover_seconds is not None:
-                finish_start_up(node)
             if check_seconds is not None:
+                finish_start_up(node)
                 return check(node, cli, params, switches, check_seconds, values=values)
             if discover_seconds is not None:
+                finish_start_up(node)
                 return discover_yaml(node, cli, params, discover_seconds, values)
             bridge, discovered = build_bridge(node, cli, params, switches, values)
             diagnostics = start_diagnostics(node, bridge, params.status_period)

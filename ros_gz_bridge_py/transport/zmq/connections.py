@@ -133,12 +133,11 @@ class SubConnections:
         self.connected.add(address)
         return True
 
-    def leave(self, address: str, now: float | None = None) -> None:
-        """Disconnect ``address`` :data:`LEAVE_AFTER` from ``now``: its publishers are gone, and
+    def leave(self, address: str) -> None:
+        """Disconnect ``address`` :data:`LEAVE_AFTER` from now: its publishers are gone, and
         what they sent last may still be on its way (see the module docstring)."""
         if address in self.connected and address not in self._leaving:
-            now = time.monotonic() if now is None else now
-            self._leaving[address] = now + LEAVE_AFTER
+            self._leaving[address] = time.monotonic() + LEAVE_AFTER
 
     def disconnect(self, address: str) -> None:
         """Stop connecting to ``address`` now (safely, see the module docstring)."""
