@@ -13,6 +13,7 @@ from setuptools import Extension, setup
 NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/_native.c",
     "ros_gz_bridge_py/native/encode.c",
+    "ros_gz_bridge_py/native/loop.c",
     "ros_gz_bridge_py/native/pump.c",
     "ros_gz_bridge_py/native/ros_pump.c",
     "ros_gz_bridge_py/native/transcode.c",

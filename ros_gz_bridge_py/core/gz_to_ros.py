@@ -31,6 +31,7 @@ from ros_gz_bridge_py.native.pump import ChannelPump
 from ros_gz_bridge_py.ros.qos import PUBLISHER_OVERRIDES, gz_to_ros_publisher_qos
 from ros_gz_bridge_py.ros.serialized_publisher import SerializedPublisher, object_publisher
 from ros_gz_bridge_py.transport import MessageInfo, Subscription
+from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 
 def has_top_level_header(ros_class: type[Any]) -> bool:
@@ -134,6 +135,7 @@ class GzToRosChannel(Channel):
                 publisher=self._publisher,
                 programs=self._programs,
                 capacity=max(self._qos.depth, MIN_DELIVERY_QUEUE),
+                max_bytes=MAX_QUEUED_BYTES,
                 max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
                 refused=self._convert_and_publish,
                 counted=self._counted,
@@ -146,7 +148,7 @@ class GzToRosChannel(Channel):
             self._publish = own.wrap(publisher)
 
     def _counted(self, received: int, rate_limited: int, published: int) -> None:
-        """What the native loop did since it last said (on the reader thread)."""
+        """What the native loop did since it last said (on the loop's thread)."""
         stats = self.stats
         stats.received += received
         stats.rate_limited += rate_limited

@@ -211,7 +211,7 @@ PyMODINIT_FUNC PyInit__native(void) {
     Py_INCREF(&ProgramType);
     Py_INCREF(&EncoderType);
     if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0 ||
-        PyModule_AddObject(m, "Encoder", (PyObject *)&EncoderType) < 0 || pump_register(m) < 0 ||
+        PyModule_AddObject(m, "Encoder", (PyObject *)&EncoderType) < 0 || pump_register(m) < 0 || loop_register(m) < 0 ||
         ros_pump_register(m) < 0) {
         Py_DECREF(m);
         return NULL;

@@ -1,14 +1,14 @@
-/* The per-message loop of a native Gazebo -> ROS channel (docs/native.md §5).
+/* The per-message work of a native Gazebo -> ROS channel (docs/native.md §5).
  *
- * Run by the channel's reader thread with the GIL released: it polls the topic's SUB socket,
- * reads each message's four frames, keeps the newest `capacity` payloads (dropping the oldest,
- * before any work is spent on them), applies max_rate, transcodes each payload with the
- * program of its wire type and publishes it through rcl on the channel's publisher. No Python
- * runs per message. What it does not decide is handed back to Python, which stays the
- * reference: frames of a (sender, type) it has not been told about (Python judges them and
- * tells it with `learn`), and payloads its program does not take (Python converts them, or
- * says why not). It returns when the reader's wake-up socket or the connection monitor is
- * readable, or the timeout ends, so that Python does its share of the work.
+ * A Pump is one channel's state: its routes, its queue, its programs, its publisher. The
+ * process's one loop (loop.c) runs every pump with the GIL released: it reads each message's
+ * four frames from the topic's SUB socket (pump_read), keeps the newest `capacity` payloads and
+ * at most `max_bytes` of them (dropping the oldest, before any work is spent on them), applies
+ * max_rate, transcodes each payload with the program of its wire type and publishes it through
+ * rcl on the channel's publisher (pump_deliver). No Python runs per message. What it does not
+ * decide is handed back to Python, which stays the reference: frames of a (sender, type) it has
+ * not been told about (Python judges them and tells it with `learn`), and payloads its program
+ * does not take (Python converts them, or says why not): `take_handed` gives them to Python.
  *
  * libzmq and rcl are the libraries pyzmq and rclpy already loaded: Python passes the addresses
  * of their functions (pump.py). */
@@ -16,8 +16,8 @@
 #include "pump.h"
 
 #include <errno.h>
-#include <poll.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <string.h>
 #include <time.h>
@@ -38,6 +38,8 @@ typedef struct {
 } rcl_serialized;
 
 enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_FD_ = 14, ZMQ_EVENTS_ = 15 };
+/* libzmq's errno for a terminated context (zmq.h: ZMQ_HAUSNUMERO + 53). */
+#define ETERM_ (156384712 + 53)
 
 struct foreign {
     int (*msg_init)(zmq_msg *msg);
@@ -54,15 +56,17 @@ struct foreign {
 /* ---- the pump --------------------------------------------------------------------------------- */
 
 #define MAX_FRAMES 16
-#define READ_BATCH 256
-#define SLICE_NS 1000000LL
 #define HISTORY 1024
+#define MAX_ROUTES 1024
+/* Routes a full table keeps: the most recently used (and those a waiting message names). */
+#define KEEP_ROUTES (MAX_ROUTES / 2)
 
 /* What a (sender, type) pair of frames gets: a program, or nothing (another spelling taken). */
 struct route {
     uint8_t *sender, *type;
     size_t sender_len, type_len;
     int program; /* index into programs, or -1: skip without a word */
+    uint64_t used; /* the pump's `taken` when a message last took this route */
 };
 
 struct queued {
@@ -83,7 +87,7 @@ struct window {
     int64_t start, end;
 };
 
-typedef struct {
+struct PumpObject {
     PyObject_HEAD
     struct foreign f;
     void *publisher;
@@ -98,16 +102,21 @@ typedef struct {
     int nroutes;
     struct queued *ring;
     size_t capacity, head, count;
+    size_t max_bytes, queued_bytes; /* the ring's bound in payload bytes, and what it holds */
     struct handed *handover;
     size_t nhanded, handed_cap;
     struct rgb_out out;
     int64_t period_ns, next_ns; /* max_rate: next admission time (period 0: no limit) */
     unsigned long long received, rate_limited, published, dropped, skipped;
+    unsigned long long lost; /* messages for Python that could not be copied (no memory) */
+    unsigned long long taken; /* messages read from the socket, whatever became of them */
     pthread_mutex_t lock; /* the windows and the sequence (read by is_own from any thread) */
     uint64_t sequence;
     struct window windows[HISTORY];
-    int running;
-} PumpObject;
+    const atomic_int *running; /* while attached: the loop's "running" flag (loop.c) */
+};
+
+static PyTypeObject PumpType;
 
 static int64_t now_ns(clockid_t clock) {
     struct timespec t;
@@ -166,29 +175,64 @@ static struct handed *hand(PumpObject *self) {
     return h;
 }
 
-/* Copies `n` bytes for Python (NULL only when memory runs out). */
+/* Copies `n` bytes (NULL only when memory runs out). */
 static uint8_t *copy_bytes(const void *p, size_t n) {
     uint8_t *copy = malloc(n ? n : 1);
     if (copy != NULL && n) memcpy(copy, p, n);
     return copy;
 }
 
-static void keep(PumpObject *self, zmq_msg *payload, int route) {
-    if (self->count == self->capacity) { /* drop the oldest, before any work on it */
-        struct queued *oldest = &self->ring[self->head];
-        self->f.msg_close(&oldest->payload);
-        self->head = (self->head + 1) % self->capacity;
-        self->count--;
-        self->dropped++;
+/* Hands `n` frames to Python as copies. When memory runs out nothing is handed (an empty
+ * payload would parse as a valid all-default message) and the message is counted as lost. */
+static void hand_frames(PumpObject *self, int kind, int route, int status, zmq_msg *frames,
+                        int n) {
+    struct handed *h = hand(self);
+    if (h == NULL) {
+        self->lost++;
+        return;
     }
+    h->kind = kind;
+    h->route = route;
+    h->status = status;
+    for (int i = 0; i < n; i++) {
+        h->size[i] = self->f.msg_size(&frames[i]);
+        h->data[i] = copy_bytes(self->f.msg_data(&frames[i]), h->size[i]);
+        h->nframes = i + 1;
+        if (h->data[i] == NULL) {
+            for (int k = 0; k < i; k++) free(h->data[k]);
+            self->nhanded--;
+            self->lost++;
+            return;
+        }
+    }
+}
+
+static void drop_oldest(PumpObject *self) {
+    struct queued *oldest = &self->ring[self->head];
+    self->queued_bytes -= self->f.msg_size(&oldest->payload);
+    self->f.msg_close(&oldest->payload);
+    self->head = (self->head + 1) % self->capacity;
+    self->count--;
+    self->dropped++;
+}
+
+/* Queues a payload; the oldest go first, before any work on them, while the ring is full or
+ * would hold more than max_bytes (one payload is always kept, as the Python path's queue). */
+static void keep(PumpObject *self, zmq_msg *payload, int route) {
+    size_t size = self->f.msg_size(payload);
+    while (self->count && (self->count == self->capacity ||
+                           self->queued_bytes + size > self->max_bytes))
+        drop_oldest(self);
     struct queued *slot = &self->ring[(self->head + self->count) % self->capacity];
     memcpy(&slot->payload, payload, sizeof *payload);
     slot->route = route;
     self->count++;
+    self->queued_bytes += size;
 }
 
-/* Reads one message; 0 when none was waiting. The socket's own ZMQ_EVENTS is never asked: a
- * SUB socket answers it by prefetching a message (see pump_loop). */
+/* Reads one message: 1 when one was read, 0 when none was waiting, -1 when the socket cannot
+ * be read (its context terminated, or it is closed). The socket's own ZMQ_EVENTS is never
+ * asked: a SUB socket answers it by prefetching a message (see loop.c). */
 static int read_message(PumpObject *self, void *sock) {
     zmq_msg frames[MAX_FRAMES];
     int n = 0, more = 1, extra = 0;
@@ -196,9 +240,10 @@ static int read_message(PumpObject *self, void *sock) {
         zmq_msg scratch, *frame = n < MAX_FRAMES ? &frames[n] : &scratch;
         self->f.msg_init(frame);
         if (self->f.msg_recv(frame, sock, n ? 0 : ZMQ_DONTWAIT_) < 0) {
+            int error = errno;
             self->f.msg_close(frame);
-            if (n == 0) return 0;
-            break;
+            if (n == 0) return error == EAGAIN || error == EINTR ? 0 : -1;
+            break; /* a later frame cannot fail once the first is read (ZeroMQ is atomic) */
         }
         more = self->f.msg_more(frame);
         if (frame == &scratch) {
@@ -208,11 +253,13 @@ static int read_message(PumpObject *self, void *sock) {
             n++;
         }
     }
+    self->taken++;
     int route = -1;
     if (n == 4 && !extra && self->f.msg_size(&frames[0]) == self->topic_len &&
         !memcmp(self->f.msg_data(&frames[0]), self->topic, self->topic_len)) {
         route = find_route(self, self->f.msg_data(&frames[1]), self->f.msg_size(&frames[1]),
                            self->f.msg_data(&frames[3]), self->f.msg_size(&frames[3]));
+        if (route >= 0) self->routes[route].used = self->taken;
     }
     if (route >= 0 && self->routes[route].program >= 0) {
         keep(self, &frames[2], route);
@@ -221,20 +268,10 @@ static int read_message(PumpObject *self, void *sock) {
         self->f.msg_close(&frames[3]);
         return 1;
     }
-    if (route >= 0) { /* a spelling already taken from this publisher: not ours */
+    if (route >= 0) /* a spelling already taken from this publisher: not ours */
         self->skipped++;
-    } else {
-        struct handed *h = hand(self);
-        if (h != NULL) {
-            h->kind = 0;
-            h->nframes = n;
-            for (int i = 0; i < n; i++) {
-                h->size[i] = self->f.msg_size(&frames[i]);
-                h->data[i] = copy_bytes(self->f.msg_data(&frames[i]), h->size[i]);
-                if (h->data[i] == NULL) h->size[i] = 0;
-            }
-        }
-    }
+    else
+        hand_frames(self, 0, -1, 0, frames, n);
     for (int i = 0; i < n; i++) self->f.msg_close(&frames[i]);
     return 1;
 }
@@ -271,72 +308,63 @@ static void deliver(PumpObject *self, struct queued *q) {
         self->f.reset_error();
         status = RGB_FALLBACK; /* Python publishes it, or says why it cannot */
     }
-    struct handed *h = hand(self);
-    if (h == NULL) return;
-    h->kind = 1;
-    h->route = q->route;
-    h->status = (int)status;
-    h->nframes = 1;
-    h->size[0] = size;
-    h->data[0] = copy_bytes(data, size);
-    if (h->data[0] == NULL) h->size[0] = 0;
+    hand_frames(self, 1, q->route, (int)status, &q->payload, 1);
 }
 
-enum { EVENT_WAKE = 1, EVENT_MONITOR = 2, EVENT_HANDED = 4 };
+/* ---- what the loop calls (loop.c; no GIL) ------------------------------------------------ */
 
-/* The descriptor libzmq signals when `sock` has commands to process, or -1. */
-static int zmq_fd(PumpObject *self, void *sock) {
+int pump_zmq_fd(PumpObject *self, void *sock) {
     int fd = -1;
     size_t size = sizeof fd;
     return self->f.getsockopt(sock, ZMQ_FD_, &fd, &size) == 0 ? fd : -1;
 }
 
-/* Whether the monitor (a PAIR socket: asking ZMQ_EVENTS prefetches nothing) has an event. */
-static int monitor_ready(PumpObject *self, void *monitor) {
+int pump_monitor_ready(PumpObject *self, void *monitor) {
     int events = 0;
     size_t size = sizeof events;
     return self->f.getsockopt(monitor, ZMQ_EVENTS_, &events, &size) == 0 &&
            (events & ZMQ_POLLIN_);
 }
 
-/* Sleeps in poll(2) on the sockets' ZMQ_FD descriptors rather than in zmq_poll: zmq_poll asks
- * every socket's ZMQ_EVENTS before and after it sleeps, two more rounds of libzmq's command
- * processing (getpid, poll) per message. The descriptor is edge-like: it is readable while
- * commands wait, so it is slept on only after a read found the socket empty (a recv that
- * returns EAGAIN has processed every command). */
-static int pump_loop(PumpObject *self, void *sock, int wake_fd, void *monitor, long timeout_ms) {
-    int64_t deadline = now_ns(CLOCK_MONOTONIC) + (int64_t)timeout_ms * 1000000LL;
-    int sock_fd = zmq_fd(self, sock), monitor_fd = monitor ? zmq_fd(self, monitor) : -1;
-    if (sock_fd < 0 || (monitor && monitor_fd < 0)) return 0; /* a closed socket: Python looks */
-    if (monitor && monitor_ready(self, monitor)) return EVENT_MONITOR; /* left from a run */
-    for (;;) {
-        int empty = 0; /* a read found the socket empty: its descriptor may be slept on */
-        for (int i = 0; i < READ_BATCH && !empty; i++) empty = !read_message(self, sock);
-        int64_t slice_end = now_ns(CLOCK_MONOTONIC) + SLICE_NS;
-        while (self->count) {
-            struct queued *q = &self->ring[self->head];
-            self->head = (self->head + 1) % self->capacity;
-            self->count--;
-            deliver(self, q);
-            self->f.msg_close(&q->payload);
-            if (now_ns(CLOCK_MONOTONIC) >= slice_end) break;
-        }
-        if (self->nhanded) return EVENT_HANDED;
-        int64_t left = deadline - now_ns(CLOCK_MONOTONIC);
-        if (left <= 0) return 0; /* also under a flood: Python's share is due */
-        if (self->count || !empty) continue;
-        struct pollfd fds[3] = {
-            {sock_fd, POLLIN, 0},
-            {wake_fd, POLLIN, 0},
-            {monitor_fd, POLLIN, 0},
-        };
-        int ready = poll(fds, monitor ? 3 : 2, (int)((left + 999999) / 1000000));
-        if (ready < 0 && errno != EINTR) return 0;
-        int events = (fds[1].revents ? EVENT_WAKE : 0) |
-                     (monitor && fds[2].revents && monitor_ready(self, monitor) ? EVENT_MONITOR : 0);
-        if (events) return events;
+int pump_read(PumpObject *self, void *sock, int budget) {
+    for (int i = 0; i < budget; i++) {
+        int read = read_message(self, sock);
+        if (read <= 0) return read < 0 ? -1 : 1;
+    }
+    return 0;
+}
+
+void pump_deliver(PumpObject *self, int budget, int64_t slice_end) {
+    for (int i = 0; i < budget && self->count; i++) {
+        struct queued *q = &self->ring[self->head];
+        self->head = (self->head + 1) % self->capacity;
+        self->count--;
+        self->queued_bytes -= self->f.msg_size(&q->payload);
+        deliver(self, q);
+        self->f.msg_close(&q->payload);
+        if (now_ns(CLOCK_MONOTONIC) >= slice_end) break;
     }
 }
+
+size_t pump_queued(const PumpObject *self) { return self->count; }
+
+size_t pump_handed(const PumpObject *self) { return self->nhanded; }
+
+unsigned long long pump_taken(const PumpObject *self) { return self->taken; }
+
+PumpObject *native_pump_of(PyObject *object) {
+    if (!PyObject_TypeCheck(object, &PumpType)) return NULL;
+    PumpObject *pump = (PumpObject *)object;
+    return pump->topic == NULL ? NULL : pump;
+}
+
+int pump_attach(PumpObject *self, const atomic_int *running) {
+    if (self->running != NULL) return -1;
+    self->running = running;
+    return 0;
+}
+
+void pump_detach(PumpObject *self) { self->running = NULL; }
 
 /* ---- Python methods -------------------------------------------------------------------------- */
 
@@ -346,11 +374,13 @@ static void clear_handover(PumpObject *self) {
     self->nhanded = 0;
 }
 
+static void free_route(struct route *r) {
+    free(r->sender);
+    free(r->type);
+}
+
 static void clear_routes(PumpObject *self) {
-    for (int i = 0; i < self->nroutes; i++) {
-        free(self->routes[i].sender);
-        free(self->routes[i].type);
-    }
+    for (int i = 0; i < self->nroutes; i++) free_route(&self->routes[i]);
     free(self->routes);
     self->routes = NULL;
     self->nroutes = 0;
@@ -362,6 +392,62 @@ static void clear_ring(PumpObject *self) {
         self->head = (self->head + 1) % self->capacity;
         self->count--;
     }
+    self->queued_bytes = 0;
+}
+
+static int newest_first(const void *a, const void *b) {
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? 1 : x > y ? -1 : 0;
+}
+
+/* Makes room in a full route table: the KEEP_ROUTES most recently used routes stay, and so do
+ * those a queued or handed message names (under a new index); the others are forgotten, and
+ * Python judges their next message again. A sender that changes its sender frame every message
+ * thus costs its own messages a trip through Python, never the routes of the publishers that
+ * keep sending, nor anyone's queue. */
+static void evict_routes(PumpObject *self) {
+    size_t n = (size_t)self->nroutes;
+    int *renumber = malloc(n * sizeof *renumber);
+    char *keep = calloc(n, 1);
+    uint64_t *uses = malloc(n * sizeof *uses);
+    if (renumber == NULL || keep == NULL || uses == NULL) { /* no memory: forget them all */
+        free(renumber);
+        free(keep);
+        free(uses);
+        self->dropped += self->count + self->nhanded;
+        clear_ring(self);
+        clear_handover(self);
+        clear_routes(self);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) uses[i] = self->routes[i].used;
+    qsort(uses, n, sizeof *uses, newest_first);
+    uint64_t oldest_kept = uses[KEEP_ROUTES - 1];
+    for (size_t i = 0; i < n; i++) keep[i] = self->routes[i].used > oldest_kept;
+    for (size_t i = 0; i < self->count; i++)
+        keep[self->ring[(self->head + i) % self->capacity].route] = 1;
+    for (size_t i = 0; i < self->nhanded; i++)
+        if (self->handover[i].kind == 1) keep[self->handover[i].route] = 1;
+    int kept = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (keep[i]) {
+            renumber[i] = kept;
+            self->routes[kept++] = self->routes[i];
+        } else {
+            free_route(&self->routes[i]);
+        }
+    }
+    for (size_t i = 0; i < self->count; i++) {
+        struct queued *q = &self->ring[(self->head + i) % self->capacity];
+        q->route = renumber[q->route];
+    }
+    for (size_t i = 0; i < self->nhanded; i++)
+        if (self->handover[i].kind == 1)
+            self->handover[i].route = renumber[self->handover[i].route];
+    self->nroutes = kept;
+    free(renumber);
+    free(keep);
+    free(uses);
 }
 
 static void pump_dealloc(PumpObject *self) {
@@ -389,31 +475,48 @@ static PyObject *pump_new(PyTypeObject *type, PyObject *args, PyObject *kwds) {
     return (PyObject *)self;
 }
 
-/* Pump(topic, functions, publisher, programs, capacity, max_rate)
+/* 0, or -1 with a Python error when the pump was never initialised (Pump.__new__ alone) or
+ * (`idle`) while the loop runs it. */
+static int usable(PumpObject *self, int idle) {
+    if (self->topic == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "the Pump is not initialised");
+        return -1;
+    }
+    if (idle && self->running != NULL && atomic_load(self->running)) {
+        PyErr_SetString(PyExc_RuntimeError, "the Pump's loop is running it");
+        return -1;
+    }
+    return 0;
+}
+
+/* Pump(topic, functions, publisher, programs, capacity, max_rate, max_bytes)
  * functions: 9 addresses (zmq_msg_init, zmq_msg_recv, zmq_msg_close, zmq_msg_data,
  * zmq_msg_size, zmq_msg_more, zmq_getsockopt, rcl_publish_serialized_message,
  * rcutils_reset_error); programs: {wire type (bytes): Program}. */
 static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"topic", "functions", "publisher", "programs", "capacity",
-                               "max_rate", NULL};
+                               "max_rate", "max_bytes", NULL};
     Py_buffer topic;
     PyObject *functions, *programs;
     unsigned long long publisher;
-    Py_ssize_t capacity;
+    Py_ssize_t capacity, max_bytes;
     double max_rate;
-    if (self->topic != NULL) {
+    if (self->topic != NULL || self->ring != NULL) {
         PyErr_SetString(PyExc_RuntimeError, "a Pump is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*OKO!nd", keywords, &topic, &functions,
-                                     &publisher, &PyDict_Type, &programs, &capacity, &max_rate))
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*OKO!ndn", keywords, &topic, &functions,
+                                     &publisher, &PyDict_Type, &programs, &capacity, &max_rate,
+                                     &max_bytes))
         return -1;
     int result = -1;
     void *addresses[9];
     if (native_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0)
         goto done;
-    if (publisher == 0 || capacity < 1 || capacity > (1 << 24) || !(max_rate >= 0)) {
-        PyErr_SetString(PyExc_ValueError, "publisher, capacity or max_rate out of range");
+    if (publisher == 0 || capacity < 1 || capacity > (1 << 24) || !(max_rate >= 0) ||
+        max_bytes < 1) {
+        PyErr_SetString(PyExc_ValueError,
+                        "publisher, capacity, max_rate or max_bytes out of range");
         goto done;
     }
     memcpy(&self->f.msg_init, &addresses[0], sizeof(void *));
@@ -431,14 +534,12 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     self->program_types = calloc((size_t)n + 1, sizeof *self->program_types);
     self->program_type_lens = calloc((size_t)n + 1, sizeof *self->program_type_lens);
     self->ring = calloc((size_t)capacity, sizeof *self->ring);
-    self->topic = copy_bytes(topic.buf, (size_t)topic.len);
-    if (!self->programs || !self->program_types || !self->program_type_lens || !self->ring ||
-        !self->topic) {
+    if (!self->programs || !self->program_types || !self->program_type_lens || !self->ring) {
         PyErr_NoMemory();
         goto done;
     }
-    self->topic_len = (size_t)topic.len;
     self->capacity = (size_t)capacity;
+    self->max_bytes = (size_t)max_bytes;
     self->program_objects = PyList_New(0);
     if (self->program_objects == NULL) goto done;
     PyObject *key, *value;
@@ -461,6 +562,13 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     }
     self->period_ns = max_rate > 0 ? (int64_t)(1e9 / max_rate) : 0;
     self->next_ns = INT64_MIN;
+    /* set last: a Pump with a topic is whole (native_pump_of, usable) */
+    self->topic = copy_bytes(topic.buf, (size_t)topic.len);
+    if (self->topic == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    self->topic_len = (size_t)topic.len;
     result = 0;
 done:
     PyBuffer_Release(&topic);
@@ -471,6 +579,7 @@ done:
 static PyObject *pump_learn(PumpObject *self, PyObject *args) {
     Py_buffer sender, type;
     int take;
+    if (usable(self, 1) < 0) return NULL;
     if (!PyArg_ParseTuple(args, "y*y*p", &sender, &type, &take)) return NULL;
     PyObject *result = NULL;
     int program = -1;
@@ -483,10 +592,10 @@ static PyObject *pump_learn(PumpObject *self, PyObject *args) {
         goto done;
     }
     if (find_route(self, sender.buf, (size_t)sender.len, type.buf, (size_t)type.len) < 0) {
-        if (self->nroutes >= 1024) { /* as Python's verdict cache; queued ones name routes */
-            self->dropped += self->count;
-            clear_ring(self);
-            clear_routes(self);
+        if (self->nroutes >= MAX_ROUTES) evict_routes(self);
+        if (self->nroutes >= MAX_ROUTES) { /* every route is named by a waiting message */
+            result = Py_NewRef(Py_False);
+            goto done;
         }
         struct route *grown = realloc(self->routes, (size_t)(self->nroutes + 1) * sizeof *grown);
         if (grown == NULL) {
@@ -498,14 +607,14 @@ static PyObject *pump_learn(PumpObject *self, PyObject *args) {
         r->sender = copy_bytes(sender.buf, (size_t)sender.len);
         r->type = copy_bytes(type.buf, (size_t)type.len);
         if (r->sender == NULL || r->type == NULL) {
-            free(r->sender);
-            free(r->type);
+            free_route(r);
             PyErr_NoMemory();
             goto done;
         }
         r->sender_len = (size_t)sender.len;
         r->type_len = (size_t)type.len;
         r->program = program;
+        r->used = self->taken; /* as new as the message that made Python learn it */
         self->nroutes++;
     }
     result = Py_NewRef(Py_True);
@@ -517,33 +626,22 @@ done:
 
 static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     (void)unused;
-    if (self->running) {
-        PyErr_SetString(PyExc_RuntimeError, "forget while the pump runs");
+    if (usable(self, 0) < 0) return NULL;
+    if (self->running != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "forget while a loop runs the pump");
         return NULL;
     }
     clear_routes(self);
     clear_ring(self);
+    clear_handover(self);
     Py_RETURN_NONE;
 }
 
-/* run(sock, wake_fd, monitor, timeout_ms) -> (events, handed)
- * handed: [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused. */
-static PyObject *pump_run(PumpObject *self, PyObject *args) {
-    unsigned long long sock, monitor;
-    int wake_fd;
-    long timeout_ms;
-    if (!PyArg_ParseTuple(args, "KiKl", &sock, &wake_fd, &monitor, &timeout_ms)) return NULL;
-    if (sock == 0 || self->running) {
-        PyErr_SetString(PyExc_ValueError, "no socket, or the pump already runs");
-        return NULL;
-    }
-    self->running = 1;
-    int events;
-    Py_BEGIN_ALLOW_THREADS;
-    events = pump_loop(self, (void *)(uintptr_t)sock, wake_fd, (void *)(uintptr_t)monitor,
-                       timeout_ms < 0 ? 0 : timeout_ms);
-    Py_END_ALLOW_THREADS;
-    self->running = 0;
+/* take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused:
+ * what the loop left to Python since the last call. */
+static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
+    (void)unused;
+    if (usable(self, 1) < 0) return NULL;
     PyObject *handed = PyList_New(0);
     for (size_t i = 0; handed != NULL && i < self->nhanded; i++) {
         struct handed *h = &self->handover[i];
@@ -566,14 +664,13 @@ static PyObject *pump_run(PumpObject *self, PyObject *args) {
         Py_XDECREF(item);
     }
     clear_handover(self);
-    if (handed == NULL) return NULL;
-    return Py_BuildValue("(iN)", events, handed);
+    return handed;
 }
 
 static PyObject *pump_counts(PumpObject *self, PyObject *unused) {
     (void)unused;
-    return Py_BuildValue("(KKKKK)", self->received, self->rate_limited, self->published,
-                         self->dropped, self->skipped);
+    return Py_BuildValue("(KKKKKK)", self->received, self->rate_limited, self->published,
+                         self->dropped, self->skipped, self->lost);
 }
 
 static PyObject *pump_begin_publication(PumpObject *self, PyObject *unused) {
@@ -606,10 +703,10 @@ static PyMethodDef pump_methods[] = {
      "learn(sender, msg_type, take) -> bool: route messages of (sender, type) natively (take) "
      "or skip them; False where no program takes msg_type"},
     {"forget", (PyCFunction)pump_forget, METH_NOARGS, "forget routes and queued messages"},
-    {"run", (PyCFunction)pump_run, METH_VARARGS,
-     "run(sock, wake_fd, monitor, timeout_ms) -> (events, handed), the GIL released"},
+    {"take_handed", (PyCFunction)pump_take_handed, METH_NOARGS,
+     "take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused"},
     {"counts", (PyCFunction)pump_counts, METH_NOARGS,
-     "(received, rate_limited, published, dropped, skipped) so far"},
+     "(received, rate_limited, published, dropped, skipped, lost) so far"},
     {"begin_publication", (PyCFunction)pump_begin_publication, METH_NOARGS,
      "a publication made from Python on the same publisher: its sequence number"},
     {"end_publication", (PyCFunction)pump_end_publication, METH_VARARGS,
@@ -623,7 +720,7 @@ static PyTypeObject PumpType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.Pump",
     .tp_basicsize = sizeof(PumpObject),
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "The per-message loop of one Gazebo -> ROS channel (docs/native.md §5).",
+    .tp_doc = "The per-message work of one Gazebo -> ROS channel (docs/native.md §5).",
     .tp_new = pump_new,
     .tp_init = (initproc)pump_init,
     .tp_dealloc = (destructor)pump_dealloc,

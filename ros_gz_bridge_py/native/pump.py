@@ -1,12 +1,13 @@
-"""A native Gazebo -> ROS channel's pump, as its reader thread and its channel use it.
+"""A native Gazebo -> ROS channel's pump, as its reader and its channel use it.
 
 :class:`ChannelPump` holds the C ``Pump`` (pump.c) of one channel: made when the channel's
 ROS publisher exists, with one program per spelling of the channel's Gazebo type, and kept for
 the publisher's life (its publication sequence numbers are the loop guard's, whichever path
-published). The ZeroMQ reader calls :meth:`ChannelPump.run` instead of polling and reading
-itself (``transport/zmq/reader.py``); what the C loop hands back is done here in Python: the
-payloads no program took go through the channel's Python path (``refused``), which converts
-them or says why not, with the Python path's own error reasons.
+published). The ZeroMQ reader attaches it to the process's one loop (``loop.py``) instead of
+reading its socket on a thread of its own (``transport/zmq/reader.py``); what the C loop hands
+back is done here in Python, on the loop's thread: the payloads no program took go through the
+channel's Python path (``refused``), which converts them or says why not, with the Python
+path's own error reasons, and the frames of a sender not yet known go to the reader.
 
 libzmq and rcl are not linked: their functions are taken from the libraries pyzmq and rclpy
 already loaded (docs/native.md §5).
@@ -24,7 +25,9 @@ from typing import Any
 import zmq  # noqa: F401 - loads pyzmq's libzmq, which libzmq_path finds
 
 from ros_gz_bridge_py.native import extension
+from ros_gz_bridge_py.native.loop import shared_loop
 from ros_gz_bridge_py.transport import MessageInfo
+from ros_gz_bridge_py.transport.api import NativeHost
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 _ZMQ_FUNCTIONS = (
@@ -36,7 +39,7 @@ _ZMQ_FUNCTIONS = (
     "zmq_msg_more",
     "zmq_getsockopt",
 )
-#: Handed back by the C loop: frames it has no route for, or a payload no program took.
+#: Handed back by the C pump: frames it has no route for, or a payload no program took.
 _UNROUTED, _REFUSED = 0, 1
 
 
@@ -97,6 +100,7 @@ class ChannelPump:
         publisher: Any,
         programs: Mapping[str, Any],
         capacity: int,
+        max_bytes: int,
         max_rate: float,
         refused: Callable[[bytes, MessageInfo], None],
         counted: Callable[[int, int, int], None],
@@ -116,20 +120,27 @@ class ChannelPump:
             {name.encode(): program for name, program in programs.items()},
             capacity,
             max_rate,
+            max_bytes,
         )
+        self._loop = shared_loop()
+        self._host: NativeHost | None = None
         self._refused = refused
         self._counted = counted
         self._partition = partition
         self._name = name
-        #: Messages the last run took from the socket (delivered here, or handed back).
-        self.took = 0
         self._infos: dict[tuple[bytes, bytes], MessageInfo] = {}
-        self._seen = (0, 0, 0, 0, 0)
+        self._seen = (0, 0, 0, 0)
 
-    # --- the reader thread ----------------------------------------------------------------
+    @property
+    def pump(self) -> Any:
+        """The C Pump."""
+        return self._pump
+
+    # --- the reader -----------------------------------------------------------------------
 
     def forget(self) -> None:
-        """A new subscription: no route is known yet (a closed one's queue is dropped)."""
+        """No route is known yet (a closed subscription's queue is dropped); the loop calls it
+        when the pump is attached."""
         self._pump.forget()
 
     def learn(self, sender: bytes, msg_type: bytes, *, take: bool) -> None:
@@ -137,12 +148,27 @@ class ChannelPump:
         program takes the type), or are skipped (another spelling of a type taken)."""
         self._pump.learn(sender, msg_type, take)
 
-    def run(self, sock: int, wake_fd: int, monitor: int, timeout_ms: int) -> tuple[int, list[Any]]:
-        """Pump messages with the GIL released until the wake-up socket or the monitor is
-        readable or ``timeout_ms`` ends; returns the events and the frames with no route (for
-        the reader to judge). Refused payloads are converted here, in Python."""
-        with self._handle:
-            events, handed = self._pump.run(sock, wake_fd, monitor, timeout_ms)
+    def attach(self, sock: int, monitor: int, host: NativeHost) -> None:
+        """Read ``sock`` (with its connection ``monitor``) on the process's loop; ``host`` does
+        the reader's share on the loop's thread."""
+        self._host = host
+        self._loop.attach(self, sock, monitor, self._handle)
+
+    def detach(self) -> None:
+        """Returns once the loop no longer reads the socket."""
+        self._loop.detach(self)
+
+    def wake(self) -> None:
+        """The host wants a turn soon (any thread)."""
+        self._loop.ask(self)
+
+    # --- the loop's thread ----------------------------------------------------------------
+
+    def loop_turn(self, events: int) -> float | None:
+        """What the C loop left to Python: refused payloads converted here, unrouted frames
+        judged by the host, the counts; then the host's own turn."""
+        loop = self._loop
+        handed = self._pump.take_handed() if events & loop.handed_event else ()
         received, rate_limited, published, _dropped = self.take_counts()
         if received:
             self._counted(received, rate_limited, published)
@@ -153,8 +179,13 @@ class ChannelPump:
             else:
                 _kind, sender, msg_type, payload, _status = item
                 self._refused(payload, self._info(sender, msg_type))
-        self.took = received + len(unrouted)
-        return events, unrouted
+        if self._host is None:
+            return None
+        return self._host.native_turn(
+            unrouted,
+            monitor=bool(events & loop.monitor_event),
+            broken=bool(events & loop.broken_event),
+        )
 
     def _info(self, sender: bytes, msg_type: bytes) -> MessageInfo:
         info = self._infos.get((sender, msg_type))
@@ -168,7 +199,8 @@ class ChannelPump:
 
     def take_counts(self) -> tuple[int, int, int, int]:
         """(received, rate_limited, published, dropped) since the last call."""
-        now = self._pump.counts()
+        received, rate_limited, published, dropped, _skipped, lost = self._pump.counts()
+        now = (received, rate_limited, published, dropped + lost)
         before, self._seen = self._seen, now
         return (now[0] - before[0], now[1] - before[1], now[2] - before[2], now[3] - before[3])
 
@@ -179,8 +211,10 @@ class ChannelPump:
 
     @property
     def dropped(self) -> int:
-        """Payloads dropped so far, oldest first, before any work on them."""
-        return int(self._pump.counts()[3])
+        """Payloads dropped so far: the oldest, before any work on them (over the queue's count
+        or bytes), and those that could not be handed to Python (no memory for a copy)."""
+        counts = self._pump.counts()
+        return int(counts[3] + counts[5])
 
     # --- the loop guard -------------------------------------------------------------------
 

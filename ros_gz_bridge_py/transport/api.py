@@ -153,21 +153,38 @@ Callback = Callable[[Any, MessageInfo], None]
 RejectCallback = Callable[[Rejection, str], None]
 
 
+class NativeHost(Protocol):
+    """The reader a :class:`NativeLoop` reads for (``zmq/reader.py``): its share of the work,
+    on the loop's thread."""
+
+    def native_turn(
+        self, unrouted: list[list[Any]], *, monitor: bool, broken: bool
+    ) -> float | None:
+        """Judges the frames the loop had no route for, runs posted commands and the
+        connections (``monitor``: the connection monitor has events; ``broken``: the socket
+        cannot be read any more); returns when it wants its next turn at the latest
+        (``time.monotonic()``), or None."""
+        ...
+
+
 class NativeLoop(Protocol):
     """A per-message loop that reads a subscription's ZeroMQ socket outside Python
-    (``native/pump.py``); the ZeroMQ reader runs it instead of reading, and judges only what it
-    hands back (``zmq/reader.py``). Other backends do not use it."""
-
-    def forget(self) -> None:
-        """A new subscription starts: no (sender, type) is known."""
+    (``native/pump.py``, on the process's one loop thread, ``native/loop.py``); the ZeroMQ
+    reader attaches its socket instead of reading it, and judges only what it hands back
+    (``zmq/reader.py``). Other backends do not use it."""
 
     def learn(self, sender: bytes, msg_type: bytes, *, take: bool) -> None:
         """Messages of (sender, type) are the loop's from now on (``take``), or skipped."""
 
-    def run(self, sock: int, wake_fd: int, monitor: int, timeout_ms: int) -> tuple[int, list[Any]]:
-        """Runs until the wake-up fd or the monitor socket is readable (events 1, 2) or the
-        time is up; returns the events and the frames of messages it has no route for."""
-        ...
+    def attach(self, sock: int, monitor: int, host: NativeHost) -> None:
+        """Read ``sock`` (a socket's address, with its connection ``monitor``) from now on;
+        ``host.native_turn`` runs on the loop's thread. No route is known at first."""
+
+    def detach(self) -> None:
+        """Returns once the loop no longer touches the sockets."""
+
+    def wake(self) -> None:
+        """Calls ``host.native_turn`` soon (from any thread)."""
 
     @property
     def received(self) -> int:
@@ -175,13 +192,8 @@ class NativeLoop(Protocol):
         ...
 
     @property
-    def took(self) -> int:
-        """Messages its last run took from the socket (delivered, or handed back)."""
-        ...
-
-    @property
     def dropped(self) -> int:
-        """Messages it dropped, oldest first."""
+        """Messages it dropped."""
         ...
 
 

@@ -4,9 +4,14 @@ Through the node's shared SUB socket, every message of a queued subscription cro
 threads: the I/O thread read its four frames (pyzmq releases the GIL around each read) and
 handed it to the subscription's delivery thread. At kilohertz rates those hand-overs cost
 more than converting the message. A :class:`SubscriptionReader` instead owns a SUB socket
-subscribed to its one topic and connected to that topic's publishers, and its thread both
+subscribed to its one topic and connected to that topic's publishers, and one thread both
 reads and delivers: no hand-over, and each topic has its own TCP connection, so a flooded
-topic's back-pressure never holds another topic's messages.
+topic's back-pressure never holds another topic's messages. That thread is the reader's own,
+or, for a native channel, the process's one native loop, which serves every native channel
+(``native/loop.py``): a fleet of robots costs no thread per topic. The native loop reads and
+publishes the messages itself and runs :meth:`SubscriptionReader.native_turn` only for what it
+hands back and for the reader's own share (connections, posted commands, intra-process
+messages).
 
 The newest ``size`` messages (and at most ``max_bytes`` of them) wait in the transport's one
 :class:`~ros_gz_bridge_py.transport.delivery.DropOldestQueue`; the socket is drained between
@@ -62,18 +67,12 @@ COPY_BELOW = 64 * 1024
 INFO_CACHE_SIZE = 1024
 #: Longest time one delivery run goes on before the socket is drained again (s).
 DELIVERY_SLICE = 0.001
-#: Longest poll while idle (s). A close or a posted command wakes the reader at once; this
-#: bounds how stale the counters of a native loop get while messages flow.
+#: Longest poll while idle (s). A close or a posted command wakes the reader at once.
 IDLE_POLL = 0.25
-#: Longest poll of a native loop whose last turn took no message: nothing to count, and 132
-#: idle channels turning four times a second cost an idle bridge about 5% of a core.
-QUIET_POLL = 1.0
 #: Messages read from the socket per drain, so a flood cannot hold the thread in reading.
 READ_BATCH = 256
 #: ``zmq.POLLIN`` as a plain int: ``&`` with the enum runs Python code (enum.Flag.__and__).
 _POLLIN = int(zmq.POLLIN)
-#: What a native loop's run returns for: the wake-up socket, the connection monitor.
-_WAKE, _MONITOR = 1, 2
 #: What a message's (topic, sender, type) frames make of it: what the callback is told, a
 #: rejection (reason, detail), or None (another topic's).
 Verdict = MessageInfo | tuple[Rejection, str] | None
@@ -103,7 +102,6 @@ class SubscriptionReader:
         self._received = 0
         self._native = native
         self._native_dropped = 0
-        self._quiet = False  # the native loop's last turn took no message
         self._partition = partition
         self._name = (decompose(fqn) or ("", fqn))[1]
         self._topic_frame = fqn.encode()
@@ -121,15 +119,19 @@ class SubscriptionReader:
         self._infos: dict[tuple[Frame, Frame, Frame], Verdict] = {}
         self._posted: collections.deque[Callable[[], object]] = collections.deque()
         self._closed = False
-        self._wake_r, self._wake_w = socket.socketpair()
-        self._wake_r.setblocking(False)
-        self._wake_fd = self._wake_r.fileno()
-        self._wake_w.setblocking(False)
         self._sock = subscriber_socket(context, settings)
         self._sock.setsockopt(zmq.SUBSCRIBE, fqn.encode())
         self._connections = SubConnections(
             self._sock, drain=self._drain, on_refused=self._refused, count=count, what=fqn
         )
+        self._thread: threading.Thread | None = None
+        if native is not None:
+            native.attach(self._sock.underlying, self._connections.monitor.underlying, self)
+            return
+        self._wake_r, self._wake_w = socket.socketpair()
+        self._wake_r.setblocking(False)
+        self._wake_fd = self._wake_r.fileno()
+        self._wake_w.setblocking(False)
         self._thread = threading.Thread(target=self._run, name=f"gz-sub {self._name}", daemon=True)
         self._thread.start()
 
@@ -168,7 +170,12 @@ class SubscriptionReader:
         if self._closed:
             return
         self._closed = True
+        if self._native is not None:
+            self._native.detach()
+            self._release()
+            return
         self._wake()
+        assert self._thread is not None  # a reader without a native loop has its own
         if self._thread is not threading.current_thread():
             self._thread.join()
 
@@ -178,8 +185,15 @@ class SubscriptionReader:
             self._wake()
 
     def _wake(self) -> None:
+        if self._native is not None:
+            self._native.wake()
+            return
         with contextlib.suppress(OSError):
             self._wake_w.send(b"\0")
+
+    def _release(self) -> None:
+        self._connections.close()
+        self._sock.close(linger=0)
 
     # --- the reader thread ------------------------------------------------------------------
 
@@ -187,52 +201,54 @@ class SubscriptionReader:
         try:
             if self._on_start is not None:
                 self._on_start()
-            if self._native is not None:
-                self._native.forget()
-                poll = self._native_poll(self._native)
-            else:
-                poller = zmq.Poller()
-                poller.register(self._sock, zmq.POLLIN)
-                poller.register(self._wake_r.fileno(), zmq.POLLIN)
-                poller.register(self._connections.monitor, zmq.POLLIN)
-                poll = lambda timeout: dict(poller.poll(timeout))  # noqa: E731
+            poller = zmq.Poller()
+            poller.register(self._sock, zmq.POLLIN)
+            poller.register(self._wake_r.fileno(), zmq.POLLIN)
+            poller.register(self._connections.monitor, zmq.POLLIN)
             while not self._closed:
                 try:
-                    self._turn(poll(self._poll_timeout()))
+                    self._turn(dict(poller.poll(self._poll_timeout())))
                 except zmq.ContextTerminated:  # the node went away without closing us
                     return
                 except Exception:  # the reader must survive anything, as the I/O thread does
                     self._count("io_errors")
                     _LOG.exception("unexpected error reading %s", self.fqn)
         finally:
-            self._connections.close()
-            self._sock.close(linger=0)
+            self._release()
             self._wake_r.close()
             self._wake_w.close()
 
-    def _native_poll(self, native: NativeLoop) -> Callable[[int], dict[Any, int]]:
-        """A poll that lets ``native`` read and deliver the socket's messages while it waits:
-        it returns what else is ready (the wake-up socket, the monitor), after judging the
-        messages the loop handed back (those of a sender and type it was not told about)."""
-        sock = self._sock.underlying
-        monitor = self._connections.monitor
-        address = monitor.underlying
+    # --- the native loop's thread -----------------------------------------------------------
 
-        def poll(timeout: int) -> dict[Any, int]:
-            events, unrouted = native.run(sock, self._wake_fd, address, timeout)
-            self._quiet = not native.took
-            for frames in unrouted:
-                self._judge_for(native, frames)
-            dropped = native.dropped - self._native_dropped
-            if dropped:
-                self._native_dropped += dropped
-                self._count("messages_dropped", dropped)
-            ready = {self._wake_fd: _POLLIN} if events & _WAKE else {}
-            if events & _MONITOR:
-                ready[monitor] = _POLLIN
-            return ready
-
-        return poll
+    def native_turn(
+        self, unrouted: list[list[Frame]], *, monitor: bool, broken: bool
+    ) -> float | None:
+        """The reader's share of a native channel's work (``NativeHost``): posted commands,
+        the frames the loop had no route for, the connections, the messages queued here."""
+        native = self._native
+        if self._closed or native is None:
+            return None
+        if broken:  # the node went away without closing us
+            self._count("io_errors")
+            _LOG.warning("the socket of %s cannot be read any more; it is no longer read", self.fqn)
+            native.detach()
+            return None
+        while self._posted:
+            self._posted.popleft()()
+        for frames in unrouted:
+            self._judge_for(native, frames)
+        dropped = native.dropped - self._native_dropped
+        if dropped:
+            self._native_dropped += dropped
+            self._count("messages_dropped", dropped)
+        now = time.monotonic()
+        connections = self._connections
+        if monitor or connections.is_due(now):
+            connections.turn()
+        self._deliver_pending()
+        if len(self._pending):
+            return now  # more to deliver: again at once
+        return connections.next_deadline()
 
     def _judge_for(self, native: NativeLoop, frames: list[Frame]) -> None:
         """A message the native loop had no route for: judged here (the Python reference),
@@ -248,11 +264,10 @@ class SubscriptionReader:
 
     def _poll_timeout(self) -> int:
         """Milliseconds to wait: none with messages pending, else until the connections
-        have something to do, at most IDLE_POLL (QUIET_POLL after a native turn that took
-        nothing)."""
+        have something to do, at most IDLE_POLL."""
         if len(self._pending):
             return 0
-        wait = QUIET_POLL if self._quiet else IDLE_POLL
+        wait = IDLE_POLL
         deadline = self._connections.next_deadline()
         if deadline is not None:
             wait = min(wait, max(0.0, deadline - time.monotonic()))

@@ -1,0 +1,95 @@
+"""Every native Gazebo -> ROS channel of a bridge runs on one loop (docs/native.md §5).
+
+A fleet in one process: the bridge's thread count must not grow with its native channels, every
+channel's messages must flow, and a flooded channel must not starve a light one. The Gazebo side
+is the C++ Fortress peer (one process publishing many topics, as a simulator does); the ROS side
+an rclpy node of this process; the bridge a real ``parameter_bridge`` process.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from std_msgs.msg import String
+
+from ros_gz_bridge_py.native import extension
+from tests.bridge.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge, started
+from tests.gzpeer import PeerProcess, require_peer, start_peer, unique_name, wait_until
+
+__all__ = ["ros_side", "started"]
+
+pytestmark = [pytest.mark.ros, pytest.mark.peer, pytest.mark.slow]
+
+#: Channels of the small bridge and of the large one.
+SMALL, LARGE = 2, 32
+#: Messages the light topic publishes beside the flood, and the share that must arrive.
+LIGHT_COUNT, LIGHT_SHARE = 100, 0.9
+#: What the flood sends, as fast as the peer can.
+FLOOD_TEXT = "x" * 2000
+
+
+def threads_of(process: PeerProcess) -> int:
+    for line in Path(f"/proc/{process.pid}/status").read_text().splitlines():
+        if line.startswith("Threads:"):
+            return int(line.split()[1])
+    msg = "no Threads line"
+    raise AssertionError(msg)
+
+
+def bridge_of(topics: list[str], started: list[PeerProcess]) -> PeerProcess:
+    bridge = start_bridge(
+        *(f"{topic}@std_msgs/msg/String[{STRING}" for topic in topics), creating=len(topics)
+    )
+    started.append(bridge)
+    return bridge
+
+
+def flowing(ros_side: RosSide, topics: list[str]) -> None:
+    """Wait until every topic's messages reach the ROS side, with the peer's text."""
+    inboxes = [ros_side.subscribe(String, topic)[0] for topic in topics]
+    for topic, inbox in zip(topics, inboxes, strict=True):
+        items = inbox.wait_for_count(3, WAIT * 2)
+        assert items[-1][0].data == "fleet", f"{topic} carried {items[-1][0].data!r}"
+
+
+def test_the_thread_count_does_not_grow_with_native_channels(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    if extension() is None:
+        pytest.skip("the native extension is not built here")
+    base = unique_name("fleet")
+    topics = [f"{base}_{i}" for i in range(LARGE)]
+    started.append(start_peer("pub-many", STRING, "50", 'data: "fleet"', *topics))
+    small = bridge_of(topics[:SMALL], started)
+    large = bridge_of(topics[SMALL:], started)
+    flowing(ros_side, topics)
+    small_threads, large_threads = threads_of(small), threads_of(large)
+    # One native loop for all: 30 channels cost no thread of their own (a thread per channel
+    # gave the large bridge 30 more).
+    assert large_threads <= small_threads + 2, (small_threads, large_threads)
+
+
+def test_a_flooded_channel_does_not_starve_a_light_one(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    require_peer()
+    if extension() is None:
+        pytest.skip("the native extension is not built here")
+    flood, light = unique_name("flood"), unique_name("light")
+    bridge_of([flood, light], started)
+    started.append(
+        start_peer("pub", flood, STRING, "100000", "0", f'data: "{FLOOD_TEXT}"', "--wait", "0")
+    )
+    inbox = ros_side.subscribe(String, light, 1000)[0]
+    wait_until(lambda: ros_side.count_publishers(light) >= 1, WAIT, "the bridge's publisher")
+    started.append(
+        start_peer(
+            "pub", light, STRING, "100", str(LIGHT_COUNT), 'data: "light"', "--wait", str(WAIT)
+        )
+    )
+    inbox.holds_within(lambda items: len(items) >= LIGHT_COUNT, WAIT * 2)
+    received = [message.data for message, _ in inbox.items()]
+    assert set(received) <= {"light"}
+    assert len(received) >= LIGHT_SHARE * LIGHT_COUNT, len(received)
