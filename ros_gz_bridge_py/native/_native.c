@@ -27,6 +27,11 @@ static void program_dealloc(ProgramObject *self) {
 static int program_init(ProgramObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"schema", "ops", NULL};
     Py_buffer schema, ops;
+    /* A pump may be reading the words with the GIL released: they are never replaced. */
+    if (self->words != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "a Program is loaded once; make a new Program");
+        return -1;
+    }
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*y*", keywords, &schema, &ops)) return -1;
     int result = -1;
     if (schema.len % 4 || ops.len % 4) {
@@ -47,7 +52,6 @@ static int program_init(ProgramObject *self, PyObject *args, PyObject *kwds) {
         PyErr_Format(PyExc_ValueError, "not a native program: %s", why);
         goto done;
     }
-    PyMem_Free(self->words);
     self->words = words;
     result = 0;
 done:
@@ -102,6 +106,11 @@ static void encoder_dealloc(EncoderObject *self) {
 static int encoder_init(EncoderObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"words", NULL};
     Py_buffer words;
+    /* A loop may be reading the words with the GIL released: they are never replaced. */
+    if (self->words != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "an Encoder is loaded once; make a new Encoder");
+        return -1;
+    }
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*", keywords, &words)) return -1;
     int result = -1;
     if (words.len % 4) {
@@ -120,7 +129,6 @@ static int encoder_init(EncoderObject *self, PyObject *args, PyObject *kwds) {
         PyErr_Format(PyExc_ValueError, "not a native encoder: %s", why);
         goto done;
     }
-    PyMem_Free(self->words);
     self->words = copy;
     result = 0;
 done:
