@@ -6,6 +6,7 @@
  * RosPump: the per-message loop of one ROS -> Gazebo channel (ros_pump.c). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <structmember.h>
 
 #include "encode.h"
 #include "pump.h"
@@ -16,6 +17,7 @@ typedef struct {
     struct rgb_program program;
     int32_t *words; /* schema then ops, owned */
     struct rgb_out out;
+    Py_ssize_t steps; /* fields the last to_cdr read: its work, for the tests */
 } ProgramObject;
 
 static void program_dealloc(ProgramObject *self) {
@@ -68,17 +70,30 @@ static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
     }
     Py_buffer payload;
     if (PyObject_GetBuffer(arg, &payload, PyBUF_SIMPLE)) return NULL;
-    enum rgb_status status =
-        rgb_to_cdr(&self->program, payload.buf, (size_t)payload.len, &self->out);
+    size_t steps = 0;
+    enum rgb_status status = rgb_to_cdr_counted(&self->program, payload.buf, (size_t)payload.len,
+                                                &self->out, &steps);
     PyBuffer_Release(&payload);
-    if (status != RGB_OK) return Py_BuildValue("(iO)", (int)status, Py_None);
-    return Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
+    self->steps = steps > PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)steps;
+    PyObject *result;
+    if (status != RGB_OK)
+        result = Py_BuildValue("(iO)", (int)status, Py_None);
+    else
+        result = Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
+    rgb_out_trim(&self->out);
+    return result;
 }
 
 static PyMethodDef program_methods[] = {
     {"to_cdr", (PyCFunction)program_to_cdr, METH_O,
      "to_cdr(payload) -> (status, cdr or None): 0 ok, 1 undecodable, 2 conversion, 3 fallback"},
     {NULL, NULL, 0, NULL},
+};
+
+static PyMemberDef program_members[] = {
+    {"steps", T_PYSSIZET, offsetof(ProgramObject, steps), READONLY,
+     "the protobuf fields the last to_cdr read (its work)"},
+    {NULL, 0, 0, 0, NULL},
 };
 
 static PyTypeObject ProgramType = {
@@ -90,6 +105,7 @@ static PyTypeObject ProgramType = {
     .tp_init = (initproc)program_init,
     .tp_dealloc = (destructor)program_dealloc,
     .tp_methods = program_methods,
+    .tp_members = program_members,
 };
 
 typedef struct {
@@ -145,7 +161,7 @@ static PyObject *encoder_to_pb(EncoderObject *self, PyObject *arg) {
     }
     Py_buffer cdr;
     if (PyObject_GetBuffer(arg, &cdr, PyBUF_SIMPLE)) return NULL;
-    struct rgb_out out = {NULL, 0, 0};
+    struct rgb_out out = {NULL, 0, 0, 0, NULL, 0};
     enum rgb_status status = rgb_to_pb(&self->encoder, cdr.buf, (size_t)cdr.len, &out);
     PyBuffer_Release(&cdr);
     PyObject *result;

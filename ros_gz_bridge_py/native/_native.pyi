@@ -3,6 +3,8 @@
 class Program:
     """One pair's Gazebo -> ROS transcoder (docs/native.md §3)."""
 
+    #: The protobuf fields the last ``to_cdr`` read (its work).
+    steps: int
     def __init__(self, schema: bytes, ops: bytes) -> None: ...
     def to_cdr(self, payload: bytes | bytearray | memoryview, /) -> tuple[int, bytes | None]: ...
 
