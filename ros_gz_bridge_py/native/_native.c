@@ -96,6 +96,17 @@ static PyMemberDef program_members[] = {
     {NULL, 0, 0, 0, NULL},
 };
 
+static PyObject *program_kept_bytes(ProgramObject *self, void *closure) {
+    (void)closure;
+    return PyLong_FromSize_t(self->out.cap + self->out.scratch_cap);
+}
+
+static PyGetSetDef program_getset[] = {
+    {"kept_bytes", (getter)program_kept_bytes, NULL,
+     "the bytes of output buffer and scratch kept for the next to_cdr", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
 static PyTypeObject ProgramType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.Program",
     .tp_basicsize = sizeof(ProgramObject),
@@ -106,6 +117,7 @@ static PyTypeObject ProgramType = {
     .tp_dealloc = (destructor)program_dealloc,
     .tp_methods = program_methods,
     .tp_members = program_members,
+    .tp_getset = program_getset,
 };
 
 typedef struct {

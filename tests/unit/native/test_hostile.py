@@ -124,3 +124,15 @@ def test_every_distinctive_message_is_within_the_bound() -> None:
         assert status == OK
         assert cdr is not None
         assert len(cdr) <= OUTPUT_FLOOR // 4 + OUTPUT_RATIO // 4 * len(payload), pair
+
+
+def test_a_large_output_does_not_keep_its_buffer() -> None:
+    transcoder = _pair("tf2_msgs/msg/TFMessage", "gz.msgs.Pose_V")
+    pose = distinctive("gz.msgs.Pose_V").pose[0].SerializeToString()
+    status, cdr = transcoder.program.to_cdr(gzp.length_delimited(2, pose) * 20_000)
+    assert status == OK
+    assert cdr is not None
+    assert len(cdr) > 2 * 2**20
+    assert transcoder.program.kept_bytes <= 2**20
+    assert transcoder.program.to_cdr(gzp.length_delimited(2, pose))[0] == OK
+    assert 0 < transcoder.program.kept_bytes <= 2**20
