@@ -7,6 +7,8 @@ would free words a running loop reads: ``__init__`` runs once.
 
 from __future__ import annotations
 
+import copy
+import pickle
 import shutil
 import subprocess
 from pathlib import Path
@@ -69,3 +71,20 @@ def test_the_extension_is_built_hardened_without_libdl(native: Any) -> None:
     undefined = {line.split()[-1].split("@")[0] for line in symbols.stdout.splitlines()}
     assert "__stack_chk_fail" in undefined  # -fstack-protector-strong
     assert not {name for name in undefined if name.startswith("dl")}
+
+
+def test_copies_odd_buffers_and_attribute_writes_are_refused(native: Any) -> None:
+    schema, ops = _program_words()
+    program = native.Program(schema, ops)
+    for copy_of in (copy.copy, copy.deepcopy, pickle.dumps):
+        with pytest.raises(TypeError):
+            copy_of(program)
+    with pytest.raises(TypeError):
+        program.to_cdr(None)
+    with pytest.raises(BufferError):
+        program.to_cdr(memoryview(b"abcd")[::2])
+    with pytest.raises(AttributeError):
+        program.steps = 0
+    with pytest.raises(AttributeError):
+        program.kept_bytes = 0
+    assert program.to_cdr(bytearray())[0] == 0
