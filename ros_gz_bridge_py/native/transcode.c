@@ -2,7 +2,9 @@
  *
  * Every payload byte is untrusted: each read is checked against the end of its view before it
  * is made, lengths are compared with what remains before they are used, and the output grows
- * only by what the program writes for data that is there (with a hard cap). A payload is
+ * only by what the program writes for data that is there, up to a bound proportional to the
+ * payload (output_limit). The work is linear in the payload too: each message the ops read is
+ * scanned once into an index (struct node) that every op reads from. A payload is
  * first validated against the whole schema, as the Python protobuf runtime does when it
  * parses (UTF-8 of every string field, every nested message), so that what this code accepts
  * the Python path accepts too; anything it is not sure about is left to Python

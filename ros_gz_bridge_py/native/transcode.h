@@ -1,9 +1,10 @@
 /* The native transcoder: Gazebo protobuf payloads to ROS CDR, driven by a program.
  *
- * Sans-IO: no Python, no sockets, no allocation outside the output buffer. The Python side
- * (program.py) compiles each pair's declaration into two arrays of int32 words, a schema of
- * the Gazebo message types (docs/native.md §2) and a program of ROS fields in wire order
- * (§3); rgb_load checks both once, and rgb_to_cdr runs them on untrusted payloads. */
+ * Sans-IO: no Python, no sockets, no allocation outside the output buffer (and its scratch,
+ * the index of the messages read). The Python side (program.py) compiles each pair's
+ * declaration into two arrays of int32 words, a schema of the Gazebo message types
+ * (docs/native.md §2) and a program of ROS fields in wire order (§3); rgb_load checks both
+ * once, and rgb_to_cdr runs them on untrusted payloads. */
 #ifndef RGB_TRANSCODE_H
 #define RGB_TRANSCODE_H
 
