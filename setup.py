@@ -30,8 +30,18 @@ setup(
                 "ros_gz_bridge_py/native/transcode.h",
                 "ros_gz_bridge_py/native/wire.h",
             ],
-            extra_compile_args=["-O2", "-std=gnu11", "-Wall", "-Wextra", "-fvisibility=hidden"],
-            libraries=["dl"],
+            extra_compile_args=[
+                "-O2",
+                "-std=gnu11",
+                "-Wall",
+                "-Wextra",
+                "-fvisibility=hidden",
+                # The extension parses network input: canaries on every frame with arrays, and
+                # glibc's checked memcpy/memset where sizes are known (needs -O1 or more).
+                "-fstack-protector-strong",
+                "-U_FORTIFY_SOURCE",
+                "-D_FORTIFY_SOURCE=2",
+            ],
             optional=True,
         )
     ]

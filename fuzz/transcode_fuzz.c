@@ -10,14 +10,16 @@
  *   0xc0-0xff  mutate: byte 1 picks a program, byte 2 (modulo 9) is a count of edits of 6
  *              bytes each (a word index, modulo the program's words, and the word's new value),
  *              the rest is a payload; when rgb_load accepts the edited words, they run on it.
- * Every status is legal; what is checked is that the code stays in bounds, defined, and that
- * an RGB_OK output starts with the CDR header. */
+ * Every status is legal; what is checked is that the code stays in bounds, defined, that an
+ * RGB_OK output starts with the CDR header and keeps within the output bound, and that a
+ * compiled program reads at most 8 fields a payload byte (its work stays linear). */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "programs.h"
 #include "transcode.h"
+#include "wire.h"
 
 #define MAX_WORDS 4096
 #define MAX_EDITS 8
@@ -25,10 +27,15 @@
 static struct rgb_program loaded[PROGRAM_COUNT];
 static struct rgb_out out;
 
-static void transcode(const struct rgb_program *program, const uint8_t *payload, size_t n) {
-    enum rgb_status status = rgb_to_cdr(program, payload, n, &out);
+/* Returns the fields read (rgb_to_cdr_counted). */
+static size_t transcode(const struct rgb_program *program, const uint8_t *payload, size_t n) {
+    size_t steps = 0;
+    enum rgb_status status = rgb_to_cdr_counted(program, payload, n, &out, &steps);
     if (status > RGB_FALLBACK) abort();
     if (status == RGB_OK && (out.len < 4 || memcmp(out.data, "\0\1\0\0", 4) != 0)) abort();
+    /* the output bound (wire.h) */
+    if (status == RGB_OK && out.len > RGB_OUTPUT_FLOOR + RGB_OUTPUT_RATIO * n) abort();
+    return steps;
 }
 
 /* Loads the words (a copy of exactly their length, so that ASan sees any read past them) and
@@ -92,7 +99,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                 abort(); /* every compiled program loads */
         }
         /* libFuzzer's buffer ends where the input does: a read past the payload is caught. */
-        transcode(&loaded[i], data + 1, size - 1);
+        size_t steps = transcode(&loaded[i], data + 1, size - 1);
+        /* A compiled program's work is linear in the payload: a field takes 2 bytes or more,
+         * and is read by validation, the index, and a few ops that go through a repeated
+         * field's elements (docs/native.md §4). */
+        if (steps > 8 * size + 64) abort();
     } else if (!(data[0] & 0x40)) {
         load_mode(data + 1, size - 1);
     } else {

@@ -7,8 +7,9 @@ Usage::
 
 writes ``OUT_DIR/programs.h``, the words of every pair whose program compiles
 (``compile_to_ros``) as C arrays, and ``OUT_DIR/corpus/``, the seed inputs: per program, its
-index byte then a valid payload (empty, and a message with every field set,
-:func:`distinctive`); and one seed of each program-loading mode (the fuzz target's comment
+index byte then a valid payload (empty, a message with every field set, :func:`distinctive`,
+and the same shaped to cost: wrapped in small unknown fields, or followed by thousands of
+empty elements); and one seed of each program-loading mode (the fuzz target's comment
 says how an input is read). With ``--target encode``, the same for the ROS -> Gazebo encoders
 (``compile_to_gz``): ``OUT_DIR/encoders.h``, and seeds of CDR messages (the default message,
 and one with every field set, :func:`distinctive_ros`). Both are build products under
@@ -235,7 +236,35 @@ def seeds(programs: Sequence[tuple[Pair, Compiled]]) -> dict[str, bytes]:
         found[f"load{i:02d}"] = bytes([LOAD_MODE]) + split + words
         # Mutate mode: program i, no edit (the edit count byte is 0), then the payload.
         found[f"mutate{i:02d}"] = bytes([MUTATE_MODE, i, 0]) + payload
+        for name, hostile in _hostile_payloads(pair.gz_type, payload).items():
+            found[f"program{i:02d}-{name}"] = bytes([i]) + hostile
     return found
+
+
+#: A small unknown field (number 2000, a one-byte varint), the filler of costly payloads.
+_JUNK_FIELD = bytes([0x80, 0x7D, 0x01])
+
+
+def _hostile_payloads(gz_type: str, payload: bytes) -> dict[str, bytes]:
+    """Payloads shaped to cost (docs/native.md §4): many small unknown fields around a message,
+    and per repeated submessage field, thousands of empty elements (an output many times the
+    payload, which the transcoder refuses)."""
+    junk = _JUNK_FIELD * 2000
+    found = {"unknown": junk + payload + junk}
+    for field in message_class(gz_type).DESCRIPTOR.fields:
+        if field.message_type is not None and field.is_repeated:
+            empty = _varint(field.number << 3 | 2) + b"\0"
+            found[f"empty-{field.name}"] = payload + empty * 4000
+    return found
+
+
+def _varint(value: int) -> bytes:
+    out = bytearray()
+    while value > 0x7F:
+        out.append(value & 0x7F | 0x80)
+        value >>= 7
+    out.append(value)
+    return bytes(out)
 
 
 def encoders_header_text(encoders: Sequence[tuple[Pair, bytes]]) -> str:

@@ -19,6 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from ros_gz_bridge_py.converters._limits import check_list, fill_bounded, least_item_bytes
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros.constructors import constructor
@@ -100,14 +101,19 @@ def fields(*entries: Entry) -> Fill:
 
 def each(fill: Fill, new_ros: Callable[[], Any]) -> Fill:
     """The Fill of a list of submessages: one gz element added per ROS item, and the ROS list
-    replaced by one new item (``new_ros()``) per gz element."""
+    replaced by one new item (``new_ros()``) per gz element, unless that list would be an
+    amplification (``_limits.check_list``: refused with a ConversionError)."""
     new_ros = _fast(new_ros)
+    measured: list[tuple[int, str]] = []  # an item's fewest CDR bytes and type, on first use
 
     def to_gz(ros_items: Any, gz_items: Any) -> None:
         for item in ros_items:
             fill.to_gz(item, gz_items.add())
 
     def to_ros(gz_items: Any, ros_items: Any) -> None:
+        if not measured:
+            measured.append((least_item_bytes(new_ros), type(new_ros()).__name__))
+        check_list(gz_items, *measured[0])
         ros_items[:] = [_filled(fill, element, new_ros()) for element in gz_items]
 
     return Fill(to_gz, to_ros, Each(fill, new_ros))
@@ -170,9 +176,25 @@ def converters(
         fill.to_ros(gz, ros)
         return ros
 
+    def to_ros_with_lists(gz: Any) -> Any:
+        ros = new_ros()
+        fill_bounded(fill.to_ros, gz, ros)  # its lists are bounded by gz's size
+        return ros
+
+    if _has_list(fill):
+        to_ros = to_ros_with_lists
     _DECLARED[to_ros] = (fill, new_ros)
     _DECLARED_TO_GZ[to_gz] = fill
     return to_gz, to_ros
+
+
+def _has_list(fill: Fill) -> bool:
+    """Whether the Fill converts a list of submessages (:func:`each`), at any depth."""
+    if isinstance(fill.shape, Each):
+        return True
+    if isinstance(fill.shape, Table):
+        return any(isinstance(how, Fill) and _has_list(how) for _ros, _gz, how in fill.shape.parts)
+    return False
 
 
 #: The Fill and ROS message maker behind each ``to_ros`` that :func:`converters` made.

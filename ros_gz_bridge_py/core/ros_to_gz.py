@@ -19,6 +19,7 @@ from ros_gz_bridge_py.bulk.path import ros_cdr_to_gz
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import Channel, ChannelContext, ChannelState
+from ros_gz_bridge_py.native.abi import rmw_layout_fits
 from ros_gz_bridge_py.native.channel import native_encoders
 from ros_gz_bridge_py.native.ros_pump import RosChannelPump, ros_functions
 from ros_gz_bridge_py.ros import light_reader
@@ -59,13 +60,14 @@ class RosToGzChannel(Channel):
         #: (docs/native.md §6): no light tree, converter or protobuf objects per message.
         self._encoders = native_encoders(layouts, ctx.options) if self._light else {}
         #: Whether a native loop takes the messages, encodes and sends them itself
-        #: (docs/native.md §7): where the encoders are, and the backend gives publishers a
-        #: socket of their own.
+        #: (docs/native.md §7): where the encoders are, the backend gives publishers a
+        #: socket of their own, and the loaded rmw lays out what the loop declares.
         self._native_loop = (
             bool(self._encoders)
             and ctx.gz_node.runs_native_loops
             and ctx.options.rcl_serialized_publish
             and ros_functions() is not None
+            and rmw_layout_fits()
         )
         self._pump: RosChannelPump | None = None
         self._subscription: Any = None

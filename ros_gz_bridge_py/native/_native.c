@@ -6,6 +6,7 @@
  * RosPump: the per-message loop of one ROS -> Gazebo channel (ros_pump.c). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <structmember.h>
 
 #include "encode.h"
 #include "pump.h"
@@ -16,6 +17,7 @@ typedef struct {
     struct rgb_program program;
     int32_t *words; /* schema then ops, owned */
     struct rgb_out out;
+    Py_ssize_t steps; /* fields the last to_cdr read: its work, for the tests */
 } ProgramObject;
 
 static void program_dealloc(ProgramObject *self) {
@@ -27,6 +29,11 @@ static void program_dealloc(ProgramObject *self) {
 static int program_init(ProgramObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"schema", "ops", NULL};
     Py_buffer schema, ops;
+    /* A pump may be reading the words with the GIL released: they are never replaced. */
+    if (self->words != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "a Program is loaded once; make a new Program");
+        return -1;
+    }
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*y*", keywords, &schema, &ops)) return -1;
     int result = -1;
     if (schema.len % 4 || ops.len % 4) {
@@ -47,7 +54,6 @@ static int program_init(ProgramObject *self, PyObject *args, PyObject *kwds) {
         PyErr_Format(PyExc_ValueError, "not a native program: %s", why);
         goto done;
     }
-    PyMem_Free(self->words);
     self->words = words;
     result = 0;
 done:
@@ -64,17 +70,41 @@ static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
     }
     Py_buffer payload;
     if (PyObject_GetBuffer(arg, &payload, PyBUF_SIMPLE)) return NULL;
-    enum rgb_status status =
-        rgb_to_cdr(&self->program, payload.buf, (size_t)payload.len, &self->out);
+    size_t steps = 0;
+    enum rgb_status status = rgb_to_cdr_counted(&self->program, payload.buf, (size_t)payload.len,
+                                                &self->out, &steps);
     PyBuffer_Release(&payload);
-    if (status != RGB_OK) return Py_BuildValue("(iO)", (int)status, Py_None);
-    return Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
+    self->steps = steps > PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)steps;
+    PyObject *result;
+    if (status != RGB_OK)
+        result = Py_BuildValue("(iO)", (int)status, Py_None);
+    else
+        result = Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
+    rgb_out_trim(&self->out);
+    return result;
 }
 
 static PyMethodDef program_methods[] = {
     {"to_cdr", (PyCFunction)program_to_cdr, METH_O,
      "to_cdr(payload) -> (status, cdr or None): 0 ok, 1 undecodable, 2 conversion, 3 fallback"},
     {NULL, NULL, 0, NULL},
+};
+
+static PyMemberDef program_members[] = {
+    {"steps", T_PYSSIZET, offsetof(ProgramObject, steps), READONLY,
+     "the protobuf fields the last to_cdr read (its work)"},
+    {NULL, 0, 0, 0, NULL},
+};
+
+static PyObject *program_kept_bytes(ProgramObject *self, void *closure) {
+    (void)closure;
+    return PyLong_FromSize_t(self->out.cap + self->out.scratch_cap);
+}
+
+static PyGetSetDef program_getset[] = {
+    {"kept_bytes", (getter)program_kept_bytes, NULL,
+     "the bytes of output buffer and scratch kept for the next to_cdr", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
 };
 
 static PyTypeObject ProgramType = {
@@ -86,6 +116,8 @@ static PyTypeObject ProgramType = {
     .tp_init = (initproc)program_init,
     .tp_dealloc = (destructor)program_dealloc,
     .tp_methods = program_methods,
+    .tp_members = program_members,
+    .tp_getset = program_getset,
 };
 
 typedef struct {
@@ -102,6 +134,11 @@ static void encoder_dealloc(EncoderObject *self) {
 static int encoder_init(EncoderObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"words", NULL};
     Py_buffer words;
+    /* A loop may be reading the words with the GIL released: they are never replaced. */
+    if (self->words != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "an Encoder is loaded once; make a new Encoder");
+        return -1;
+    }
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*", keywords, &words)) return -1;
     int result = -1;
     if (words.len % 4) {
@@ -120,7 +157,6 @@ static int encoder_init(EncoderObject *self, PyObject *args, PyObject *kwds) {
         PyErr_Format(PyExc_ValueError, "not a native encoder: %s", why);
         goto done;
     }
-    PyMem_Free(self->words);
     self->words = copy;
     result = 0;
 done:
@@ -137,7 +173,7 @@ static PyObject *encoder_to_pb(EncoderObject *self, PyObject *arg) {
     }
     Py_buffer cdr;
     if (PyObject_GetBuffer(arg, &cdr, PyBUF_SIMPLE)) return NULL;
-    struct rgb_out out = {NULL, 0, 0};
+    struct rgb_out out = {NULL, 0, 0, 0, NULL, 0};
     enum rgb_status status = rgb_to_pb(&self->encoder, cdr.buf, (size_t)cdr.len, &out);
     PyBuffer_Release(&cdr);
     PyObject *result;

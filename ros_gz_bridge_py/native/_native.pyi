@@ -3,6 +3,10 @@
 class Program:
     """One pair's Gazebo -> ROS transcoder (docs/native.md §3)."""
 
+    #: The protobuf fields the last ``to_cdr`` read (its work).
+    steps: int
+    #: The bytes of output buffer and scratch kept for the next ``to_cdr``.
+    kept_bytes: int
     def __init__(self, schema: bytes, ops: bytes) -> None: ...
     def to_cdr(self, payload: bytes | bytearray | memoryview, /) -> tuple[int, bytes | None]: ...
 

@@ -16,6 +16,7 @@ from typing import Any
 
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.native import extension, unavailable_reason
+from ros_gz_bridge_py.native.abi import zmq_layout_fits
 from ros_gz_bridge_py.native.encoder import compile_to_gz
 from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
 from ros_gz_bridge_py.native.pump import foreign_functions, why_no_functions
@@ -71,13 +72,14 @@ def _extension_available() -> bool:
 
 @functools.cache
 def native_path_available() -> bool:
-    """Whether the extension and the functions it calls are there; logged once where not."""
+    """Whether the extension and the functions it calls are there, and libzmq lays out its
+    messages as the loop declares (native/abi.py); logged once where not."""
     if not _extension_available():
         return False
     if foreign_functions() is None:
         _LOG.warning("Every channel takes the Python path: %s", why_no_functions())
         return False
-    return True
+    return zmq_layout_fits()
 
 
 @functools.cache

@@ -547,7 +547,9 @@ static int write_message(const struct reader *r, const int32_t *op, const int32_
 
 enum rgb_status rgb_to_pb(const struct rgb_encoder *encoder, const uint8_t *cdr, size_t len,
                           struct rgb_out *out) {
+    rgb_trim(out); /* the last message's output is no longer used */
     out->len = 0;
+    out->limit = RGB_MAX_OUTPUT;
     if (len < 4 || cdr[0] != 0 || cdr[1] != 1) return RGB_FALLBACK; /* not little-endian CDR */
     struct reader r = {cdr, len, 4, NULL, 0, 0};
     size_t top;

@@ -2,7 +2,9 @@
  *
  * Every payload byte is untrusted: each read is checked against the end of its view before it
  * is made, lengths are compared with what remains before they are used, and the output grows
- * only by what the program writes for data that is there (with a hard cap). A payload is
+ * only by what the program writes for data that is there, up to a bound proportional to the
+ * payload (output_limit). The work is linear in the payload too: each message the ops read is
+ * scanned once into an index (struct node) that every op reads from. A payload is
  * first validated against the whole schema, as the Python protobuf runtime does when it
  * parses (UTF-8 of every string field, every nested message), so that what this code accepts
  * the Python path accepts too; anything it is not sure about is left to Python
@@ -78,9 +80,20 @@ struct field {
     struct view payload; /* WIRE_LEN: the bytes; WIRE_I32/I64: the 4 or 8 bytes */
 };
 
+/* What one rgb_to_cdr call works with: the program, the output, the index of the messages it
+ * reads (kept in out->scratch as a stack: each run of ops pops what it indexed) and the number
+ * of fields it read, its work (rgb_to_cdr_counted). */
+struct ctx {
+    const struct rgb_program *pr;
+    struct rgb_out *out;
+    size_t top;   /* bytes of out->scratch in use */
+    size_t steps; /* fields read */
+};
+
 /* Reads the field at *pos. Groups and odd tags are left to Python. */
-static int read_field(struct view v, size_t *pos, struct field *f) {
+static int read_field(struct ctx *c, struct view v, size_t *pos, struct field *f) {
     uint64_t tag;
+    c->steps++;
     size_t start = *pos;
     int status = read_varint(v, pos, &tag);
     if (status) return status;
@@ -126,14 +139,16 @@ static uint64_t le64(const uint8_t *p) { return (uint64_t)le32(p) | (uint64_t)le
 
 /* ---- the schema ---------------------------------------------------------------------------- */
 
-/* The field of message `msg` numbered `number`: its 4 words, or NULL when unknown. */
-static const int32_t *schema_field(const struct rgb_program *pr, int32_t msg, uint32_t number) {
-    const int32_t *m = pr->schema + pr->schema[1 + msg];
-    for (int32_t i = 0; i < m[0]; i++) {
-        const int32_t *f = m + 1 + 4 * i;
-        if ((uint32_t)f[0] == number) return f;
-    }
-    return NULL;
+/* The words of message type `msg`: its field count, then 4 words a field. */
+static const int32_t *message_words(const struct rgb_program *pr, int32_t msg) {
+    return pr->schema + pr->schema[1 + msg];
+}
+
+/* The index among message `m`'s fields of the one numbered `number`, or -1 when unknown. */
+static int field_index(const int32_t *m, uint32_t number) {
+    for (int32_t i = 0; i < m[0]; i++)
+        if ((uint32_t)m[1 + 4 * i] == number) return (int)i;
+    return -1;
 }
 
 /* Validates a packed run of scalars of `type`. */
@@ -153,18 +168,19 @@ static int validate_packed(struct view run, int32_t type) {
 }
 
 /* Validates message `v` of schema type `msg`, as the Python runtime's parse would. */
-static int validate(const struct rgb_program *pr, struct view v, int32_t msg, int depth) {
+static int validate(struct ctx *c, struct view v, int32_t msg, int depth) {
     if (depth > MAX_DEPTH) return RGB_FALLBACK;
-    const int32_t *m = pr->schema + pr->schema[1 + msg];
+    const int32_t *m = message_words(c->pr, msg);
     /* Singular submessages seen, to leave merged duplicates to Python (bit per field). */
     uint64_t seen = 0;
     size_t pos = 0;
     while (pos < v.n) {
         struct field f;
-        int status = read_field(v, &pos, &f);
+        int status = read_field(c, v, &pos, &f);
         if (status) return status;
-        const int32_t *sf = schema_field(pr, msg, f.number);
-        if (sf == NULL) continue; /* unknown: kept aside by the runtime, never an error */
+        int index = field_index(m, f.number);
+        if (index < 0) continue; /* unknown: kept aside by the runtime, never an error */
+        const int32_t *sf = m + 1 + 4 * index;
         int32_t type = sf[1], repeated = sf[2];
         int wire = rgb_wire_of(type);
         if (repeated && wire != WIRE_LEN && f.wire == WIRE_LEN) {
@@ -177,12 +193,11 @@ static int validate(const struct rgb_program *pr, struct view v, int32_t msg, in
             if (!rgb_utf8_valid(f.payload.p, f.payload.n)) return RGB_UNDECODABLE;
         } else if (type == PB_MESSAGE) {
             if (!repeated) {
-                int index = (int)(sf - (m + 1)) / 4;
                 uint64_t bit = index < 64 ? (uint64_t)1 << index : 0;
                 if (bit == 0 || (seen & bit)) return RGB_FALLBACK;
                 seen |= bit;
             }
-            status = validate(pr, f.payload, sf[3], depth + 1);
+            status = validate(c, f.payload, sf[3], depth + 1);
             if (status) return status;
         } else if (type == PB_GROUP) {
             return RGB_FALLBACK;
@@ -193,14 +208,15 @@ static int validate(const struct rgb_program *pr, struct view v, int32_t msg, in
 
 /* ---- finding values (in a validated message) --------------------------------------------- */
 
-/* The last occurrence of field `number` (a singular field: the one Python keeps); found 0
- * when absent. */
-static int find_last(struct view v, uint32_t number, struct field *out, int *found) {
+/* The last occurrence of field `number` (a singular field: the one Python keeps), found by
+ * scanning `v`; found 0 when absent. */
+static int find_last(struct ctx *c, struct view v, uint32_t number, struct field *out,
+                     int *found) {
     size_t pos = 0;
     *found = 0;
     while (pos < v.n) {
         struct field f;
-        int status = read_field(v, &pos, &f);
+        int status = read_field(c, v, &pos, &f);
         if (status) return status;
         if (f.number == number) {
             *out = f;
@@ -210,22 +226,135 @@ static int find_last(struct view v, uint32_t number, struct field *out, int *fou
     return 0;
 }
 
-/* The submessage reached through `steps` (an empty view where one is absent). */
-static int descend(struct view v, const int32_t *steps, int32_t nsteps, struct view *out) {
-    for (int32_t i = 0; i < nsteps; i++) {
+/* ---- the index: each message read by the ops is scanned once ------------------------------ */
+
+/* Ops read many fields of one message; scanning it for each would cost the ops times its size
+ * (an Odometry followed by a megabyte of small unknown fields took 60-72 ms). So a message of
+ * known type is scanned once into an index, which records per field of its schema type how
+ * many occurrences there are, where the first starts and the last ends, and the last (the
+ * value of a singular field); every op reads from it. */
+
+#define NO_NODE SIZE_MAX
+/* Most scratch bytes one payload may index; past them it is left to Python. Legitimate
+ * programs index a few nodes per level of nesting, each at most 64 slots. */
+#define MAX_SCRATCH ((size_t)64 << 20)
+
+struct slot {
+    size_t count;      /* occurrences of the field */
+    size_t first, end; /* where the first starts (its tag) and the last ends */
+    struct field last; /* the last occurrence */
+    size_t child;      /* the index of `last` as a submessage once built, else NO_NODE */
+};
+
+struct node {
+    int32_t msg;           /* schema type */
+    struct slot slots[];   /* one per field of the type, in schema order */
+};
+
+/* A message the ops read: its bytes, and its index where it has one (NO_NODE: a view whose
+ * type the schema does not give, e.g. reached through a path a damaged program names, read by
+ * scanning it). */
+struct at {
+    struct view v;
+    size_t node;
+};
+
+static struct node *node_at(struct ctx *c, size_t offset) {
+    return (struct node *)((uint8_t *)c->out->scratch + offset);
+}
+
+/* Reserves an index for a message of type `msg` on the scratch stack, its slots empty. */
+static int push_node(struct ctx *c, int32_t msg, size_t *offset) {
+    const int32_t *m = message_words(c->pr, msg);
+    size_t size = sizeof(struct node) + (size_t)m[0] * sizeof(struct slot);
+    if (size > MAX_SCRATCH - c->top) return RGB_FALLBACK;
+    size_t need = c->top + size;
+    if (need > c->out->scratch_cap) {
+        size_t cap = c->out->scratch_cap ? c->out->scratch_cap : 4096;
+        while (cap < need) cap *= 2;
+        void *data = realloc(c->out->scratch, cap);
+        if (data == NULL) return RGB_FALLBACK;
+        c->out->scratch = data;
+        c->out->scratch_cap = cap;
+    }
+    *offset = c->top;
+    c->top = need;
+    struct node *n = node_at(c, *offset);
+    n->msg = msg;
+    for (int32_t i = 0; i < m[0]; i++)
+        n->slots[i] = (struct slot){0, 0, 0, {0, 0, 0, {NULL, 0}}, NO_NODE};
+    return 0;
+}
+
+/* Indexes `v`, a validated message of schema type `msg`, in one scan. */
+static int index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset) {
+    int status = push_node(c, msg, offset);
+    if (status) return status;
+    const int32_t *m = message_words(c->pr, msg);
+    size_t pos = 0;
+    while (pos < v.n) {
+        size_t start = pos;
         struct field f;
-        int found, status = find_last(v, (uint32_t)steps[i], &f, &found);
+        status = read_field(c, v, &pos, &f);
+        if (status) return status;
+        int k = field_index(m, f.number);
+        if (k < 0) continue;
+        struct slot *s = &node_at(c, *offset)->slots[k];
+        if (s->count++ == 0) s->first = start;
+        s->end = pos;
+        s->last = f;
+    }
+    return 0;
+}
+
+/* The slot of field `number` in the index of `a` (with the field's schema words in *sf), or
+ * -1 where `a` has no index or its type no such field: then `a` is scanned. */
+static int slot_of(struct ctx *c, struct at a, uint32_t number, const int32_t **sf) {
+    if (a.node == NO_NODE) return -1;
+    const int32_t *m = message_words(c->pr, node_at(c, a.node)->msg);
+    int k = field_index(m, number);
+    if (k >= 0 && sf != NULL) *sf = m + 1 + 4 * k;
+    return k;
+}
+
+/* The last occurrence of field `number` in `a`; found 0 when absent. */
+static int last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, int *found) {
+    int k = slot_of(c, a, number, NULL);
+    if (k < 0) return find_last(c, a.v, number, out, found);
+    const struct slot *s = &node_at(c, a.node)->slots[k];
+    *found = s->count > 0;
+    if (*found) *out = s->last;
+    return 0;
+}
+
+/* The submessage reached through `steps` (an empty view where one is absent), indexed where
+ * the schema gives its type (each submessage once, however many ops read it). */
+static int descend(struct ctx *c, struct at a, const int32_t *steps, int32_t nsteps,
+                   struct at *out) {
+    for (int32_t i = 0; i < nsteps; i++) {
+        const int32_t *sf = NULL;
+        int k = slot_of(c, a, (uint32_t)steps[i], &sf);
+        struct field f;
+        int found, status = last_of(c, a, (uint32_t)steps[i], &f, &found);
         if (status) return status;
         if (!found) {
-            v.p = NULL;
-            v.n = 0;
-        } else if (f.wire != WIRE_LEN) {
-            return RGB_FALLBACK; /* not what the program expects here */
-        } else {
-            v = f.payload;
+            a = (struct at){{NULL, 0}, NO_NODE};
+            continue;
         }
+        if (f.wire != WIRE_LEN) return RGB_FALLBACK; /* not what the program expects here */
+        if (k < 0 || sf[1] != PB_MESSAGE) {
+            a = (struct at){f.payload, NO_NODE};
+            continue;
+        }
+        size_t child = node_at(c, a.node)->slots[k].child;
+        if (child == NO_NODE) {
+            status = index_message(c, f.payload, sf[3], &child);
+            if (status) return status;
+            node_at(c, a.node)->slots[k].child = child; /* the scratch may have moved */
+        }
+        a = (struct at){f.payload, child};
     }
-    *out = v;
+    *out = a;
     return 0;
 }
 
@@ -397,38 +526,45 @@ static int put_frame(struct rgb_out *out, struct view s) {
 
 /* ---- running a program ------------------------------------------------------------------- */
 
-static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *end,
-               struct view v, struct rgb_out *out);
+static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v);
 
-/* Reads the path at *op (count, then field numbers) and returns the view it reaches. */
-static int path(const int32_t **op, struct view v, struct view *out) {
+/* Reads the path at *op (count, then field numbers) and returns the message it reaches. */
+static int path(struct ctx *c, const int32_t **op, struct at v, struct at *out) {
     int32_t nsteps = (*op)[0];
-    int status = descend(v, *op + 1, nsteps, out);
+    int status = descend(c, v, *op + 1, nsteps, out);
     *op += 1 + nsteps;
     return status;
 }
 
 /* The value of singular scalar `number` of protobuf `type` in `v` (0 when absent). */
-static int scalar(struct view v, uint32_t number, int32_t type, struct value *val) {
+static int scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct value *val) {
     struct field f;
-    int found, status = find_last(v, number, &f, &found);
+    int found, status = last_of(c, v, number, &f, &found);
     if (status) return status;
     if (found && f.wire != rgb_wire_of(type)) return RGB_FALLBACK;
     *val = decode_scalar(type, &f, found ? raw_of(&f) : 0);
     return 0;
 }
 
-/* Calls `each(element)` for every element of repeated field `number` in `v`. */
+/* Calls `each(element)` for every element of repeated field `number` in `v`: with an index,
+ * from the first element to the last only. */
 typedef int (*element_fn)(void *ctx, const struct field *f);
 
-static int for_each(struct view v, uint32_t number, element_fn each, void *ctx) {
-    size_t pos = 0;
-    while (pos < v.n) {
+static int for_each(struct ctx *c, struct at v, uint32_t number, element_fn each, void *arg) {
+    size_t pos = 0, end = v.v.n;
+    int k = slot_of(c, v, number, NULL);
+    if (k >= 0) {
+        const struct slot *s = &node_at(c, v.node)->slots[k];
+        if (s->count == 0) return 0;
+        pos = s->first;
+        end = s->end;
+    }
+    while (pos < end) {
         struct field f;
-        int status = read_field(v, &pos, &f);
+        int status = read_field(c, v.v, &pos, &f);
         if (status) return status;
         if (f.number != number) continue;
-        status = each(ctx, &f);
+        status = each(arg, &f);
         if (status) return status;
     }
     return 0;
@@ -480,21 +616,46 @@ static int count_field(void *ctx, const struct field *f) {
     return 0;
 }
 
-/* The elements of a repeated submessage field, each run through a body of ops. */
+/* The number of occurrences of field `number` in `v`. */
+static int count_of(struct ctx *c, struct at v, uint32_t number, size_t *count) {
+    int k = slot_of(c, v, number, NULL);
+    if (k >= 0) {
+        *count = node_at(c, v.node)->slots[k].count;
+        return 0;
+    }
+    *count = 0;
+    return for_each(c, v, number, count_field, count);
+}
+
+/* The schema type of the elements of message field `number` of `v`, or -1 where unknown. */
+static int32_t element_type(struct ctx *c, struct at v, uint32_t number) {
+    const int32_t *sf = NULL;
+    if (slot_of(c, v, number, &sf) < 0 || sf[1] != PB_MESSAGE) return -1;
+    return sf[3];
+}
+
+/* The elements of a repeated submessage field, each indexed (when its type is known) and run
+ * through a body of ops; the element's index is popped after. */
 struct messages {
-    const struct rgb_program *pr;
+    struct ctx *c;
     const int32_t *body, *body_end;
-    struct rgb_out *out;
+    int32_t type;
 };
 
 static int message_element(void *ctx, const struct field *f) {
     struct messages *m = ctx;
     if (f->wire != WIRE_LEN) return RGB_FALLBACK;
-    return run(m->pr, m->body, m->body_end, f->payload, m->out);
+    size_t mark = m->c->top;
+    struct at element = {f->payload, NO_NODE};
+    int status = m->type >= 0 ? index_message(m->c, f->payload, m->type, &element.node) : 0;
+    if (!status) status = run(m->c, m->body, m->body_end, element);
+    m->c->top = mark;
+    return status;
 }
 
 /* One scalar (or string) of each element of a repeated submessage field: a column. */
 struct column {
+    struct ctx *c;
     const int32_t *steps;
     int32_t nsteps;
     uint32_t number;
@@ -504,20 +665,21 @@ struct column {
 
 static int column_element(void *ctx, const struct field *f) {
     struct column *c = ctx;
-    struct view element;
+    struct at element;
     if (f->wire != WIRE_LEN) return RGB_FALLBACK;
-    int status = descend(f->payload, c->steps, c->nsteps, &element);
+    /* each element is read by one op only: scanned, not indexed */
+    int status = descend(c->c, (struct at){f->payload, NO_NODE}, c->steps, c->nsteps, &element);
     if (status) return status;
     if (c->kind == 0) {
         struct field s;
         int found;
-        status = find_last(element, c->number, &s, &found);
+        status = find_last(c->c, element.v, c->number, &s, &found);
         if (status) return status;
         if (found && s.wire != WIRE_LEN) return RGB_FALLBACK;
         return found ? put_string(c->out, s.payload.p, s.payload.n) : put_string(c->out, NULL, 0);
     }
     struct value val;
-    status = scalar(element, c->number, c->type, &val);
+    status = scalar(c->c, element, c->number, c->type, &val);
     if (status) return status;
     return put_value(c->out, c->kind, CONV_EXACT, val);
 }
@@ -534,6 +696,7 @@ static int sequence_start(struct rgb_out *out, size_t count, size_t element_size
 /* A Header's value for `key` (docs/native.md §3): the first or last `data` entry whose key is
  * `key` and that has a value; its first value. */
 struct header_lookup {
+    struct ctx *c;
     const uint8_t *key;
     size_t key_len;
     int last;
@@ -546,7 +709,7 @@ static int header_entry(void *ctx, const struct field *f) {
     if (h->found && !h->last) return 0;
     if (f->wire != WIRE_LEN) return RGB_FALLBACK; /* f->payload is only set for WIRE_LEN */
     struct field key, value;
-    int found_key, status = find_last(f->payload, 1, &key, &found_key);
+    int found_key, status = find_last(h->c, f->payload, 1, &key, &found_key);
     if (status) return status;
     if (found_key && key.wire != WIRE_LEN) return RGB_FALLBACK;
     struct view key_bytes = found_key ? key.payload : (struct view){NULL, 0};
@@ -555,7 +718,7 @@ static int header_entry(void *ctx, const struct field *f) {
     /* value[0]: the first occurrence of field 2 */
     size_t pos = 0;
     while (pos < f->payload.n) {
-        status = read_field(f->payload, &pos, &value);
+        status = read_field(h->c, f->payload, &pos, &value);
         if (status) return status;
         if (value.number == 2) {
             if (value.wire != WIRE_LEN) return RGB_FALLBACK;
@@ -570,18 +733,18 @@ static int header_entry(void *ctx, const struct field *f) {
 /* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
 static const uint8_t *word_bytes(const int32_t *words) { return (const uint8_t *)(words + 1); }
 
-static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *end,
-               struct view v, struct rgb_out *out) {
+static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v) {
+    struct rgb_out *out = c->out;
     while (op < end && *op != OP_END) {
         int32_t code = *op++;
-        struct view at;
+        struct at at;
         int status;
         switch (code) {
         case OP_NUM: {
-            status = path(&op, v, &at);
+            status = path(c, &op, v, &at);
             if (status) return status;
             struct value val;
-            status = scalar(at, (uint32_t)op[0], op[1], &val);
+            status = scalar(c, at, (uint32_t)op[0], op[1], &val);
             if (status) return status;
             status = put_value(out, op[2], op[3], val);
             op += 4;
@@ -598,11 +761,11 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
             break;
         }
         case OP_STR: {
-            status = path(&op, v, &at);
+            status = path(c, &op, v, &at);
             if (status) return status;
             struct field f;
             int found;
-            status = find_last(at, (uint32_t)op[0], &f, &found);
+            status = last_of(c, at, (uint32_t)op[0], &f, &found);
             if (status) return status;
             if (found && f.wire != WIRE_LEN) return RGB_FALLBACK;
             status = found ? put_string(out, f.payload.p, f.payload.n) : put_string(out, NULL, 0);
@@ -614,11 +777,11 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
             op += rgb_text_span(op[0]);
             break;
         case OP_HEADER_STR: {
-            status = path(&op, v, &at);
+            status = path(c, &op, v, &at);
             if (status) return status;
-            struct header_lookup h = {word_bytes(op + 1), (size_t)op[1], op[0], 0, {NULL, 0}};
+            struct header_lookup h = {c, word_bytes(op + 1), (size_t)op[1], op[0], 0, {NULL, 0}};
             op += 1 + rgb_text_span(op[1]);
-            status = for_each(at, 2, header_entry, &h);
+            status = for_each(c, at, 2, header_entry, &h);
             if (status) return status;
             status = h.found ? put_frame(out, h.value)
                              : put_string(out, word_bytes(op), (size_t)op[0]);
@@ -626,19 +789,19 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
             break;
         }
         case OP_FIXED_LIST: {
-            status = path(&op, v, &at);
+            status = path(c, &op, v, &at);
             if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t type = op[1], kind = op[2], count = op[3];
             op += 4;
             struct scalars counting = {type, 0, 0, out};
-            status = for_each(at, number, scalar_element, &counting);
+            status = for_each(c, at, number, scalar_element, &counting);
             if (status) return status;
             status = align(out, rgb_ros_size(kind));
             if (status) return status;
             if (counting.count == (size_t)count) {
                 struct scalars writing = {type, 0, kind, out};
-                status = for_each(at, number, scalar_element, &writing);
+                status = for_each(c, at, number, scalar_element, &writing);
             } else {
                 struct value zero = {rgb_wire_of(type) != WIRE_VARINT, 0, 0, 0, 0.0};
                 for (int32_t k = 0; k < count && !status; k++)
@@ -647,50 +810,50 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
             break;
         }
         case OP_SEQ_MSG: {
-            status = path(&op, v, &at);
+            status = path(c, &op, v, &at);
             if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t body_len = op[1];
             const int32_t *body = op + 2;
             op = body + body_len;
-            size_t count = 0;
-            status = for_each(at, number, count_field, &count);
+            size_t count;
+            status = count_of(c, at, number, &count);
             if (status) return status;
             status = sequence_start(out, count, 0);
             if (status) return status;
-            struct messages m = {pr, body, body + body_len, out};
-            status = for_each(at, number, message_element, &m);
+            struct messages m = {c, body, body + body_len, element_type(c, at, number)};
+            status = for_each(c, at, number, message_element, &m);
             break;
         }
         case OP_COLUMN:
         case OP_COLUMN_STR: {
-            status = path(&op, v, &at);
+            status = path(c, &op, v, &at);
             if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t nsub = op[1];
-            struct column c = {op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0, out};
+            struct column col = {c, op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0, out};
             op += 3 + nsub;
             if (code == OP_COLUMN) {
-                c.type = op[0];
-                c.kind = op[1];
+                col.type = op[0];
+                col.kind = op[1];
                 op += 2;
             }
-            size_t count = 0;
-            status = for_each(at, number, count_field, &count);
+            size_t count;
+            status = count_of(c, at, number, &count);
             if (status) return status;
-            status = sequence_start(out, count, code == OP_COLUMN ? rgb_ros_size(c.kind) : 0);
+            status = sequence_start(out, count, code == OP_COLUMN ? rgb_ros_size(col.kind) : 0);
             if (status) return status;
-            status = for_each(at, number, column_element, &c);
+            status = for_each(c, at, number, column_element, &col);
             break;
         }
         case OP_CLOCK: {
-            status = path(&op, v, &at);
+            status = path(c, &op, v, &at);
             if (status) return status;
             int32_t part = op[0];
             op += 1;
             struct value sec, nsec;
-            status = scalar(at, 1, PB_INT64, &sec);
-            if (!status) status = scalar(at, 2, PB_INT32, &nsec);
+            status = scalar(c, at, 1, PB_INT64, &sec);
+            if (!status) status = scalar(c, at, 2, PB_INT32, &nsec);
             if (status) return status;
             int64_t s = (int32_t)(uint32_t)(uint64_t)sec.i;
             if (s < 0) return RGB_CONVERSION;
@@ -729,22 +892,52 @@ static int run(const struct rgb_program *pr, const int32_t *op, const int32_t *e
     return 0;
 }
 
-enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
-                           size_t payload_len, struct rgb_out *out) {
+/* The largest CDR message written for a payload of `n` bytes (docs/native.md §4): a message
+ * of defaults has a fixed part (RGB_OUTPUT_FLOOR covers every pair's), and beyond it each
+ * payload byte may give at most RGB_OUTPUT_RATIO bytes; more is an amplification (a Pose_V of
+ * empty poses gives 28-40 times its size), left to Python, which refuses it too. */
+static size_t output_limit(size_t n) {
+    if (n > (RGB_MAX_OUTPUT - RGB_OUTPUT_FLOOR) / RGB_OUTPUT_RATIO) return RGB_MAX_OUTPUT;
+    return RGB_OUTPUT_FLOOR + RGB_OUTPUT_RATIO * n;
+}
+
+void rgb_out_trim(struct rgb_out *out) { rgb_trim(out); }
+
+enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
+                                   size_t payload_len, struct rgb_out *out, size_t *steps) {
     static const uint8_t header[4] = {0, 1, 0, 0};
     struct view v = {payload, payload_len};
+    struct ctx c = {program, out, 0, 0};
+    rgb_trim(out); /* the last message's output is no longer used */
     out->len = 0;
-    int status = validate(program, v, program->root, 0);
-    if (status) return (enum rgb_status)status;
-    status = rgb_put(out, header, 4);
-    if (!status) status = run(program, program->ops, program->ops + program->ops_len, v, out);
+    out->limit = output_limit(payload_len);
+    struct at root = {v, NO_NODE};
+    int status = validate(&c, v, program->root, 0);
+    if (!status) status = index_message(&c, v, program->root, &root.node);
+    if (!status) status = rgb_put(out, header, 4);
+    if (!status) status = run(&c, program->ops, program->ops + program->ops_len, root);
+    if (status) {
+        rgb_trim(out);
+    } else if (out->scratch_cap > RGB_KEEP_BYTES) { /* the output stays for the caller */
+        free(out->scratch);
+        out->scratch = NULL;
+        out->scratch_cap = 0;
+    }
+    if (steps != NULL) *steps = c.steps;
     return (enum rgb_status)status;
+}
+
+enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
+                           size_t payload_len, struct rgb_out *out) {
+    return rgb_to_cdr_counted(program, payload, payload_len, out, NULL);
 }
 
 void rgb_out_free(struct rgb_out *out) {
     free(out->data);
+    free(out->scratch);
     out->data = NULL;
-    out->len = out->cap = 0;
+    out->scratch = NULL;
+    out->len = out->cap = out->scratch_cap = 0;
 }
 
 /* ---- loading: every word checked once ----------------------------------------------------- */

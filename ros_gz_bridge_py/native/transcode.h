@@ -1,9 +1,10 @@
 /* The native transcoder: Gazebo protobuf payloads to ROS CDR, driven by a program.
  *
- * Sans-IO: no Python, no sockets, no allocation outside the output buffer. The Python side
- * (program.py) compiles each pair's declaration into two arrays of int32 words, a schema of
- * the Gazebo message types (docs/native.md §2) and a program of ROS fields in wire order
- * (§3); rgb_load checks both once, and rgb_to_cdr runs them on untrusted payloads. */
+ * Sans-IO: no Python, no sockets, no allocation outside the output buffer (and its scratch,
+ * the index of the messages read). The Python side (program.py) compiles each pair's
+ * declaration into two arrays of int32 words, a schema of the Gazebo message types
+ * (docs/native.md §2) and a program of ROS fields in wire order (§3); rgb_load checks both
+ * once, and rgb_to_cdr runs them on untrusted payloads. */
 #ifndef RGB_TRANSCODE_H
 #define RGB_TRANSCODE_H
 
@@ -28,11 +29,14 @@ struct rgb_program {
     int32_t root; /* schema index of the Gazebo message type */
 };
 
-/* A growable output buffer. */
+/* A growable output buffer (all zero before first use), with the transcoder's scratch. */
 struct rgb_out {
     uint8_t *data;
     size_t len;
     size_t cap;
+    size_t limit;       /* most bytes this call may write (0: RGB_MAX_OUTPUT); set per call */
+    void *scratch;      /* rgb_to_cdr's index of the payload's messages, reused between calls */
+    size_t scratch_cap; /* its bytes */
 };
 
 /* Checks the words; 0 when they make a program, else -1 with a reason in *why. */
@@ -44,7 +48,15 @@ int rgb_load(struct rgb_program *program, const int32_t *schema, size_t schema_l
 enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
                            size_t payload_len, struct rgb_out *out);
 
-/* Frees the output buffer. */
+/* rgb_to_cdr that also says how many protobuf fields it read (*steps), the work that bounds
+ * its time: a few times the fields of the payload, whatever the program (the tests check it). */
+enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
+                                   size_t payload_len, struct rgb_out *out, size_t *steps);
+
+/* Frees the buffers that grew past 1 MiB; call after a large output was used. */
+void rgb_out_trim(struct rgb_out *out);
+
+/* Frees the output buffer and the scratch. */
 void rgb_out_free(struct rgb_out *out);
 
 #endif

@@ -54,6 +54,10 @@ enum { WIRE_VARINT = 0, WIRE_I64 = 1, WIRE_LEN = 2, WIRE_SGROUP = 3, WIRE_EGROUP
 
 /* Largest message either transcoder writes. */
 #define RGB_MAX_OUTPUT ((size_t)1 << 30)
+/* rgb_to_cdr's bound on its output: RGB_OUTPUT_FLOOR + RGB_OUTPUT_RATIO x the payload's bytes
+ * (docs/native.md §4; converters/limits.py applies the same to the Python path). */
+#define RGB_OUTPUT_FLOOR ((size_t)64 << 10)
+#define RGB_OUTPUT_RATIO 16
 
 /* The wire size of a ROS basic type (0: not one). */
 static inline size_t rgb_ros_size(int32_t kind) {
@@ -131,9 +135,11 @@ static inline int rgb_utf8_valid(const uint8_t *s, size_t n) {
     return 1;
 }
 
-/* Makes room for `extra` more bytes; RGB_FALLBACK past RGB_MAX_OUTPUT or without memory. */
+/* Makes room for `extra` more bytes; RGB_FALLBACK past out->limit (or RGB_MAX_OUTPUT) or
+ * without memory. */
 static inline int rgb_grow(struct rgb_out *out, size_t extra) {
-    if (extra > RGB_MAX_OUTPUT - out->len) return RGB_FALLBACK;
+    size_t limit = out->limit && out->limit < RGB_MAX_OUTPUT ? out->limit : RGB_MAX_OUTPUT;
+    if (out->len > limit || extra > limit - out->len) return RGB_FALLBACK;
     size_t need = out->len + extra;
     if (need <= out->cap) return 0;
     size_t cap = out->cap ? out->cap : 256;
@@ -143,6 +149,24 @@ static inline int rgb_grow(struct rgb_out *out, size_t extra) {
     out->data = data;
     out->cap = cap;
     return 0;
+}
+
+/* Buffers above this size are freed once used instead of kept for the next message. */
+#define RGB_KEEP_BYTES ((size_t)1 << 20)
+
+/* Frees what of `out` grew past RGB_KEEP_BYTES (its contents are no longer needed), so that a
+ * large message does not keep its memory for the small ones after it. */
+static inline void rgb_trim(struct rgb_out *out) {
+    if (out->cap > RGB_KEEP_BYTES) {
+        free(out->data);
+        out->data = NULL;
+        out->len = out->cap = 0;
+    }
+    if (out->scratch_cap > RGB_KEEP_BYTES) {
+        free(out->scratch);
+        out->scratch = NULL;
+        out->scratch_cap = 0;
+    }
 }
 
 /* Appends `n` bytes. */
