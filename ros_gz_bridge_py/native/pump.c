@@ -301,6 +301,7 @@ static void deliver(PumpObject *self, struct queued *q) {
         uint64_t sequence = begin_publication(self);
         int ret = self->f.publish(self->publisher, &message, NULL);
         end_publication(self, sequence, ret == 0);
+        rgb_out_trim(&self->out); /* a large message's buffer goes back at once */
         if (ret == 0) {
             self->published++;
             return;
