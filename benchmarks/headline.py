@@ -271,11 +271,12 @@ def provenance(runs: dict[str, Stored]) -> str:
         return f"Every figure below comes from commit {commits.pop()} (dates in the last column)."
     newest = max(runs.values(), key=lambda stored: stored.when)
     older = sorted(name for name, stored in runs.items() if stored.commit != newest.commit)
+    older_text = " and ".join(f"`{name}`" for name in older)
     return (
-        f"The figures below come from {len(commits)} different commits: each row says the "
+        f"**The figures below come from {len(commits)} different commits**: each says the "
         f"commit and date of its run. The newest run is at commit {newest.commit} "
-        f"({newest.when}); the figures of {', '.join(f'`{name}`' for name in older)} are "
-        "older and may not show what that commit does. `make bench` measures them all again."
+        f"({newest.when}); the figures of {older_text} are older and may not show what that "
+        "commit does. `make bench` measures them all again."
     )
 
 
@@ -304,21 +305,23 @@ def section(
     return f"""## Headline (issue 15)
 
 Written by `make bench` (`benchmarks.headline`) from the last run of each benchmark (stored in
-`benchmarks/results.json`; when and under what load below). {provenance(present)} Each
-figure stands beside its ceiling, measured in the same run: rclpy -> rclpy with the bridge's
-speed settings. Each verdict is computed from the figure in its row when this headline is
-written. The C++ ros_gz_bridge cannot be built here: its figures are quoted from issue 15,
-which measured it side by side with this bridge (on this machine type, on another day, at an
-older commit of this bridge); none of them is measured by these benchmarks. Details, and every
-other figure, in the sections below.
+`benchmarks/results.json`; when and under what load below). Each figure stands beside its
+ceiling, measured in the same run: rclpy -> rclpy with the bridge's speed settings. Each
+verdict is computed from the figure in its row when this headline is written. The C++
+ros_gz_bridge cannot be built here: its figures are quoted from issue 15, which measured it
+side by side with this bridge (on this machine type, on another day, at an older commit of
+this bridge); none of them is measured by these benchmarks. Details, and every other figure,
+in the sections below.
+
+{provenance(present)}
 
 {HEADER}
 {chr(10).join(rows)}
 
-CPU per delivered message, per type{_from(costs)} (a fixed rate, histories deep enough that
+CPU per delivered message, per type{_from(costs)}: a fixed rate, histories deep enough that
 every message arrives; the rclpy columns are the publisher and subscriber processes of
 rclpy -> rclpy at the same rate, the same run: what a ROS node in Python spends on each end of
-the hop):
+the hop.
 
 {per_type(costs)}
 

@@ -75,7 +75,7 @@ def test_each_figure_names_its_run_and_older_runs_are_called_older() -> None:
     assert odometry.endswith(f"| commit bbb2222, {COSTS_WHEN} |")
     assert "come from 2 different commits" in text
     assert f"The newest run is at commit bbb2222 ({COSTS_WHEN}); the figures of `sustained`" in text
-    assert f"CPU per delivered message, per type (commit bbb2222, {COSTS_WHEN})" in text
+    assert f"CPU per delivered message, per type (commit bbb2222, {COSTS_WHEN}): " in text
     assert "| /clock at 1 kHz" in text
     assert "not measured yet (`benchmarks.starvation`) |||||" in text
 
