@@ -20,9 +20,17 @@ WITH_LOOPBACK := if [ -f $(LOOPBACK) ]; then source $(LOOPBACK); else source too
 
 .PHONY: setup-demo setup test lint typecheck unit demo bench soak fuzz clean
 
+# The package's bytecode, brought up to date on every run (0.2 s when it is): an editable install
+# has none, and where PYTHONDONTWRITEBYTECODE is set (as on the project machines) every bridge
+# process would compile the whole package again (3 entries: the last channel 1.5 s after start
+# instead of 0.8 s, median of 6 alternated rounds, load average 5).
+BYTECODE := $(PY) -m compileall -q ros_gz_bridge_py
+
 setup-demo: $(DEMO_STAMP)
+	@$(BYTECODE)
 
 setup: $(STAMP)
+	@$(BYTECODE)
 
 $(DEMO_STAMP): pyproject.toml tools/apt_ensure.sh tools/setup_build.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
 	bash tools/setup_build.sh
