@@ -3,6 +3,8 @@
 Usage: ``.venv/bin/python -m benchmarks.headline`` (``benchmarks.run`` calls it last). It
 reads what ``sustained``, ``costs`` and ``starvation`` stored in ``benchmarks/results.json``,
 writes the ``headline`` section at the top of BENCHMARKS.md and draws the plots it links.
+Each figure is shown with the commit and date of the run it came from, and each verdict is
+computed from the figure beside it when the headline is written, never stored.
 """
 
 from __future__ import annotations
@@ -30,7 +32,6 @@ from benchmarks.reference import (
     GOAL_LATENCY_30HZ_MS,
     GOAL_SUSTAINED_HZ,
     LATENCY_30HZ,
-    QUOTED,
     SUSTAINED_1080P,
     cpu_goal_ms,
 )
@@ -40,8 +41,9 @@ from benchmarks.sustained import PACED_HZ, highest, side_flows
 from benchmarks.tables import SIZES, verdict
 
 HEADER = (
-    "| figure | this bridge | ceiling, same run | goal (issue 15) "
-    f"| C++ ros_gz_bridge ({QUOTED}) |\n|---|---|---|---|---|"
+    "| figure | this bridge | ceiling, same run | goal (issue 15), verdict from this row's figure "
+    "| C++ ros_gz_bridge, not measured here (issue 15's run) | measured at |\n"
+    "|---|---|---|---|---|---|"
 )
 CASES = [("GZ->ROS", kind, hz) for kind, hz in GZ_TO_ROS]
 CASES += [("ROS->GZ", kind, hz) for kind, hz in ROS_TO_GZ]
@@ -64,7 +66,7 @@ def _rate(hz: float | None, offered: list[float]) -> str:
 def image_rows(stored: Stored | None) -> list[str]:
     """Highest sustainable 1080p rate; latency and CPU per frame at 30 Hz."""
     if stored is None:
-        return ["| 1080p Gazebo -> ROS | not measured yet (`benchmarks.sustained`) ||||"]
+        return ["| 1080p Gazebo -> ROS | not measured yet (`benchmarks.sustained`) |||||"]
     bridge, ceiling = side_flows(stored, "bridge"), side_flows(stored, "ceiling")
     best, offered = highest(bridge), sorted(bridge)
     met = best is not None and best >= GOAL_SUSTAINED_HZ
@@ -72,7 +74,7 @@ def image_rows(stored: Stored | None) -> list[str]:
         "| Highest sustainable 1080p rate, Gazebo -> ROS (>= 99% delivered, p99 < 100 ms) "
         f"| **{_rate(best, offered)}** | {_rate(highest(ceiling), offered)} "
         f"| >= {GOAL_SUSTAINED_HZ:g} Hz: {verdict(met, f'{GOAL_SUSTAINED_HZ - (best or 0):g} Hz')}"
-        f" | {SUSTAINED_1080P.cpp_text()} |"
+        f" | {SUSTAINED_1080P.cpp_text()} | {stored.measured()} |"
     ]
     paced, base = bridge.get(PACED_HZ), ceiling.get(PACED_HZ)
     if paced is None or paced.error:
@@ -83,7 +85,7 @@ def image_rows(stored: Stored | None) -> list[str]:
         f"| 1080p Gazebo -> ROS at {PACED_HZ:g} Hz, latency median | **{_latency(paced)}** "
         f"| {'-' if base is None or base.error else _latency(base)} "
         f"| <= {GOAL_LATENCY_30HZ_MS:g} ms: {verdict(median <= GOAL_LATENCY_30HZ_MS, late)} "
-        f"| {LATENCY_30HZ.cpp_text()} |"
+        f"| {LATENCY_30HZ.cpp_text()} | {stored.measured()} |"
     )
     frame = per_message_ms(paced.cpu, PACED_HZ, paced)
     if frame is not None:
@@ -97,7 +99,7 @@ def image_rows(stored: Stored | None) -> list[str]:
             f"| **{frame:.2f} ms**{of_which} | {_frame_ends(base)} "
             f"| <= {GOAL_CPU_PER_FRAME_30HZ_MS:g} ms: "
             f"{verdict(frame <= GOAL_CPU_PER_FRAME_30HZ_MS, over)} "
-            f"| {CPU_PER_FRAME_30HZ.cpp_text()} |"
+            f"| {CPU_PER_FRAME_30HZ.cpp_text()} | {stored.measured()} |"
         )
     return rows
 
@@ -114,14 +116,14 @@ def clock_row(stored: Stored | None) -> str:
     what = "/clock at 1 kHz received while 1080p frames flood the same Gazebo process"
     default = None if stored is None else stored.flow(starvation.DEFAULT.name)
     if stored is None or default is None or default.error:
-        return f"| {what} | not measured yet (`benchmarks.starvation`) ||||"
+        return f"| {what} | not measured yet (`benchmarks.starvation`) |||||"
     ceiling = stored.flow(starvation.CEILING.name)
     gap = f"{(GOAL_CLOCK_SHARE - default.share) * 100:.1f} points"
     return (
         f"| {what} (depth-10 subscriber) | **{default.share:.1%}**, latency "
         f"{_latency(default)} | {'-' if ceiling is None else f'{ceiling.share:.1%}'} "
         f"| >= {GOAL_CLOCK_SHARE:.0%}: {verdict(default.share >= GOAL_CLOCK_SHARE, gap)} "
-        f"| {CLOCK_UNDER_FLOOD.cpp_text()} |"
+        f"| {CLOCK_UNDER_FLOOD.cpp_text()} | {stored.measured()} |"
     )
 
 
@@ -148,7 +150,7 @@ def cpu_rows(stored: Stored | None) -> list[str]:
         flow = None if stored is None else stored.flow(flow_key(way, kind, hz))
         cost = None if flow is None else per_message_ms(flow.cpu, hz, flow)
         if stored is None or flow is None or cost is None:
-            rows.append(f"| {what} | not measured yet (`benchmarks.costs`) ||||")
+            rows.append(f"| {what} | not measured yet (`benchmarks.costs`) |||||")
             continue
         publisher, subscriber = _ends(stored, kind, hz)
         end = f"rclpy publisher {_ms(publisher)} ms, subscriber {_ms(subscriber)} ms"
@@ -160,7 +162,7 @@ def cpu_rows(stored: Stored | None) -> list[str]:
             f"| {what}, every message delivered | **{cost:.3f} ms** "
             f"({flow.received}/{flow.sent} delivered) | {end} "
             f"| <= {bar:.3f} ms: {verdict(not misses, ' and '.join(misses))} "
-            f"| {quoted.cpp_text()} |"
+            f"| {quoted.cpp_text()} | {stored.measured()} |"
         )
     return rows
 
@@ -260,42 +262,72 @@ def draw(sustained: Stored | None, costs: Stored | None) -> str:
     return "\n\n".join(links)
 
 
-def section() -> str:
-    sustained, costs, clock = load("sustained"), load("costs"), load("starvation")
+def provenance(runs: dict[str, Stored]) -> str:
+    """Whether the figures shown come from one commit, and if not, which is which."""
+    if not runs:
+        return "No benchmark has stored figures yet."
+    commits = {stored.commit for stored in runs.values()}
+    if len(commits) == 1:
+        return f"Every figure below comes from commit {commits.pop()} (dates in the last column)."
+    newest = max(runs.values(), key=lambda stored: stored.when)
+    older = sorted(name for name, stored in runs.items() if stored.commit != newest.commit)
+    older_text = " and ".join(f"`{name}`" for name in older)
+    return (
+        f"**The figures below come from {len(commits)} different commits**: each says the "
+        f"commit and date of its run. The newest run is at commit {newest.commit} "
+        f"({newest.when}); the figures of {older_text} are older and may not show what that "
+        "commit does. `make bench` measures them all again."
+    )
+
+
+def _from(stored: Stored | None) -> str:
+    """`` (commit ..., date)``: where a block of figures came from."""
+    return "" if stored is None else f" ({stored.measured()})"
+
+
+def section(
+    sustained: Stored | None, costs: Stored | None, clock: Stored | None, plots_text: str
+) -> str:
+    """The headline, from the stored runs of ``sustained``, ``costs`` and ``starvation``."""
     rows = [*image_rows(sustained), clock_row(clock), *cpu_rows(costs)]
-    runs = [
-        f"- `{name}`: {stored.run_line()}"
-        for name, stored in (("sustained", sustained), ("costs", costs), ("starvation", clock))
-        if stored is not None
-    ]
+    named = {"sustained": sustained, "costs": costs, "starvation": clock}
+    present = {name: stored for name, stored in named.items() if stored is not None}
+    runs = [f"- `{name}`: {stored.run_line()}" for name, stored in present.items()]
     notes = clock_notes(clock)
     cpu_missed = cpu_notes(costs)
     cpu_text = ""
     if cpu_missed:
         cpu_text = (
-            "\nWhat bounds the CPU per message where it misses:\n" + "\n".join(cpu_missed) + "\n"
+            f"\nWhat bounds the CPU per message where it misses{_from(costs)}:\n"
+            + "\n".join(cpu_missed)
+            + "\n"
         )
     return f"""## Headline (issue 15)
 
 Written by `make bench` (`benchmarks.headline`) from the last run of each benchmark (stored in
 `benchmarks/results.json`; when and under what load below). Each figure stands beside its
-ceiling, measured in the same run: rclpy -> rclpy with the bridge's speed settings. The C++
+ceiling, measured in the same run: rclpy -> rclpy with the bridge's speed settings. Each
+verdict is computed from the figure in its row when this headline is written. The C++
 ros_gz_bridge cannot be built here: its figures are quoted from issue 15, which measured it
-side by side with this bridge on this machine type (medians of three rounds); none of them is
-measured by these benchmarks. Details, and every other figure, in the sections below.
+side by side with this bridge (on this machine type, on another day, at an older commit of
+this bridge); none of them is measured by these benchmarks. Details, and every other figure,
+in the sections below.
+
+{provenance(present)}
 
 {HEADER}
 {chr(10).join(rows)}
 
-CPU per delivered message, per type (a fixed rate, histories deep enough that every message
-arrives; the rclpy columns are the publisher and subscriber processes of rclpy -> rclpy at the
-same rate, the same run: what a ROS node in Python spends on each end of the hop):
+CPU per delivered message, per type{_from(costs)}: a fixed rate, histories deep enough that
+every message arrives; the rclpy columns are the publisher and subscriber processes of
+rclpy -> rclpy at the same rate, the same run: what a ROS node in Python spends on each end of
+the hop.
 
 {per_type(costs)}
 
-{draw(sustained, costs)}
+{plots_text}
 
-Where /clock was lost under the flood:
+Where /clock was lost under the flood{_from(clock)}:
 {chr(10).join(notes) if notes else "- not measured yet (`benchmarks.starvation`)"}
 {cpu_text}
 Measured (2 cores shared with other work: every figure is noisy, the load averages say how
@@ -306,7 +338,8 @@ busy the machine was):
 
 def main(argv: list[str] | None = None) -> int:
     del argv  # no options
-    write_section("headline", section(), first=True)
+    sustained, costs, clock = load("sustained"), load("costs"), load("starvation")
+    write_section("headline", section(sustained, costs, clock, draw(sustained, costs)), first=True)
     return 0
 
 

@@ -40,6 +40,10 @@ class Stored:
     def flow(self, name: str) -> FlowResult | None:
         return self.flows.get(name)
 
+    def measured(self) -> str:
+        """The commit and date of the run, for a figure taken from it."""
+        return f"commit {self.commit}, {self.when}"
+
     def run_line(self) -> str:
         """When, at which commit and under which load the figures were measured."""
         return (
@@ -74,8 +78,11 @@ def store(
 def load(name: str) -> Stored | None:
     """Benchmark ``name``'s stored figures, None if it never stored any."""
     entry = _read().get(name)
-    if entry is None:
-        return None
+    return None if entry is None else stored(entry)
+
+
+def stored(entry: dict[str, Any]) -> Stored:
+    """One benchmark's entry of ``results.json`` as :class:`Stored`."""
     flows = {key: _flow(value) for key, value in entry["flows"].items()}
     return Stored(
         entry["when"],

@@ -4,12 +4,22 @@ from __future__ import annotations
 
 import sys
 
+from ros_gz_bridge_py.app.rclpy_check import rclpy_problem
 from ros_gz_bridge_py.app.startup import pause_collector
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 
+def _exit_without_rclpy(program: str) -> None:
+    """Stop with one line that says what is needed, before an import of rclpy would fail."""
+    problem = rclpy_problem()
+    if problem is not None:
+        print(f"{program}: {problem}", file=sys.stderr)
+        sys.exit(1)
+
+
 def parameter_bridge_main() -> None:
     pause_collector()
+    _exit_without_rclpy("parameter_bridge")
     with StopSignal() as stop:
         from ros_gz_bridge_py.app import parameter_bridge  # noqa: PLC0415 - imports rclpy
 
@@ -24,6 +34,7 @@ def bridge_types_main() -> None:
 
 def image_bridge_main() -> None:
     pause_collector()
+    _exit_without_rclpy("image_bridge")
     with StopSignal() as stop:
         from ros_gz_bridge_py.app import image_bridge  # noqa: PLC0415 - imports rclpy
 

@@ -19,7 +19,8 @@ VENV=$BASE/venv
 WS=$BASE/ws
 # The Python that runs the installed package afterwards (it has protobuf & co).
 PROJECT_PYTHON=${PROJECT_PYTHON:-$ROOT/.venv/bin/python}
-# setuptools: >=77 reads pyproject's SPDX `license` string; colcon-core 0.21 wants <80.
+# setuptools: Ubuntu 24.04's (Jazzy's) python3-setuptools, the oldest a colcon user has; it cannot
+# read an SPDX `license` string in pyproject.toml (setup.cfg holds the license instead).
 PINS=(
   colcon-core==0.21.3
   colcon-ros==0.5.0

@@ -88,7 +88,7 @@ def bridge_commands() -> list[BridgeCommand]:
         raise DemoSetupError(msg)
     executable = Path(sys.executable).with_name("parameter_bridge")
     if not executable.exists():
-        msg = f"{executable} is missing; run `make setup` (pip install -e .)"
+        msg = f"{executable} is missing; run `make setup-demo` (pip install -e .)"
         raise DemoSetupError(msg)
     parameter_bridge = [str(executable), "--ros-args", "-p", f"config_file:={topics.CONFIG_FILE}"]
     image_bridge = [sys.executable, "-m", "ros_gz_bridge_py.app.image_bridge", topics.CAMERA_IMAGE]

@@ -1,0 +1,102 @@
+"""The headline of BENCHMARKS.md, written from a small results dict: every figure says the
+commit and date of its run, runs of different commits are called so, and each verdict follows
+the figure shown."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from benchmarks import headline
+from benchmarks.results import Stored, stored
+
+SUSTAINED_WHEN = "2026-11-26 17:49 UTC"
+COSTS_WHEN = "2026-11-27 05:20 UTC"
+ODOMETRY_5K = "CPU per message, Odometry GZ->ROS at 5 kHz"
+
+
+def flow(
+    sent: int, received: int, p99_ms: float, cpu: float | None = None, **more: Any
+) -> dict[str, Any]:
+    """A flow as ``results.json`` stores it."""
+    return {
+        "sent": sent,
+        "received": received,
+        "rate": 0.0,
+        "median_us": p99_ms * 500,
+        "p99_us": p99_ms * 1000,
+        "cpu": cpu,
+        "error": "",
+        **more,
+    }
+
+
+def entry(commit: str, when: str, flows: dict[str, dict[str, Any]]) -> Stored:
+    return stored(
+        {"commit": commit, "when": when, "load_before": 0.5, "load_after": 0.7, "flows": flows}
+    )
+
+
+def sustained(commit: str, p99_at_120_ms: float = 20.0) -> Stored:
+    return entry(
+        commit,
+        SUSTAINED_WHEN,
+        {
+            "bridge 30": flow(300, 300, 15.0, cpu=21.0),
+            "bridge 120": flow(1200, 1200, p99_at_120_ms),
+            "ceiling 30": flow(300, 300, 9.0),
+            "ceiling 120": flow(1200, 1200, 12.0),
+        },
+    )
+
+
+def costs(commit: str, cpu: float) -> Stored:
+    """Odometry Gazebo -> ROS at 5 kHz, the bridge at ``cpu`` % of a core."""
+    return entry(
+        commit,
+        COSTS_WHEN,
+        {
+            "GZ->ROS odometry 5000": flow(15001, 15001, 1.0, cpu=cpu),
+            "ceiling odometry 5000": flow(15001, 15001, 1.0, pub_cpu=50.0, sub_cpu=60.0),
+        },
+    )
+
+
+def row(text: str, starts: str) -> str:
+    (found,) = [line for line in text.splitlines() if line.startswith(f"| {starts}")]
+    return found
+
+
+def test_each_figure_names_its_run_and_older_runs_are_called_older() -> None:
+    text = headline.section(sustained("aaa1111"), costs("bbb2222", 25.0), None, "")
+
+    rate = row(text, "Highest sustainable 1080p rate")
+    assert rate.endswith(f"| commit aaa1111, {SUSTAINED_WHEN} |")
+    odometry = row(text, ODOMETRY_5K)
+    assert odometry.endswith(f"| commit bbb2222, {COSTS_WHEN} |")
+    assert "come from 2 different commits" in text
+    assert f"The newest run is at commit bbb2222 ({COSTS_WHEN}); the figures of `sustained`" in text
+    assert f"CPU per delivered message, per type (commit bbb2222, {COSTS_WHEN}): " in text
+    assert "| /clock at 1 kHz" in text
+    assert "not measured yet (`benchmarks.starvation`) |||||" in text
+
+
+def test_one_commit_is_said_once() -> None:
+    text = headline.section(sustained("ccc3333"), costs("ccc3333", 25.0), None, "")
+
+    assert "Every figure below comes from commit ccc3333" in text
+    assert "different commits" not in text
+
+
+def test_verdicts_follow_the_figures_shown() -> None:
+    # 25 % of a core at 5 kHz is 0.050 ms per message, under the 0.063 ms bar; 40 % is 0.080.
+    met = headline.section(sustained("ddd4444"), costs("ddd4444", 25.0), None, "")
+    missed = headline.section(sustained("ddd4444", 150.0), costs("ddd4444", 40.0), None, "")
+
+    assert "| **0.050 ms** (15001/15001 delivered)" in row(met, ODOMETRY_5K)
+    assert "<= 0.063 ms: **met**" in row(met, ODOMETRY_5K)
+    assert "<= 0.063 ms: **missed** by 0.017 ms (1.3x)" in row(missed, ODOMETRY_5K)
+    assert "| **120 Hz (the highest offered)** |" in row(met, "Highest sustainable")
+    assert ">= 120 Hz: **met**" in row(met, "Highest sustainable")
+    # A p99 of 150 ms at 120 Hz leaves 30 Hz as the highest sustainable rate.
+    assert "| **30 Hz** |" in row(missed, "Highest sustainable")
+    assert ">= 120 Hz: **missed** by 90 Hz" in row(missed, "Highest sustainable")
