@@ -108,7 +108,9 @@ class Round:
     messages: float = 0.0
     threads: int = 0
     rss: float = 0.0
-    startup_s: float = 0.0
+    #: Seconds to every topic flowing; None when some never did (``silent``).
+    startup_s: float | None = 0.0
+    silent: tuple[str, ...] = ()
     sub_cpu: float = 0.0
     #: What the simulator sent of its schedule (the bridge rounds).
     simulator_share: float = 0.0
@@ -132,6 +134,17 @@ def _counts(sub: PeerProcess) -> dict[str, int]:
     sub.send_signal(signal.SIGUSR1)
     counts: dict[str, int] = json.loads(wait_for_line(sub, r"^COUNTS (.*)$", 10)[1])
     return counts
+
+
+def _wait_flowing(sub: PeerProcess) -> tuple[float | None, tuple[str, ...]]:
+    """When (wall clock) every topic had brought the subscriber a message; if that does not
+    happen within :data:`FLOW_TIMEOUT`, None and the topics that brought nothing (the run
+    goes on: the delivered shares then show them)."""
+    try:
+        return float(wait_for_line(sub, r"^ALL_FLOWING (\S+)$", FLOW_TIMEOUT)[1]), ()
+    except FlowFailure:
+        counts = _counts(sub)
+        return None, tuple(t for t, n in counts.items() if not n and t != "cmd_vel")
 
 
 def _delivered(
@@ -167,7 +180,7 @@ def bridge_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
     bridge = start_process(
         [str(BIN / "parameter_bridge"), *fleet_sim.bridge_arguments(names)], bridge_env
     )
-    flowing = float(wait_for_line(sub, r"^ALL_FLOWING (\S+)$", FLOW_TIMEOUT)[1])
+    flowing, silent = _wait_flowing(sub)
     time.sleep(SETTLE)
     before = _counts(sub)
     windows = [CpuWindow(bridge.pid), CpuWindow(sub.pid)]
@@ -200,7 +213,8 @@ def bridge_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
         messages=in_window,
         threads=threads,
         rss=rss,
-        startup_s=flowing - started,
+        startup_s=None if flowing is None else flowing - started,
+        silent=silent,
         sub_cpu=windows[1].percent or 0.0,
         simulator_share=sum(sent) / schedule,
     )
@@ -216,7 +230,7 @@ def ceiling_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
     sub = _start_subscriber(robots, env)
     command = [sys.executable, "-m", "benchmarks.fleet_ros", "pub", str(robots)]
     publisher = start_process(command, env)
-    wait_for_line(sub, r"^ALL_FLOWING (\S+)$", FLOW_TIMEOUT)
+    silent = _wait_flowing(sub)[1]
     time.sleep(SETTLE)
     before = _counts(sub)
     windows = [CpuWindow(publisher.pid), CpuWindow(sub.pid)]
@@ -239,6 +253,7 @@ def ceiling_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
         threads=threads,
         rss=rss,
         sub_cpu=windows[1].percent or 0.0,
+        silent=silent,
     )
 
 
@@ -263,6 +278,13 @@ def _percent(share: float) -> str:
 
 def _delivered_cell(row: Round) -> str:
     return " / ".join(_percent(row.delivered[kind]) for kind in KINDS if kind in row.delivered)
+
+
+def _startup_cell(row: Round) -> str:
+    if row.startup_s is not None:
+        return f"{row.startup_s:.2f} s"
+    examples = " ".join(row.silent[:3])
+    return f"> {FLOW_TIMEOUT:g} s: {len(row.silent)} topics never flowed ({examples} ...)"
 
 
 def _quoted_cell(low: float, high: float, *, unit: str = "") -> str:
@@ -307,8 +329,8 @@ def goal_lines(rows: Sequence[Round]) -> list[str]:
     row = bridge.get(GOAL_STARTUP_ROBOTS)
     judge(
         f"start-up at {GOAL_STARTUP_ROBOTS} robots <= C++ ({GOAL_STARTUP_S:g} s)",
-        None if row is None else row.startup_s <= GOAL_STARTUP_S,
-        "-" if row is None else f"{row.startup_s:.2f} s",
+        None if row is None else row.startup_s is not None and row.startup_s <= GOAL_STARTUP_S,
+        "-" if row is None else _startup_cell(row),
     )
     judge(
         f"delivered >= {GOAL_DELIVERED:.0%} per kind at {GOAL_STARTUP_ROBOTS} robots",
@@ -360,7 +382,7 @@ def report(rows: Sequence[Round], args: argparse.Namespace, load: float, plot: s
             lines.append(head + f"| failed: {row.error} |" + " |" * 7)
             continue
         lines.append(
-            head + f"| {row.cpu:.1f}% | {row.us_per_message:.1f} | {row.startup_s:.2f} "
+            head + f"| {row.cpu:.1f}% | {row.us_per_message:.1f} | {_startup_cell(row)} "
             f"| {_delivered_cell(row)} | {row.threads} | {row.rss:.0f} | {row.sub_cpu:.1f}% "
             f"| {_percent(row.simulator_share)} |"
         )
@@ -422,7 +444,9 @@ def numbers(rows: Sequence[Round]) -> dict[str, float]:
             **{f"{key}.delivered.{k}": round(v, 4) for k, v in row.delivered.items()},
         }
         if not row.ceiling:
-            stored[f"{key}.startup_s"] = round(row.startup_s, 3)
+            if row.startup_s is not None:
+                stored[f"{key}.startup_s"] = round(row.startup_s, 3)
+            stored[f"{key}.silent_topics"] = len(row.silent)
             stored[f"{key}.simulator_share"] = round(row.simulator_share, 4)
     return stored
 

@@ -189,7 +189,11 @@ def fleet_plot(rows: Sequence[Round], quoted: Mapping[int, Quoted]) -> str:
         label=f"goal: {GOAL_CPU_RATIO:g}x C++",
     )  # fmt: skip
     cpu.set_ylabel("µs CPU per delivered message")
-    startup.plot(robots, [row.startup_s for row in bridge], "o-", label="parameter_bridge")
+    started = [row for row in bridge if row.startup_s is not None]
+    startup.plot(
+        [row.robots for row in started], [row.startup_s for row in started], "o-",
+        label="parameter_bridge",
+    )  # fmt: skip
     for count, q in cpp:
         startup.plot([count, count], list(q.startup_cpp), "k^:")
     startup.plot([], [], "k^:", label="C++ bridge (issue 28, quoted)")
