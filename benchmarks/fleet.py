@@ -35,6 +35,7 @@ from benchmarks.harness import BIN, ROOT, CpuWindow, FlowFailure, bench_env, rss
 from benchmarks.report import write_section
 from benchmarks.results import store
 from tests import fleet_sim
+from tests.bridge.e2e_harness import status_rows
 from tests.gzpeer import PeerProcess, start_peer, start_process, wait_for_line
 
 #: Where the quoted figures come from.
@@ -111,6 +112,8 @@ class Round:
     #: Seconds to every topic flowing; None when some never did (``silent``).
     startup_s: float | None = 0.0
     silent: tuple[str, ...] = ()
+    #: The bridge's status rows of the silent topics.
+    silent_status: tuple[str, ...] = ()
     sub_cpu: float = 0.0
     #: What the simulator sent of its schedule (the bridge rounds).
     simulator_share: float = 0.0
@@ -181,6 +184,7 @@ def bridge_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
         [str(BIN / "parameter_bridge"), *fleet_sim.bridge_arguments(names)], bridge_env
     )
     flowing, silent = _wait_flowing(sub)
+    silent_status = tuple(status_rows(bridge, silent)) if silent else ()
     time.sleep(SETTLE)
     before = _counts(sub)
     windows = [CpuWindow(bridge.pid), CpuWindow(sub.pid)]
@@ -215,6 +219,7 @@ def bridge_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
         rss=rss,
         startup_s=None if flowing is None else flowing - started,
         silent=silent,
+        silent_status=silent_status,
         sub_cpu=windows[1].percent or 0.0,
         simulator_share=sum(sent) / schedule,
     )
@@ -389,11 +394,18 @@ def report(rows: Sequence[Round], args: argparse.Namespace, load: float, plot: s
             f"| {_delivered_cell(row)} | {row.threads} | {row.rss:.0f} | {row.sub_cpu:.1f}% "
             f"| {_percent(row.simulator_share)} |"
         )
+    for row in rows:
+        if row.silent_status:
+            lines += [
+                "",
+                f"The bridge's status of the topics that never flowed ({row.robots} robots):",
+            ]
+            lines += ["", "```", *row.silent_status, "```"]
     lines += [
         "",
         "The same run's rclpy ceiling: one rclpy process publishing the same ROS topics at the "
         "same rates (each message serialized once, no Gazebo side, no conversion) to the same "
-        "subscriber: what any Python process pays for the fleet's ROS traffic alone.",
+        "subscriber: what one rclpy process pays for the fleet's ROS traffic alone.",
         "",
         "| robots | rclpy publisher CPU | µs CPU / delivered msg | delivered clock / odom / imu "
         "/ joint_states | threads | RSS MB | subscriber CPU |",

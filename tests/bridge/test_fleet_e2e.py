@@ -14,8 +14,6 @@ from __future__ import annotations
 
 import functools
 import os
-import signal
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -30,10 +28,11 @@ from tests.bridge.e2e_harness import (
     RosChecker,
     lines,
     parse_gz,
+    status_rows,
     wait_all,
 )
 from tests.bridge.e2e_values import mismatches
-from tests.gzpeer import ROOT, PeerProcess, require_peer, wait_for_line
+from tests.gzpeer import ROOT, require_peer, wait_for_line
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros]
 
@@ -111,7 +110,7 @@ def check_fleet(
     }
     assert not missing, (
         f"Gazebo -> ROS, not (or wrongly) arrived: {missing}; the bridge's status of those:\n"
-        + "\n".join(_status_lines(bridge, list(missing)))
+        + "\n".join(status_rows(bridge, list(missing)))
     )
 
     def command_arrived(robot: str) -> bool:
@@ -126,19 +125,6 @@ def check_fleet(
     )
     firsts = lines(simulator, "FIRST ")
     assert all(to_gz.values()), f"ROS -> Gazebo: {to_gz}; the simulator saw {firsts}"
-
-
-def _status_lines(bridge: PeerProcess, topics: list[str]) -> list[str]:
-    """The rows (and explanations) of the bridge's status table (SIGUSR1) that name
-    ``topics``, after the table's header."""
-    bridge.send_signal(signal.SIGUSR1)
-    time.sleep(1.0)
-    table = bridge.output().splitlines()
-    header = [line for line in table if "LIMITED" in line][-1:]
-    named = [
-        line for line in table if any(f"{topic}{end}" in line for topic in topics for end in " :")
-    ]
-    return header + named
 
 
 def _twist(text: str) -> dict[str, dict[str, float]]:
