@@ -18,9 +18,10 @@ from benchmarks.costs import (
     per_message_ms,
     thread_split_ms,
 )
+from benchmarks.fleet import GOAL_CPU_RATIO, GOAL_THREADS, Quoted, Round
 from benchmarks.harness import PYTHON_THREADS
 from benchmarks.reference import CPU_PER_MESSAGE, QUOTED, SUSTAINED_P99_MS, cpu_goal_ms
-from benchmarks.results import COSTS_PNG, SUSTAINED_PNG, Stored
+from benchmarks.results import COSTS_PNG, FLEET_PNG, SUSTAINED_PNG, Stored
 from benchmarks.sustained import side_flows
 from benchmarks.tables import SIZES
 
@@ -160,6 +161,67 @@ def native_overload_plot(series: Mapping[str, Sequence[tuple[float, float]]], re
     axes.grid(alpha=0.3)
     axes.legend(fontsize=8)
     return _save(figure, relative)
+
+
+def fleet_plot(rows: Sequence[Round], quoted: Mapping[int, Quoted]) -> str:
+    """``benchmarks.fleet`` against the number of robots: CPU per delivered message,
+    start-up, threads and the worst delivered share, the bridge beside the rclpy ceiling and
+    the C++ figures quoted from issue 28."""
+    _agg()
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    bridge = [row for row in rows if not row.ceiling and not row.error]
+    ceiling = [row for row in rows if row.ceiling and not row.error]
+    cpp = sorted(quoted.items())
+    figure, axes = plt.subplots(2, 2, figsize=(9, 6.5))
+    cpu, startup, threads, delivered = axes.flat
+    robots = [row.robots for row in bridge]
+    cpp_robots = [count for count, _ in cpp]
+    cpp_us = [q.cpp_us_per_message() for _, q in cpp]
+    cpu.plot(robots, [row.us_per_message for row in bridge], "o-", label="parameter_bridge")
+    cpu.plot(
+        [row.robots for row in ceiling], [row.us_per_message for row in ceiling], "s--",
+        label="rclpy publisher alone (ceiling)",
+    )  # fmt: skip
+    cpu.plot(cpp_robots, cpp_us, "k^:", label="C++ bridge (issue 28, quoted)")
+    cpu.plot(
+        cpp_robots, [GOAL_CPU_RATIO * us for us in cpp_us], ":", color="grey",
+        label=f"goal: {GOAL_CPU_RATIO:g}x C++",
+    )  # fmt: skip
+    cpu.set_ylabel("µs CPU per delivered message")
+    started = [row for row in bridge if row.startup_s is not None]
+    startup.plot(
+        [row.robots for row in started], [row.startup_s for row in started], "o-",
+        label="parameter_bridge",
+    )  # fmt: skip
+    for count, q in cpp:
+        startup.plot([count, count], list(q.startup_cpp), "k^:")
+    startup.plot([], [], "k^:", label="C++ bridge (issue 28, quoted)")
+    startup.set_ylabel("start-up to every topic flowing, s")
+    threads.plot(robots, [row.threads for row in bridge], "o-", label="parameter_bridge")
+    threads.plot(cpp_robots, [q.threads_cpp for _, q in cpp], "k^:", label="C++ (issue 28)")
+    threads.axhline(GOAL_THREADS, color="grey", linestyle=":", label="goal")
+    threads.set_ylabel("threads")
+    delivered.plot(
+        robots, [100 * min(row.delivered.values()) for row in bridge], "o-",
+        label="parameter_bridge, worst kind",
+    )  # fmt: skip
+    delivered.plot(
+        robots,
+        [100 * row.delivered["clock"] for row in bridge],
+        "o--",
+        label="parameter_bridge, /clock",
+    )
+    for count, q in cpp:
+        delivered.plot([count, count], [100 * d for d in q.delivered_cpp], "k^:")
+    delivered.plot([], [], "k^:", label="C++ bridge (issue 28, quoted)")
+    delivered.set_ylabel("delivered, % of offered")
+    for axes_ in axes.flat:
+        axes_.set_xlabel("robots")
+        axes_.grid(alpha=0.3)
+        axes_.legend(fontsize=7)
+    figure.suptitle("A fleet in one bridge process (issue 28)")
+    return _save(figure, FLEET_PNG)
 
 
 def _save(figure: Figure, relative: str) -> str:

@@ -23,6 +23,7 @@ RESULTS = Path(__file__).resolve().parent / "results.json"
 #: The plots drawn from them, relative to the repository root (BENCHMARKS.md links them so).
 SUSTAINED_PNG = "benchmarks/plots/sustained_1080p.png"
 COSTS_PNG = "benchmarks/plots/cpu_per_message.png"
+FLEET_PNG = "benchmarks/plots/fleet.png"
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """``make bench``: every benchmark in one go, each bounded, rewriting BENCHMARKS.md.
 
 Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
-about 20 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
+about 25 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
 Each module writes its own section; a module that fails is reported and the others still run.
 Last, the headline is rewritten from the figures stored by ``sustained``, ``costs`` and
 ``starvation`` (this run's, or their last run's when they were not run), and its plots drawn.
@@ -23,6 +23,7 @@ from benchmarks import (
     costs,
     discovery,
     first_call,
+    fleet,
     headline,
     images,
     memory,
@@ -68,6 +69,9 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
         ),
         "startup": lambda: startup.main(["--rounds", "3" if quick else "5"]),
         "first_call": lambda: first_call.main(["--runs", "5" if quick else "10"]),
+        "fleet": lambda: fleet.main(
+            ["--robots", "10", "25", "50", "--seconds", "5" if quick else "20"]
+        ),
         "memory": lambda: memory.main(
             ["--flood-seconds", "15" if quick else "60", "--slow-seconds", "8" if quick else "15"]
         ),

@@ -120,6 +120,19 @@ class GzEcho:
         return found
 
 
+def status_rows(bridge: PeerProcess, topics: Sequence[str]) -> list[str]:
+    """The rows (and explanations) of the bridge's status table that name ``topics``, after
+    the table's header: the bridge prints the table on SIGUSR1, which this sends."""
+    bridge.send_signal(signal.SIGUSR1)
+    time.sleep(1.0)
+    table = bridge.output().splitlines()
+    header = [line for line in table if "LIMITED" in line][-1:]
+    named = [
+        line for line in table if any(f"{topic}{end}" in line for topic in topics for end in " :")
+    ]
+    return header + named
+
+
 def parse_gz(type_name: str, text: str) -> Any:
     """Protobuf text of a ``<type_name>`` message as a gz-msgs 10 message."""
     return text_format.Parse(text, message_class(f"gz.msgs.{type_name}")())

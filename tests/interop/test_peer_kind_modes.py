@@ -1,4 +1,4 @@
-"""The C++ peer's typed benchmark modes (kind-pub, kind-sub) against our node.
+"""The C++ peer's benchmark modes (kind-pub, kind-sub, pub-fleet) against our node.
 
 The benchmarks put these modes at the Gazebo end of every ZeroMQ flow, so the stamp they write
 and read at a field path is what every latency figure rests on. Here our own node checks both:
@@ -8,6 +8,7 @@ and what the real subscriber reads back from messages we stamp.
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 from typing import Any
@@ -139,3 +140,52 @@ def test_kind_pub_floods_a_second_topic_from_the_same_process(
         assert info.msg_type == "gz.msgs.Image"
         msg.header.ClearField("stamp")
         assert msg == frame
+
+
+def test_pub_fleet_publishes_every_spec_line_at_its_rate_and_counts_what_it_subscribes(
+    ign_peer: Path, gz_node: Any, tmp_path: Path
+) -> None:
+    odometry, twist = message_class("gz.msgs.Odometry"), message_class("gz.msgs.Twist")
+    fast, slow, command = (unique_name(stem) for stem in ("fleet_fast", "fleet_slow", "fleet_cmd"))
+    spec = tmp_path / "fleet.spec"
+    spec.write_text(
+        "# a comment, then a blank line\n\n"
+        f"pub ignition.msgs.Odometry 200 {fast} pose {{ position {{ x: 1.5 }} }}\n"
+        f"pub ignition.msgs.Odometry 20 {slow} pose {{ position {{ x: -2.5 }} }}\n"
+        f"sub ignition.msgs.Twist {command}\n"
+    )
+    inboxes = {fast: Inbox(), slow: Inbox()}
+    for topic, inbox in inboxes.items():
+        gz_node.subscribe_typed(topic, odometry, inbox, msg_type="ignition.msgs.Odometry")
+    peer = start_peer("pub-fleet", str(spec), "0")
+    wait_for_line(peer, r"^READY$", 15)
+    publisher = gz_node.advertise(command, "ignition.msgs.Twist")
+    wait_until(publisher.has_connections, 10, "the peer's subscription")
+    deadline = time.monotonic() + 10
+    sent = 0
+    while "FIRST " not in peer.output() and time.monotonic() < deadline:
+        publisher.publish(twist(linear={"x": 0.75}))
+        sent += 1
+        time.sleep(0.05)
+    for inbox in inboxes.values():
+        inbox.wait_for_count(2, timeout=10)
+    peer.stop()
+
+    first = wait_for_line(peer, rf"^FIRST {command} (.*)$", 5)[1]
+    assert first == "linear { x: 0.75 }"
+    counts = {name: int(n) for name, n in re.findall(r"^SENT (\S+) (\d+)$", peer.output(), re.M)}
+    assert counts.keys() == {fast, slow}
+    assert counts[fast] > counts[slow] > 0  # each line at its own rate
+    received = int(wait_for_line(peer, rf"^RECEIVED {command} (\d+)$", 5)[1])
+    assert 0 < received <= sent
+    wait_for_line(peer, r"^DONE$", 5)
+    for topic, x in ((fast, 1.5), (slow, -2.5)):
+        assert {msg.pose.position.x for msg, _ in inboxes[topic].items()} == {x}
+
+
+def test_pub_fleet_names_the_spec_line_it_cannot_read(ign_peer: Path, tmp_path: Path) -> None:
+    spec = tmp_path / "fleet.spec"
+    spec.write_text("pub ignition.msgs.Clock 10 /clock\npublish ignition.msgs.Twist /x\n")
+    peer = start_peer("pub-fleet", str(spec), "1")
+    assert peer.wait(10) == 2
+    assert "spec line 2: starts with publish, not pub or sub" in peer.output()

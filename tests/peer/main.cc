@@ -18,6 +18,7 @@ constexpr char kUsage[] =
     "  pub TOPIC TYPE HZ COUNT [TEXTPROTO] [--bytes N] [--wait S] [--settle S] [--linger S]\n"
     "      [--wire-type WIRETYPE] [--field 'NUMBER TYPE TEXTPROTO']...\n"
     "  pub-many TYPE HZ TEXTPROTO TOPIC... [--wire-type WIRETYPE]\n"
+    "  pub-fleet SPECFILE SECONDS   (lines: pub TYPE HZ TOPIC TEXTPROTO | sub TYPE TOPIC)\n"
     "  echo TOPIC TYPE SECONDS [--count N] [--sha | --hex] [--wire-type WIRETYPE]\n"
     "  relay IN OUT TYPE SECONDS\n"
     "  reply SERVICE REQTYPE REPTYPE SECONDS [--fail] [--response TEXTPROTO] [--sha]\n"
@@ -34,6 +35,7 @@ constexpr char kUsage[] =
 int main(int argc, char **argv) {
   const std::map<std::string, int (*)(const peer::Args &)> modes = {
       {"pub", peer::RunPub},         {"pub-many", peer::RunPubMany},
+      {"pub-fleet", peer::RunPubFleet},
       {"echo", peer::RunEcho},
       {"relay", peer::RunRelay},     {"reply", peer::RunReply},
       {"call", peer::RunCall},       {"bench-pub", peer::RunBenchPub},

@@ -7,6 +7,7 @@ namespace peer {
 
 int RunPub(const Args &args);
 int RunPubMany(const Args &args);
+int RunPubFleet(const Args &args);
 int RunEcho(const Args &args);
 int RunRelay(const Args &args);
 int RunReply(const Args &args);

@@ -462,6 +462,25 @@ def test_turtlebot3_waffle_config_loads_unchanged() -> None:
     assert lines[-1] == f"{path} entry 8 (line 46)"
 
 
+def test_fleet_example_is_one_robot_file_per_robot_plus_the_clock() -> None:
+    """config/fleet_bridge.yaml (ours, one process) and config/fleet_robot.yaml (the C++
+    bridge's form, once per robot namespace) bridge the same topics."""
+    robots = ("robot_1", "robot_2")
+    fleet = read_yaml_file(EXAMPLES / "fleet_bridge.yaml", {"robot": robots})
+    assert (fleet.errors, fleet.warnings) == ((), ())
+    one_robot = _real_summary(EXAMPLES / "fleet_robot.yaml")
+    per_robot = [
+        (f"/{robot}/{ros}", f"/{robot}/{gz}", *rest)
+        for robot in robots
+        for ros, gz, *rest in one_robot
+    ]
+    clock = ("/clock", "/clock", "rosgraph_msgs/msg/Clock", "gz.msgs.Clock", Direction.GZ_TO_ROS)
+    fleet_topics = [
+        (s.ros_topic, s.gz_topic, s.ros_type, s.gz_type, s.direction) for s in _topics(fleet)
+    ]
+    assert sorted(fleet_topics) == sorted([clock, *per_robot])
+
+
 def test_diff_car_config_loads_unchanged() -> None:
     path = EXAMPLES / "diff_car_bridge.yaml"
     assert _real_summary(path) == [
