@@ -102,6 +102,7 @@ def write_spec(path: Path, names: list[str]) -> Path:
             for kind in KINDS
         ]
         lines.append(f"sub ignition.msgs.Twist {cmd_vel_topic(robot)}")
+    path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
