@@ -15,8 +15,9 @@ arrived per topic kind against what the schedule offered, the bridge's threads a
 end. ``cmd_vel``: what the simulator received of what the subscriber sent over the whole run.
 Beside it, the same run's rclpy ceiling: one rclpy process (``benchmarks.fleet_ros pub``)
 publishing the same ROS topics at the same rates, each message serialized once, with no
-Gazebo side and no conversion, to the same subscriber. The C++ bridge is not installable
-here: its figures are quoted from issue 28.
+Gazebo side and no conversion, to the same subscriber. Last, the largest fleet's bridge alone
+(no simulator, no subscriber): its CPU at rest. The C++ bridge is not installable here: its
+figures are quoted from issue 28.
 """
 
 from __future__ import annotations
@@ -52,6 +53,9 @@ GOAL_FLAT = 0.15
 GOAL_THREADS = 20
 GOAL_STARTUP_ROBOTS, GOAL_STARTUP_S = 25, 2.6
 GOAL_DELIVERED = 0.99
+GOAL_IDLE_PERCENT, GOAL_IDLE_ENTRIES = 1.0, 100
+#: Seconds between an idle bridge's start and its measured window (its channels exist).
+IDLE_SETTLE = 5.0
 
 
 @dataclass(frozen=True)
@@ -262,6 +266,41 @@ def ceiling_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
     )
 
 
+@dataclass(frozen=True)
+class Idle:
+    """The bridge of a fleet's YAML with nothing on either side: its own cost at rest."""
+
+    robots: int
+    cpu: float
+    threads: int
+    rss: float
+
+    @property
+    def entries(self) -> int:
+        return 1 + 4 * self.robots
+
+
+def idle_round(robots: int, seconds: float) -> Idle:
+    """The fleet's bridge alone, no simulator, no subscriber: CPU over ``seconds``."""
+    print(f"== idle bridge of {robots} robots", file=sys.stderr)
+    env = {**bench_env(), "PYTHONPATH": str(ROOT)}
+    names = fleet_sim.robots(robots)
+    try:
+        bridge = start_process(
+            [str(BIN / "parameter_bridge"), *fleet_sim.bridge_arguments(names)], env
+        )
+        time.sleep(IDLE_SETTLE)
+        window = CpuWindow(bridge.pid)
+        window.begin()
+        time.sleep(seconds)
+        window.end()
+        result = Idle(robots, window.percent or 0.0, _threads(bridge.pid), rss_mb(bridge.pid))
+    finally:
+        stop_all()
+    print(result, file=sys.stderr, flush=True)
+    return result
+
+
 def run(robots: int, seconds: float, ceiling: bool) -> Round:
     """One round; a round that fails is reported with its error and the others go on."""
     print(f"== fleet of {robots}, {'ceiling' if ceiling else 'bridge'}", file=sys.stderr)
@@ -296,7 +335,7 @@ def _quoted_cell(low: float, high: float, *, unit: str = "") -> str:
     return f"{low:g}{unit}" if low == high else f"{low:g}-{high:g}{unit}"
 
 
-def goal_lines(rows: Sequence[Round]) -> list[str]:
+def goal_lines(rows: Sequence[Round], idle: Idle | None = None) -> list[str]:
     """Issue 28's goals, each judged on this run's rows."""
     bridge = {row.robots: row for row in rows if not row.ceiling and not row.error}
     lines = []
@@ -348,10 +387,18 @@ def goal_lines(rows: Sequence[Round]) -> list[str]:
         None if largest_row is None else largest_row.delivered["clock"] >= GOAL_DELIVERED,
         "-" if largest_row is None else _percent(largest_row.delivered["clock"]),
     )
+    if idle is not None:
+        judge(
+            f"an idle bridge of {GOAL_IDLE_ENTRIES}+ entries < {GOAL_IDLE_PERCENT:g}% of a core",
+            idle.entries >= GOAL_IDLE_ENTRIES and idle.cpu < GOAL_IDLE_PERCENT,
+            f"{idle.cpu:.2f}% ({idle.entries} entries)",
+        )
     return lines
 
 
-def report(rows: Sequence[Round], args: argparse.Namespace, load: float, plot: str) -> str:
+def report(
+    rows: Sequence[Round], idle: Idle | None, args: argparse.Namespace, load: float, plot: str
+) -> str:
     robots = " ".join(str(n) for n in args.robots)
     lines = [
         "## A fleet in one process (issue 28)",
@@ -438,14 +485,36 @@ def report(rows: Sequence[Round], args: argparse.Namespace, load: float, plot: s
             f"| {_quoted_cell(*[100 * d for d in quoted.delivered_cpp], unit='%')} "
             f"| {quoted.threads_cpp} | {quoted.rss_cpp:g} |"
         )
-    lines += ["", "Issue 28's goals, on this run:", "", *goal_lines(rows), "", f"![fleet]({plot})"]
+    if idle is not None:
+        lines += [
+            "",
+            f"At rest: the bridge of the {idle.robots}-robot YAML ({idle.entries} entries, the "
+            "Gazebo -> ROS ones and `cmd_vel` ROS -> Gazebo native) with no simulator and no "
+            f"subscriber, measured over {args.idle_seconds:g} s after {IDLE_SETTLE:g} s: "
+            f"**{idle.cpu:.2f}% of a core**, {idle.threads} threads, {idle.rss:.0f} MB.",
+        ]
+    lines += [
+        "",
+        "Issue 28's goals, on this run:",
+        "",
+        *goal_lines(rows, idle),
+        "",
+        f"![fleet]({plot})",
+    ]
     return "\n".join(lines)
 
 
-def numbers(rows: Sequence[Round]) -> dict[str, float]:
+def numbers(rows: Sequence[Round], idle: Idle | None = None) -> dict[str, float]:
     """This run's figures for ``benchmarks/results.json`` (``fleet<N>.<figure>``; the
-    ceiling's as ``ceiling<N>.<figure>``)."""
+    ceiling's as ``ceiling<N>.<figure>``; the idle bridge's as ``idle<N>.<figure>``)."""
     stored: dict[str, float] = {}
+    if idle is not None:
+        key = f"idle{idle.robots}"
+        stored |= {
+            f"{key}.cpu_percent": round(idle.cpu, 3),
+            f"{key}.threads": idle.threads,
+            f"{key}.rss_mb": round(idle.rss, 1),
+        }
     for row in rows:
         if row.error:
             continue
@@ -470,14 +539,18 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", type=int, nargs="+", default=[10, 25, 50])
     parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument(
+        "--idle-seconds", type=float, default=20.0, help="the idle bridge's window; 0: none"
+    )
     args = parser.parse_args(argv)
     load = os.getloadavg()[0]
     rows = [run(count, args.seconds, ceiling) for count in args.robots for ceiling in (False, True)]
-    store("fleet", {}, load, numbers(rows))
+    idle = idle_round(max(args.robots), args.idle_seconds) if args.idle_seconds > 0 else None
+    store("fleet", {}, load, numbers(rows, idle))
     from benchmarks.plots import fleet_plot  # noqa: PLC0415 - matplotlib, the bench extra
 
     plot = fleet_plot(rows, ISSUE_28)
-    write_section("fleet", report(rows, args, load, plot))
+    write_section("fleet", report(rows, idle, args, load, plot))
     return 0
 
 

@@ -70,7 +70,11 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
         "startup": lambda: startup.main(["--rounds", "3" if quick else "5"]),
         "first_call": lambda: first_call.main(["--runs", "5" if quick else "10"]),
         "fleet": lambda: fleet.main(
-            ["--robots", "10", "25", "50", "--seconds", "5" if quick else "20"]
+            [
+                *("--robots", "10", "25", "50"),
+                *("--seconds", "5" if quick else "20"),
+                *("--idle-seconds", "5" if quick else "20"),
+            ]
         ),
         "memory": lambda: memory.main(
             ["--flood-seconds", "15" if quick else "60", "--slow-seconds", "8" if quick else "15"]
