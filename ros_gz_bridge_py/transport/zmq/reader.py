@@ -228,10 +228,12 @@ class SubscriptionReader:
         native = self._native
         if self._closed or native is None:
             return None
-        if broken:  # the node went away without closing us
+        if broken:  # the context went away without closing us: closed here, as a thread would
             self._count("io_errors")
-            _LOG.warning("the socket of %s cannot be read any more; it is no longer read", self.fqn)
+            _LOG.warning("the socket of %s cannot be read any more; it is closed", self.fqn)
+            self._closed = True
             native.detach()
+            self._release()
             return None
         while self._posted:
             self._posted.popleft()()
