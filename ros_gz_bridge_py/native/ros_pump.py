@@ -181,6 +181,6 @@ class RosChannelPump:
         if failure:
             self._failed(
                 f"its Gazebo socket failed ({zmq.strerror(failure)}); the channel takes no "
-                "more messages until it restarts"
+                "more ROS messages (restart the bridge)"
             )
             self.close()
