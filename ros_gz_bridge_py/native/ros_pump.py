@@ -130,8 +130,16 @@ class RosChannelPump:
             watch_own_publishers(self.wake),
             publisher.before_close(self.close),
         )
-        with self._subscription.handle:
+        # In use while attached: a destroy meanwhile (rclpy's) waits for close.
+        self._in_use = contextlib.ExitStack()
+        self._in_use.enter_context(subscription.handle)
+        try:
             self._loop.attach(self)
+        except Exception:
+            self._in_use.close()
+            for unwatch in self._unwatch:
+                unwatch()
+            raise
 
     def __repr__(self) -> str:
         return f"<native ROS -> Gazebo channel {self.name}>"
@@ -152,6 +160,7 @@ class RosChannelPump:
         for unwatch in self._unwatch:
             unwatch()
         self._loop.detach(self)
+        self._in_use.close()
 
     def sync(self) -> None:
         """Tell the C side the spellings subscribers take and the publishers to skip."""
