@@ -34,7 +34,7 @@
 /* The epoll token of the wake-up fd (a channel's is its slot and generation, never this). */
 #define WAKE_TOKEN UINT64_MAX
 
-enum { RUN_TIMEOUT = 0, RUN_WAKE = 1, RUN_HANDED = 2, RUN_STOPPED = 3 };
+enum { RUN_TIMEOUT = 0, RUN_WAKE = 1, RUN_HANDED = 2, RUN_FAILED = 3 };
 
 typedef struct {
     PyObject_HEAD
@@ -49,7 +49,6 @@ typedef struct {
     int *moved; /* slots that moved since `run` last returned */
     int nmoved;
     int running;
-    volatile int stopping;
     int error; /* an errno that ended a run: epoll itself failed */
 } RosLoopObject;
 
@@ -149,14 +148,13 @@ static int loop(RosLoopObject *self, long timeout_ms) {
     int64_t deadline = monotonic_ms() + timeout_ms;
     struct epoll_event events[MAX_EVENTS];
     for (;;) {
-        if (self->stopping) return RUN_STOPPED;
         int64_t left = deadline - monotonic_ms();
         int wait = self->nready ? 0 : (left > 0 ? (int)left : 0);
         int n = epoll_wait(self->epoll_fd, events, MAX_EVENTS, wait);
         if (n < 0) {
             if (errno == EINTR) continue;
             self->error = errno;
-            return RUN_STOPPED;
+            return RUN_FAILED;
         }
         int woke = 0;
         pthread_mutex_lock(&self->lock);
@@ -337,8 +335,8 @@ static PyObject *ros_loop_remove(RosLoopObject *self, PyObject *object) {
 }
 
 /* run(timeout_ms) -> (status, [(pump, refused CDR messages, failure errno)]): one run of the
- * loop (GIL released) and what moved. status: 0 timeout, 1 woken, 2 something for Python,
- * 3 stopped. */
+ * loop (GIL released) and what moved. status: 0 timeout, 1 woken, 2 something for Python; an
+ * OSError if epoll itself failed. */
 static PyObject *ros_loop_run(RosLoopObject *self, PyObject *arg) {
     if (!usable(self)) return NULL;
     long timeout_ms = PyLong_AsLong(arg);
@@ -394,12 +392,6 @@ static PyObject *ros_loop_wake(RosLoopObject *self, PyObject *unused) {
     Py_RETURN_NONE;
 }
 
-/* stop(): the current and every later run return at once. */
-static PyObject *ros_loop_stop(RosLoopObject *self, PyObject *unused) {
-    self->stopping = 1;
-    return ros_loop_wake(self, unused);
-}
-
 static PyObject *ros_loop_size(RosLoopObject *self, PyObject *unused) {
     (void)unused;
     if (!usable(self)) return NULL;
@@ -417,7 +409,6 @@ static PyMethodDef ros_loop_methods[] = {
     {"run", (PyCFunction)ros_loop_run, METH_O,
      "run(timeout_ms) -> (status, [(pump, refused, failure)]), the GIL released"},
     {"wake", (PyCFunction)ros_loop_wake, METH_NOARGS, "end the current run soon"},
-    {"stop", (PyCFunction)ros_loop_stop, METH_NOARGS, "end every run at once from now on"},
     {"size", (PyCFunction)ros_loop_size, METH_NOARGS, "how many channels are attached"},
     {NULL, NULL, 0, NULL},
 };

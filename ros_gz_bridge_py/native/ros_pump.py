@@ -133,6 +133,7 @@ class RosChannelPump:
         # In use while attached: a destroy meanwhile (rclpy's) waits for close.
         self._in_use = contextlib.ExitStack()
         self._in_use.enter_context(subscription.handle)
+        self.sync()  # before the loop takes a message: a subscriber's spelling is not missed
         try:
             self._loop.attach(self)
         except Exception:

@@ -274,11 +274,19 @@ def test_an_interrupted_frame_is_sent_again(native: Any, channels: Callable[...,
     loop.remove(channel.pump)
 
 
-def test_a_stopped_loop_returns_at_once(native: Any, channels: Callable[..., Channel]) -> None:
+def test_a_round_gives_each_channel_its_budget_and_a_wake_ends_the_run_after_it(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
     loop = native.RosLoop()
-    channel = channels("stopped")
-    loop.add(channel.pump)
-    channel.remove_from(loop)
-    loop.stop()
-    assert loop.run(60_000)[0] == 3
-    loop.remove(channel.pump)
+    flooded = [channels("flood_a"), channels("flood_b")]
+    for channel in flooded:
+        for index in range(100):
+            channel.publish(f"flood {index}")
+    time.sleep(0.5)  # the samples reach both subscriptions' queues (100 deep)
+    for channel in flooded:
+        loop.add(channel.pump)  # each add also wakes the loop
+        channel.remove_from(loop)
+    status, _moved = loop.run(60_000)
+    assert status == 1  # woken: returned after one round, the backlog still queued
+    assert [channel.pump.counts()[0] for channel in flooded] == [64, 64]
+    run_until(loop, lambda _m: all(c.pump.counts()[0] == 100 for c in flooded), "the rest")
