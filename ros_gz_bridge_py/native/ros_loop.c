@@ -267,7 +267,7 @@ static PyObject *ros_loop_add(RosLoopObject *self, PyObject *object) {
     }
     RosPumpObject *pump = (RosPumpObject *)object;
     if (pump->attached || pump->event_fd < 0) {
-        PyErr_SetString(PyExc_ValueError, "the RosPump is attached to a loop already");
+        PyErr_SetString(PyExc_ValueError, "the RosPump is attached to a loop already, or has no eventfd");
         return NULL;
     }
     lock_released(self);
