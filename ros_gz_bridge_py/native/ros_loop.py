@@ -62,12 +62,9 @@ class RosLoop:
         self._thread = threading.Thread(target=self._run, name="ros-loop", daemon=True)
         self._thread.start()
 
-    @property
-    def thread(self) -> threading.Thread:
-        return self._thread
-
     def attach(self, channel: LoopChannel) -> None:
-        """Serve ``channel`` from now on; its first turn syncs it."""
+        """Serve ``channel`` from now on (synced once more on the loop's thread, for a change
+        made while it joined)."""
         with self._lock:
             self._channels[channel.pump] = channel
             self._pending.add(channel)

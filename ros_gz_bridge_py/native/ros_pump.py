@@ -153,15 +153,16 @@ class RosChannelPump:
 
     def close(self) -> None:
         """Take the channel off the loop and stop rcl's callback; idempotent. The
-        subscription and the publisher's socket may go after."""
+        subscription and the publisher's socket may go after: a second caller (the channel
+        and the node's close at once) returns only when the first is done."""
         with self._close_lock:
             if self._closed:
                 return
             self._closed = True
-        for unwatch in self._unwatch:
-            unwatch()
-        self._loop.detach(self)
-        self._in_use.close()
+            for unwatch in self._unwatch:
+                unwatch()
+            self._loop.detach(self)
+            self._in_use.close()
 
     def sync(self) -> None:
         """Tell the C side the spellings subscribers take and the publishers to skip."""
@@ -193,4 +194,6 @@ class RosChannelPump:
                 f"its Gazebo socket failed ({zmq.strerror(failure)}); the channel takes no "
                 "more ROS messages (restart the bridge)"
             )
-            self.close()
+            # Off the loop now; the rest when the channel closes. Not close(): a close
+            # waiting for this turn on another thread holds its lock.
+            self._loop.detach(self)
