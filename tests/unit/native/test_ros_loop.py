@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import ctypes
 import errno
+import threading
 import time
 import uuid
 from collections.abc import Callable, Iterator
@@ -290,3 +291,40 @@ def test_a_round_gives_each_channel_its_budget_and_a_wake_ends_the_run_after_it(
     assert status == 1  # woken: returned after one round, the backlog still queued
     assert [channel.pump.counts()[0] for channel in flooded] == [64, 64]
     run_until(loop, lambda _m: all(c.pump.counts()[0] == 100 for c in flooded), "the rest")
+
+
+def test_channels_join_and_leave_while_the_loop_runs_and_the_others_keep_flowing(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
+    loop = native.RosLoop()
+    steady, churned = channels("steady"), channels("churned")
+    loop.add(steady.pump)
+    steady.remove_from(loop)
+    churned.remove_from(loop)
+    stop = threading.Event()
+
+    def run() -> None:
+        while not stop.is_set():
+            loop.run(20)
+
+    runner = threading.Thread(target=run, name="test-loop", daemon=True)
+    runner.start()
+    try:
+        for index in range(50):
+            assert loop.add(churned.pump) is None
+            for k in range(20):
+                churned.publish(f"churn {index} {k}")
+            steady.publish(f"steady {index}")
+            assert loop.remove(churned.pump) is True
+        deadline = time.monotonic() + WAIT
+        while steady.pump.counts()[3] < 50 and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        stop.set()
+        runner.join()
+    assert steady.pump.counts()[3] == 50
+    assert loop.size() == 1
+    texts = [m[2] for m in steady.messages(50)]
+    assert texts == [
+        b"\x12" + bytes([len(t)]) + t for t in (f"steady {i}".encode() for i in range(50))
+    ]
