@@ -15,6 +15,7 @@ NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/encode.c",
     "ros_gz_bridge_py/native/loop.c",
     "ros_gz_bridge_py/native/pump.c",
+    "ros_gz_bridge_py/native/ros_loop.c",
     "ros_gz_bridge_py/native/ros_pump.c",
     "ros_gz_bridge_py/native/transcode.c",
 ]
@@ -27,6 +28,7 @@ setup(
             depends=[
                 "ros_gz_bridge_py/native/encode.h",
                 "ros_gz_bridge_py/native/pump.h",
+                "ros_gz_bridge_py/native/ros_pump.h",
                 "ros_gz_bridge_py/native/transcode.h",
                 "ros_gz_bridge_py/native/wire.h",
             ],

@@ -142,20 +142,31 @@ class RosToGzChannel(Channel):
             max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
             refused=self._convert_and_publish,
             counted=self._counted,
+            failed=self._native_failed,
             own_publishers=own.rcl_publishers,
             watch_own_publishers=own.watch_rcl_publishers,
             name=self.spec.gz_topic,
         )
 
-    def _counted(self, received: int, own_skipped: int, rate_limited: int, published: int) -> None:
-        """What the native loop did since it last said (on its thread)."""
+    def _counted(
+        self, received: int, own_skipped: int, rate_limited: int, published: int, send_failures: int
+    ) -> None:
+        """What the native loop did since it last said (on its thread); a message whose send
+        failed counts among the node's ``send_failures``, as on the Python path."""
         stats = self.stats
         stats.received += received
         stats.own_skipped += own_skipped
         stats.rate_limited += rate_limited
         stats.published += published
+        if send_failures:
+            self.ctx.gz_node.count("send_failures", send_failures)
         if published and not self._announced:
             self._announce()
+
+    def _native_failed(self, reason: str) -> None:
+        """The native loop took the channel off: said, and kept as the channel's last error."""
+        self.stats.last_error = reason
+        self._logger.error(f"{self.describe()}: {reason}")
 
     def _close_input(self) -> None:
         if self._pump is not None:

@@ -1,18 +1,18 @@
-/* The per-message loop of a native ROS -> Gazebo channel (docs/native.md §7).
+/* One native ROS -> Gazebo channel (docs/native.md §7).
  *
- * Run by the channel's own thread with the GIL released: rcl tells of new messages through the
- * subscription's on-new-message callback (an eventfd), each message is taken serialized from
- * the rclpy subscription's rcl handle, skipped when one of the bridge's own publishers on the
- * topic wrote it (by publisher GID, as the C++ bridge does), passed through max_rate, encoded
- * (encode.c) in each spelling Gazebo subscribers take and sent as the four data frames on the
- * channel's own ZeroMQ PUB socket. No Python runs per message; what an encoder leaves to Python
- * is handed back, and Python converts it as without the native path. rcl, rmw, rcutils and
- * libzmq functions come from the libraries rclpy and pyzmq loaded (ros_pump.py). */
+ * Driven by the process's shared loop (ros_loop.c) with the GIL released: rcl tells of new
+ * messages through the subscription's on-new-message callback (an eventfd), each message is
+ * taken serialized from the rclpy subscription's rcl handle, skipped when one of the bridge's
+ * own publishers on the topic wrote it (by publisher GID, as the C++ bridge does), passed
+ * through max_rate, encoded (encode.c) in each spelling Gazebo subscribers take and sent as the
+ * four data frames on the channel's own ZeroMQ PUB socket. No Python runs per message; what an
+ * encoder leaves to Python is handed back, and Python converts it as without the native path.
+ * rcl, rmw, rcutils and libzmq functions come from the libraries rclpy and pyzmq loaded
+ * (ros_pump.py). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
-#include <poll.h>
-#include <pthread.h>
+#include <errno.h>
 #include <stdint.h>
 #include <string.h>
 #include <sys/eventfd.h>
@@ -21,85 +21,12 @@
 
 #include "encode.h"
 #include "pump.h"
-
-/* rcutils_allocator_t, rcl_serialized_message_t, rmw_gid_t and rmw_message_info_t as Jazzy's
- * headers lay them out. */
-typedef struct {
-    void *(*allocate)(size_t size, void *state);
-    void (*deallocate)(void *pointer, void *state);
-    void *(*reallocate)(void *pointer, size_t size, void *state);
-    void *(*zero_allocate)(size_t count, size_t size, void *state);
-    void *state;
-} rcu_allocator;
-
-typedef struct {
-    uint8_t *buffer;
-    size_t buffer_length;
-    size_t buffer_capacity;
-    rcu_allocator allocator;
-} rcl_bytes;
-
-#define GID_SIZE 16
-typedef struct {
-    const char *implementation_identifier;
-    uint8_t data[GID_SIZE];
-} rmw_gid;
-
-typedef struct {
-    int64_t source_timestamp;
-    int64_t received_timestamp;
-    uint64_t publication_sequence_number;
-    uint64_t reception_sequence_number;
-    rmw_gid publisher_gid;
-    _Bool from_intra_process;
-} rmw_info;
-
-typedef void (*event_callback)(const void *user_data, size_t number_of_events);
-
-struct ros_foreign {
-    int (*take)(const void *subscription, rcl_bytes *message, rmw_info *info, void *allocation);
-    int (*set_callback)(const void *subscription, event_callback callback, const void *user_data);
-    void (*reset_error)(void);
-    rcu_allocator (*default_allocator)(void);
-    void *(*publisher_rmw_handle)(const void *publisher);
-    int (*gid_for_publisher)(const void *rmw_publisher, rmw_gid *gid);
-    int (*send)(void *socket, const void *buffer, size_t length, int flags);
-};
+#include "ros_pump.h"
 
 enum { RCL_TAKE_FAILED = 401, ZMQ_SNDMORE_ = 2, ZMQ_DONTWAIT_ = 1 };
-#define BATCH 256
-#define MAX_SPELLINGS 4
-#define MAX_IGNORED 16
 #define INITIAL_CAPACITY 4096
-
-struct spelling {
-    uint8_t *type, *topic, *sender;
-    size_t type_len, topic_len, sender_len;
-    struct rgb_encoder *encoder;
-    int active;
-};
-
-typedef struct {
-    PyObject_HEAD
-    struct ros_foreign f;
-    void *subscription;
-    void *sock;
-    int event_fd;
-    int callback_set;
-    int running;
-    PyObject *encoders; /* list: keeps the Encoder objects alive */
-    struct spelling spellings[MAX_SPELLINGS];
-    int nspellings;
-    rcl_bytes message;
-    struct rgb_out out[MAX_SPELLINGS];
-    uint8_t ignored[MAX_IGNORED][GID_SIZE];
-    int nignored;
-    int64_t period_ns, next_ns;
-    unsigned long long received, own_skipped, rate_limited, published, take_errors;
-    uint8_t **refused;
-    size_t *refused_len;
-    size_t nrefused, refused_cap;
-} RosPumpObject;
+/* Retries of a frame send that a signal interrupted. */
+#define EINTR_RETRIES 8
 
 static int64_t monotonic_ns(void) {
     struct timespec t;
@@ -134,8 +61,8 @@ static void refuse(RosPumpObject *self, const uint8_t *cdr, size_t len) {
     if (self->nrefused == self->refused_cap) {
         size_t cap = self->refused_cap ? self->refused_cap * 2 : 16;
         uint8_t **grown = realloc(self->refused, cap * sizeof *grown);
-        size_t *grown_len = realloc(self->refused_len, cap * sizeof *grown_len);
         if (grown != NULL) self->refused = grown;
+        size_t *grown_len = realloc(self->refused_len, cap * sizeof *grown_len);
         if (grown_len != NULL) self->refused_len = grown_len;
         if (grown == NULL || grown_len == NULL) return;
         self->refused_cap = cap;
@@ -147,18 +74,45 @@ static void refuse(RosPumpObject *self, const uint8_t *cdr, size_t len) {
     self->refused_len[self->nrefused++] = len;
 }
 
-static void send_frames(RosPumpObject *self, const struct spelling *s, const struct rgb_out *out) {
-    void *sock = self->sock;
+/* One frame; 0, or libzmq's errno. An interrupted send is tried again: PUB with ZMQ_DONTWAIT
+ * never blocks (a subscriber over its high-water mark loses the message, as with the Python
+ * path), so what remains are a signal, a closed socket (ENOTSOCK) or a terminated context. */
+static int send_frame(RosPumpObject *self, const void *data, size_t len, int flags) {
+    for (int attempt = 0;; attempt++) {
+        if (self->f.send(self->sock, data, len, flags | ZMQ_DONTWAIT_) >= 0) return 0;
+        int error = errno;
+        if (error != EINTR || attempt == EINTR_RETRIES) return error ? error : EIO;
+    }
+}
+
+/* The four data frames of one message. A failed first frame sent nothing: the message is
+ * counted as a send failure. A later frame that fails would leave a part of a multipart
+ * message in the socket, which the next message would complete into a wrong one: the socket
+ * is not used again (`failure`). Returns 1 when sent. */
+static int send_frames(RosPumpObject *self, const struct spelling *s, const struct rgb_out *out) {
     const char *empty = "";
-    self->f.send(sock, s->topic, s->topic_len, ZMQ_SNDMORE_ | ZMQ_DONTWAIT_);
-    self->f.send(sock, s->sender, s->sender_len, ZMQ_SNDMORE_ | ZMQ_DONTWAIT_);
-    self->f.send(sock, out->len ? (const void *)out->data : empty, out->len,
-                 ZMQ_SNDMORE_ | ZMQ_DONTWAIT_);
-    self->f.send(sock, s->type, s->type_len, ZMQ_DONTWAIT_);
+    int error = send_frame(self, s->topic, s->topic_len, ZMQ_SNDMORE_);
+    if (error) {
+        self->send_failures++;
+        if (error != EAGAIN) self->failure = error;
+        return 0;
+    }
+    error = send_frame(self, s->sender, s->sender_len, ZMQ_SNDMORE_);
+    if (!error)
+        error = send_frame(self, out->len ? (const void *)out->data : empty, out->len,
+                           ZMQ_SNDMORE_);
+    if (!error) error = send_frame(self, s->type, s->type_len, 0);
+    if (error) {
+        self->send_failures++;
+        self->failure = error;
+        return 0;
+    }
+    return 1;
 }
 
 /* One taken message: encoded in the configured spelling (the first) and in each spelling a
- * subscriber takes, then sent in the latter; or handed to Python. */
+ * subscriber takes, then sent in the latter; or handed to Python. Published when every send
+ * went out. */
 static void deliver(RosPumpObject *self, const uint8_t *cdr, size_t len) {
     int encoded[MAX_SPELLINGS] = {0};
     for (int i = 0; i < self->nspellings; i++) {
@@ -177,18 +131,18 @@ static void deliver(RosPumpObject *self, const uint8_t *cdr, size_t len) {
         }
         encoded[i] = 1;
     }
-    for (int i = 0; i < self->nspellings; i++) {
+    int sent_all = 1;
+    for (int i = 0; i < self->nspellings && !self->failure; i++) {
         struct spelling *s = &self->spellings[i];
         if (!s->active) continue;
-        send_frames(self, s, &self->out[encoded[i] >= 2 ? encoded[i] - 2 : i]);
+        if (!send_frames(self, s, &self->out[encoded[i] >= 2 ? encoded[i] - 2 : i])) sent_all = 0;
     }
-    self->published++;
+    if (sent_all && !self->failure) self->published++;
 }
 
-/* Takes what waits (at most BATCH messages); how many were taken. */
-static int drain(RosPumpObject *self) {
+int ros_pump_drain(RosPumpObject *self, int budget) {
     int taken = 0;
-    while (taken < BATCH) {
+    while (taken < budget && !self->failure) {
         rmw_info info;
         memset(&info, 0, sizeof info);
         self->message.buffer_length = 0;
@@ -214,36 +168,17 @@ static int drain(RosPumpObject *self) {
     return taken;
 }
 
-enum { EVENT_WAKE = 1, EVENT_HANDED = 4 };
-
-static int ros_loop(RosPumpObject *self, int wake_fd, long timeout_ms) {
-    int64_t deadline = monotonic_ns() + (int64_t)timeout_ms * 1000000LL;
-    for (;;) {
-        int taken = drain(self);
-        if (self->nrefused) return EVENT_HANDED;
-        int64_t left = deadline - monotonic_ns();
-        if (left <= 0) return 0;
-        if (taken == BATCH) continue;
-        struct pollfd fds[2] = {{self->event_fd, POLLIN, 0}, {wake_fd, POLLIN, 0}};
-        int ready = poll(fds, 2, (int)((left + 999999) / 1000000));
-        if (ready < 0) return 0;
-        if (fds[0].revents & POLLIN) {
-            uint64_t count;
-            ssize_t got = read(self->event_fd, &count, sizeof count);
-            (void)got;
-        }
-        if (fds[1].revents) return EVENT_WAKE;
+int ros_pump_set_callback(RosPumpObject *self) {
+    if (self->callback_set) return 0;
+    if (self->f.set_callback(self->subscription, on_new_message, self) != 0) {
+        self->f.reset_error();
+        return -1;
     }
+    self->callback_set = 1;
+    return 0;
 }
 
-/* ---- Python ------------------------------------------------------------------------------------ */
-
-static void clear_refused(RosPumpObject *self) {
-    for (size_t i = 0; i < self->nrefused; i++) free(self->refused[i]);
-    self->nrefused = 0;
-}
-
-static void stop_callback(RosPumpObject *self) {
+void ros_pump_clear_callback(RosPumpObject *self) {
     if (self->callback_set) {
         self->f.set_callback(self->subscription, NULL, NULL);
         self->f.reset_error();
@@ -251,8 +186,28 @@ static void stop_callback(RosPumpObject *self) {
     }
 }
 
+void ros_pump_clear_refused(RosPumpObject *self) {
+    for (size_t i = 0; i < self->nrefused; i++) free(self->refused[i]);
+    self->nrefused = 0;
+}
+
+/* ---- Python ------------------------------------------------------------------------------------ */
+
+static PyTypeObject RosPumpType;
+
+int ros_pump_check(PyObject *object) {
+    return PyObject_TypeCheck(object, &RosPumpType) && ((RosPumpObject *)object)->ready;
+}
+
+/* Every method first: an object made by __new__ alone has no functions to call. */
+static int initialised(RosPumpObject *self) {
+    if (self->ready) return 1;
+    PyErr_SetString(PyExc_RuntimeError, "the RosPump is not initialised (call __init__)");
+    return 0;
+}
+
 static void ros_pump_dealloc(RosPumpObject *self) {
-    stop_callback(self);
+    if (self->ready) ros_pump_clear_callback(self);
     if (self->event_fd >= 0) close(self->event_fd);
     if (self->message.buffer != NULL)
         self->message.allocator.deallocate(self->message.buffer, self->message.allocator.state);
@@ -262,7 +217,7 @@ static void ros_pump_dealloc(RosPumpObject *self) {
         free(self->spellings[i].sender);
     }
     for (int i = 0; i < MAX_SPELLINGS; i++) rgb_out_free(&self->out[i]);
-    clear_refused(self);
+    ros_pump_clear_refused(self);
     free(self->refused);
     free(self->refused_len);
     Py_XDECREF(self->encoders);
@@ -271,7 +226,10 @@ static void ros_pump_dealloc(RosPumpObject *self) {
 
 static PyObject *ros_pump_new(PyTypeObject *type, PyObject *args, PyObject *kwds) {
     RosPumpObject *self = (RosPumpObject *)type->tp_alloc(type, 0);
-    if (self != NULL) self->event_fd = -1;
+    if (self != NULL) {
+        self->event_fd = -1;
+        self->slot = -1;
+    }
     (void)args;
     (void)kwds;
     return (PyObject *)self;
@@ -356,34 +314,13 @@ static int ros_pump_init(RosPumpObject *self, PyObject *args, PyObject *kwds) {
     self->sock = (void *)(uintptr_t)sock;
     self->period_ns = max_rate > 0 ? (int64_t)(1e9 / max_rate) : 0;
     self->next_ns = INT64_MIN;
+    self->ready = 1;
     return 0;
-}
-
-static PyObject *ros_pump_start(RosPumpObject *self, PyObject *unused) {
-    (void)unused;
-    if (!self->callback_set) {
-        if (self->f.set_callback(self->subscription, on_new_message, self) != 0) {
-            self->f.reset_error();
-            PyErr_SetString(PyExc_RuntimeError, "rcl refused the on-new-message callback");
-            return NULL;
-        }
-        self->callback_set = 1;
-    }
-    Py_RETURN_NONE;
-}
-
-static PyObject *ros_pump_stop(RosPumpObject *self, PyObject *unused) {
-    (void)unused;
-    if (self->running) {
-        PyErr_SetString(PyExc_RuntimeError, "stop while the pump runs");
-        return NULL;
-    }
-    stop_callback(self);
-    Py_RETURN_NONE;
 }
 
 /* set_active(types): the spellings Gazebo subscribers take now. */
 static PyObject *ros_pump_set_active(RosPumpObject *self, PyObject *types) {
+    if (!initialised(self)) return NULL;
     if (!PyFrozenSet_Check(types) && !PySet_Check(types)) {
         PyErr_SetString(PyExc_TypeError, "a set of type names (bytes)");
         return NULL;
@@ -403,6 +340,7 @@ static PyObject *ros_pump_set_active(RosPumpObject *self, PyObject *types) {
 /* ignore(publishers): skip what these rcl publishers (the bridge's own, on the same topic)
  * wrote. */
 static PyObject *ros_pump_ignore(RosPumpObject *self, PyObject *publishers) {
+    if (!initialised(self)) return NULL;
     PyObject *sequence = PySequence_Fast(publishers, "a sequence of rcl publisher addresses");
     if (sequence == NULL) return NULL;
     Py_ssize_t n = PySequence_Fast_GET_SIZE(sequence);
@@ -427,50 +365,20 @@ static PyObject *ros_pump_ignore(RosPumpObject *self, PyObject *publishers) {
     return PyLong_FromLong(count);
 }
 
-/* run(wake_fd, timeout_ms) -> (events, refused CDR messages) */
-static PyObject *ros_pump_run(RosPumpObject *self, PyObject *args) {
-    int wake_fd;
-    long timeout_ms;
-    if (!PyArg_ParseTuple(args, "il", &wake_fd, &timeout_ms)) return NULL;
-    if (self->running || !self->callback_set) {
-        PyErr_SetString(PyExc_RuntimeError, "the pump runs already, or was not started");
-        return NULL;
-    }
-    self->running = 1;
-    int events;
-    Py_BEGIN_ALLOW_THREADS;
-    events = ros_loop(self, wake_fd, timeout_ms < 0 ? 0 : timeout_ms);
-    Py_END_ALLOW_THREADS;
-    self->running = 0;
-    PyObject *refused = PyList_New((Py_ssize_t)self->nrefused);
-    for (size_t i = 0; refused != NULL && i < self->nrefused; i++) {
-        PyObject *cdr =
-            PyBytes_FromStringAndSize((char *)self->refused[i], (Py_ssize_t)self->refused_len[i]);
-        if (cdr == NULL) Py_CLEAR(refused);
-        else PyList_SET_ITEM(refused, (Py_ssize_t)i, cdr);
-    }
-    clear_refused(self);
-    if (refused == NULL) return NULL;
-    return Py_BuildValue("(iN)", events, refused);
-}
-
 static PyObject *ros_pump_counts(RosPumpObject *self, PyObject *unused) {
     (void)unused;
-    return Py_BuildValue("(KKKKK)", self->received, self->own_skipped, self->rate_limited,
-                         self->published, self->take_errors);
+    if (!initialised(self)) return NULL;
+    return Py_BuildValue("(KKKKKK)", self->received, self->own_skipped, self->rate_limited,
+                         self->published, self->take_errors, self->send_failures);
 }
 
 static PyMethodDef ros_pump_methods[] = {
-    {"start", (PyCFunction)ros_pump_start, METH_NOARGS, "set rcl's on-new-message callback"},
-    {"stop", (PyCFunction)ros_pump_stop, METH_NOARGS, "clear it (before the subscription goes)"},
     {"set_active", (PyCFunction)ros_pump_set_active, METH_O,
      "set_active(types): the spellings sent, a set of type names"},
     {"ignore", (PyCFunction)ros_pump_ignore, METH_O,
      "ignore(publishers) -> count: skip samples of these rcl publishers (by GID)"},
-    {"run", (PyCFunction)ros_pump_run, METH_VARARGS,
-     "run(wake_fd, timeout_ms) -> (events, refused), the GIL released"},
     {"counts", (PyCFunction)ros_pump_counts, METH_NOARGS,
-     "(received, own_skipped, rate_limited, published, take_errors) so far"},
+     "(received, own_skipped, rate_limited, published, take_errors, send_failures) so far"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -478,7 +386,7 @@ static PyTypeObject RosPumpType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.RosPump",
     .tp_basicsize = sizeof(RosPumpObject),
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "The per-message loop of one ROS -> Gazebo channel (docs/native.md §7).",
+    .tp_doc = "One native ROS -> Gazebo channel, run by a RosLoop (docs/native.md §7).",
     .tp_new = ros_pump_new,
     .tp_init = (initproc)ros_pump_init,
     .tp_dealloc = (destructor)ros_pump_dealloc,
@@ -492,5 +400,5 @@ int ros_pump_register(PyObject *module) {
         Py_DECREF(&RosPumpType);
         return -1;
     }
-    return 0;
+    return ros_loop_register(module);
 }

@@ -1,15 +1,12 @@
-"""A native ROS -> Gazebo channel's loop and the thread that runs it (docs/native.md §7).
+"""The native input of one ROS -> Gazebo channel, served by the shared loop (docs/native.md §7).
 
 :class:`RosChannelPump` holds the C ``RosPump`` (ros_pump.c) of one channel's input: the rclpy
 subscription it takes from (on a node no executor spins, so nothing else takes its messages),
-the channel's Gazebo publisher with a PUB socket of its own (only this thread sends on it), and
-the encoder of each spelling. Its thread runs the C loop with the GIL released and, between
-runs, does in Python what changes slowly: the spellings Gazebo subscribers take now, the
-bridge's own publishers on the topic (the loop guard), the counters, and the messages an
-encoder left to the Python path. A run returns with the messages left to Python, when
-:meth:`RosChannelPump.wake` is called (the channel calls it when the spellings or its own
-publishers change), and otherwise after :data:`TURN` seconds, or :data:`QUIET_TURN` after a
-run that took no message (nothing to count).
+the channel's Gazebo publisher with a PUB socket of its own (only the loop's thread sends on
+it), and the encoder of each spelling. The process's one loop (ros_loop.py) runs it; the
+pump tells that loop when the spellings Gazebo subscribers take or the bridge's own publishers
+on the topic change, and the loop's thread calls back, between C runs, to sync them, to count
+and to hand over the messages an encoder left to the Python path.
 """
 
 from __future__ import annotations
@@ -18,22 +15,17 @@ import contextlib
 import ctypes
 import functools
 import logging
-import socket
 import threading
-import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
+import zmq
+
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.pump import libzmq_path, loaded_libraries
+from ros_gz_bridge_py.native.ros_loop import shared_loop
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
-#: Longest time (s) between two turns of the Python side of the loop while messages come.
-TURN = 0.25
-#: The same after a run that took no message. Changes are pushed (:meth:`RosChannelPump.wake`),
-#: so this is only a safety net; 66 idle loops turning every :data:`TURN` cost an idle bridge
-#: of 66 bidirectional entries 2.5 points of a core (docs/native.md §7).
-QUIET_TURN = 2.0
 
 
 @functools.cache
@@ -85,11 +77,13 @@ class RosChannelPump:
     """The native input of one ROS -> Gazebo channel (see the module docstring).
 
     ``refused(cdr)``: the channel's Python path for one admitted message;
-    ``counted(received, own_skipped, rate_limited, published)``: what the loop did since it
-    last said; ``own_publishers()``: the rcl publishers of the bridge on the topic, and
-    ``watch_own_publishers(changed)`` calls ``changed()`` when they change (it returns the
-    function that stops it). The publisher's ``watch_wire_types`` does the same for the
-    spellings.
+    ``counted(received, own_skipped, rate_limited, published, send_failures)``: what the loop
+    did since it last said; ``failed(reason)``: the channel's socket failed and the loop took
+    the channel off (nothing more is taken); ``own_publishers()``: the rcl publishers of the
+    bridge on the topic, and ``watch_own_publishers(changed)`` calls ``changed()`` when they
+    change (it returns the function that stops it). The publisher's ``watch_wire_types`` does
+    the same for the spellings. Every callback runs on the loop's thread. Closing the
+    publisher (or its node) first takes the channel off the loop.
     """
 
     def __init__(
@@ -100,7 +94,8 @@ class RosChannelPump:
         encoders: Mapping[str, Any],
         max_rate: float,
         refused: Callable[[bytes], None],
-        counted: Callable[[int, int, int, int], None],
+        counted: Callable[[int, int, int, int, int], None],
+        failed: Callable[[str], None],
         own_publishers: Callable[[], frozenset[int]],
         watch_own_publishers: Callable[[Callable[[], None]], Callable[[], None]],
         name: str,
@@ -114,79 +109,91 @@ class RosChannelPump:
         for wire_type in order:
             topic, sender, _payload, type_frame = publisher.wire_frames[wire_type]
             spellings.append((type_frame, topic, sender, encoders[wire_type]))
+        self.name = name
         self._subscription = subscription
         self._publisher = publisher
-        self._pump = native.RosPump(
+        self.pump = native.RosPump(
             functions, subscription.handle.pointer, publisher.sock.underlying, spellings, max_rate
         )
         self._refused = refused
         self._counted = counted
+        self._failed = failed
         self._own_publishers = own_publishers
-        self._seen = (0, 0, 0, 0)
+        self._seen = (0, 0, 0, 0, 0)
         self._active: frozenset[str] | None = None
         self._ignored: frozenset[int] | None = None
         self._closed = False
-        self._wake_r, self._wake_w = socket.socketpair()
-        self._wake_r.setblocking(False)
-        self._wake_w.setblocking(False)
-        self._pump.start()
-        self._unwatch = (publisher.watch_wire_types(self.wake), watch_own_publishers(self.wake))
-        self._thread = threading.Thread(target=self._run, name=f"ros-pub {name}", daemon=True)
-        self._thread.start()
+        self._close_lock = threading.Lock()
+        self._loop = shared_loop()
+        self._unwatch = (
+            publisher.watch_wire_types(self.wake),
+            watch_own_publishers(self.wake),
+            publisher.before_close(self.close),
+        )
+        # In use while attached: a destroy meanwhile (rclpy's) waits for close.
+        self._in_use = contextlib.ExitStack()
+        self._in_use.enter_context(subscription.handle)
+        self.sync()  # before the loop takes a message: a subscriber's spelling is not missed
+        try:
+            self._loop.attach(self)
+        except Exception:
+            self._in_use.close()
+            for unwatch in self._unwatch:
+                unwatch()
+            raise
+
+    def __repr__(self) -> str:
+        return f"<native ROS -> Gazebo channel {self.name}>"
 
     def wake(self) -> None:
-        """End the current run soon, so the loop reads the spellings and own publishers again
-        (any thread; quick; nothing after :meth:`close`)."""
-        with contextlib.suppress(OSError):  # a wake already pending, or closed
-            self._wake_w.send(b"\0")
+        """Have the loop read the spellings and own publishers again soon (any thread; quick;
+        nothing after :meth:`close`)."""
+        if not self._closed:
+            self._loop.wake(self)
 
     def close(self) -> None:
-        """Stop the thread and rcl's callback; idempotent. The subscription may go after."""
-        if self._closed:
-            return
-        self._closed = True
-        for unwatch in self._unwatch:
-            unwatch()
-        self.wake()
-        if self._thread is not threading.current_thread():
-            self._thread.join()
-        self._pump.stop()
-        self._wake_r.close()
-        self._wake_w.close()
+        """Take the channel off the loop and stop rcl's callback; idempotent. The
+        subscription and the publisher's socket may go after: a second caller (the channel
+        and the node's close at once) returns only when the first is done."""
+        with self._close_lock:
+            if self._closed:
+                return
+            self._closed = True
+            for unwatch in self._unwatch:
+                unwatch()
+            self._loop.detach(self)
+            self._in_use.close()
 
-    def _run(self) -> None:
-        took = True
-        while not self._closed:
-            try:
-                self._sync()
-                timeout = int((TURN if took else QUIET_TURN) * 1000)
-                with self._subscription.handle:
-                    _events, refused = self._pump.run(self._wake_r.fileno(), timeout)
-                with contextlib.suppress(BlockingIOError):
-                    self._wake_r.recv(4096)
-                for cdr in refused:
-                    self._refused(cdr)
-                took = self._count()
-            except Exception:  # the loop must outlive anything, as the readers do
-                _LOG.exception("unexpected error in the native loop of %s", self._publisher.topic)
-                time.sleep(TURN)  # and not spin on an error that stays
-
-    def _sync(self) -> None:
-        """Tell the C loop the spellings subscribers take and the publishers to skip."""
+    def sync(self) -> None:
+        """Tell the C side the spellings subscribers take and the publishers to skip."""
         active = self._publisher.wire_types()
         if active != self._active:
-            self._pump.set_active({name.encode() for name in active})
+            self.pump.set_active({name.encode() for name in active})
             self._active = active
         ignored = self._own_publishers()
         if ignored != self._ignored:
-            self._pump.ignore(sorted(ignored))
+            self.pump.ignore(sorted(ignored))
             self._ignored = ignored
 
-    def _count(self) -> bool:
-        """Tell the channel what the loop did since the last turn; True if it took a message."""
-        now = self._pump.counts()[:4]
+    def turn(self, refused: list[bytes], failure: int) -> None:
+        """The loop says the channel moved: the messages left to Python, the counters, and
+        the failure of its socket (an errno of libzmq, 0 if none)."""
+        for cdr in refused:
+            self._refused(cdr)
+        received, own_skipped, rate_limited, published, _take_errors, send_failures = (
+            self.pump.counts()
+        )
+        now = (received, own_skipped, rate_limited, published, send_failures)
         before, self._seen = self._seen, now
         deltas = tuple(a - b for a, b in zip(now, before, strict=True))
         if any(deltas):
             self._counted(*deltas)
-        return bool(deltas[0])
+        self.sync()  # a channel that moved has subscribers: a cheap safety net for them
+        if failure:
+            self._failed(
+                f"its Gazebo socket failed ({zmq.strerror(failure)}); the channel takes no "
+                "more ROS messages (restart the bridge)"
+            )
+            # Off the loop now; the rest when the channel closes. Not close(): a close
+            # waiting for this turn on another thread holds its lock.
+            self._loop.detach(self)

@@ -5,6 +5,7 @@ their own entities (ZeroMQ records and frames, Zenoh declarations).
 
 from __future__ import annotations
 
+import contextlib
 import logging
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Protocol
@@ -42,6 +43,7 @@ class Publisher:
         self.names = node.names_of(msg_type)
         self._wire_types = WireTypeCache(node.subscriber_book, fqn, self.names)
         self._node = node
+        self._before_close: list[Callable[[], None]] = []
         self.closed = False
 
     def wire_types(self) -> frozenset[str]:
@@ -70,10 +72,29 @@ class Publisher:
         """True if a remote subscriber or a local subscription would receive a message."""
         return not self.closed and self._node.has_connections(self)
 
+    def before_close(self, stop: Callable[[], None]) -> Callable[[], None]:
+        """Call ``stop()`` before the publisher's socket goes (its :meth:`close`, or its
+        node's), e.g. to stop a native loop that sends on it; returns the function that
+        cancels this."""
+        self._before_close.append(stop)
+
+        def cancel() -> None:
+            with contextlib.suppress(ValueError):  # ran already
+                self._before_close.remove(stop)
+
+        return cancel
+
+    def stop_senders(self) -> None:
+        """Run what :meth:`before_close` registered (once)."""
+        stops, self._before_close = self._before_close, []
+        for stop in stops:
+            stop()
+
     def close(self) -> None:
         """Unadvertise; idempotent."""
         if not self.closed:
             self.closed = True
+            self.stop_senders()
             self._node.unadvertise(self)
 
 

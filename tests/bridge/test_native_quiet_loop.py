@@ -17,7 +17,7 @@ import pytest
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.native import extension
-from ros_gz_bridge_py.native.ros_pump import QUIET_TURN
+from ros_gz_bridge_py.native.ros_loop import QUIET_TURN
 from ros_gz_bridge_py.transport import GzNode
 from tests.bridge.behaviour_harness import (
     STRING,

@@ -111,6 +111,8 @@ class ZmqGzNode(GzNode):
         self._io_thread: threading.Thread | None = None
         self._stopping = False
         self._spellings_version = -1
+        #: Publishers with a socket of their own (a native loop may send on it).
+        self._own_socket_publishers: set[ZmqPublisher] = set()
         self._open_resources()
 
     # --- sockets and the I/O thread -------------------------------------------------------
@@ -159,6 +161,10 @@ class ZmqGzNode(GzNode):
         self._services.cancel_all()
 
     def _release(self) -> None:
+        # A native loop may still send on a publisher's own socket: it stops before the
+        # context (and every socket with it) goes.
+        for publisher in list(self._own_socket_publishers):
+            publisher.stop_senders()
         self._io.release()
 
     def _post(self, command: Callable[[], None]) -> None:
@@ -220,6 +226,8 @@ class ZmqGzNode(GzNode):
             for name, node in zip(self.names_of(msg_type), nodes, strict=False)
         )
         publisher = ZmqPublisher(self, topic, fqn, msg_type, records, sock=sock)
+        if sock is not None:
+            self._own_socket_publishers.add(publisher)
 
         def command() -> None:
             for record in records:
@@ -240,6 +248,7 @@ class ZmqGzNode(GzNode):
         with contextlib.suppress(TransportError):
             self._call(command)
         if zmq_publisher.sock is not None:
+            self._own_socket_publishers.discard(zmq_publisher)
             zmq_publisher.sock.close(linger=0)
 
     def _send(self, publisher: Publisher, wire_type: str, payload: Payload) -> None:

@@ -1,0 +1,330 @@
+"""The shared ROS -> Gazebo loop (ros_loop.c) and one channel's sends (ros_pump.c), driven
+from the test thread against a real rcl subscription and real ZeroMQ sockets (docs/native.md §7).
+
+A ``std_msgs/String`` publisher of the test's own context feeds the channel; a SUB socket
+connected to the channel's PUB socket reads the data frames. Faults in sending are those libzmq
+reports: a terminated context for real, and a frame refused mid-message through a ``zmq_send``
+that wraps the real one and refuses the frame a test names (the loop takes its functions by
+address, as from the libraries rclpy and pyzmq loaded).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import errno
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+import zmq
+
+pytestmark = pytest.mark.ros
+
+TYPE = b"ignition.msgs.StringMsg"
+TOPIC = b"@/partition@/ros_loop_test"
+SENDER = b"tcp://127.0.0.1:1"
+#: Each publish waits for delivery (DDS, then ZeroMQ) at most this long.
+WAIT = 10.0
+SEND = ctypes.CFUNCTYPE(
+    ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int, use_errno=True
+)
+
+
+def _functions() -> tuple[int, ...]:
+    from ros_gz_bridge_py.native.ros_pump import ros_functions  # noqa: PLC0415
+
+    functions = ros_functions()
+    if functions is None:
+        pytest.skip("rcl cannot be called from C here")
+    return functions
+
+
+def _libzmq() -> Any:
+    from ros_gz_bridge_py.native.pump import libzmq_path  # noqa: PLC0415
+
+    path = libzmq_path()
+    assert path is not None  # pyzmq is imported
+    return ctypes.CDLL(path)
+
+
+class Channel:
+    """One channel: a publisher and a raw subscription of ``ros_context``, a PUB socket and a
+    SUB socket reading it, and the C pump between them."""
+
+    def __init__(self, native: Any, context: Any, name: str, send: int | None = None) -> None:
+        import rclpy  # noqa: PLC0415
+        from std_msgs.msg import String  # noqa: PLC0415
+
+        from ros_gz_bridge_py.converters.registry import default_registry  # noqa: PLC0415
+        from ros_gz_bridge_py.native.channel import encoder_of  # noqa: PLC0415
+
+        self.String = String
+        self.node = rclpy.create_node(name, context=context)
+        self.publisher = self.node.create_publisher(String, f"/{name}", 100)
+        self.subscription = self.node.create_subscription(
+            String, f"/{name}", lambda _m: None, 100, raw=True
+        )
+        self.zmq = zmq.Context()
+        self.pub = self.zmq.socket(zmq.PUB)
+        self.pub.setsockopt(zmq.LINGER, 0)
+        self.pub.bind("tcp://127.0.0.1:*")
+        self.sub = self.zmq.socket(zmq.SUB)
+        self.sub.setsockopt(zmq.LINGER, 0)
+        self.sub.setsockopt(zmq.SUBSCRIBE, b"")
+        self.sub.connect(self.pub.getsockopt_string(zmq.LAST_ENDPOINT))
+        encoder = encoder_of(default_registry().get("std_msgs/msg/String", TYPE.decode()))
+        assert encoder is not None
+        functions = list(_functions())
+        if send is not None:
+            functions[6] = send
+        self.pump = native.RosPump(
+            functions,
+            self.subscription.handle.pointer,
+            self.pub.underlying,
+            [(TYPE, TOPIC, SENDER, encoder)],
+            0.0,
+        )
+        self.pump.set_active({TYPE})
+        self._loops: list[Any] = []
+        self._wait_connected()
+
+    def _wait_connected(self) -> None:
+        """A PUB socket drops what it sends before the SUB socket's connection is made."""
+        deadline = time.monotonic() + WAIT
+        while time.monotonic() < deadline:
+            self.pub.send(b"probe")
+            if self.sub.poll(50):
+                self.sub.recv()
+                return
+        pytest.fail("the SUB socket did not connect")
+
+    def publish(self, text: str) -> None:
+        self.publisher.publish(self.String(data=text))
+
+    def messages(self, count: int) -> list[list[bytes]]:
+        """The next ``count`` data messages the SUB socket reads (the probes skipped), then
+        any that come within 0.2 s more."""
+        out: list[list[bytes]] = []
+        deadline = time.monotonic() + WAIT
+        while len(out) < count and time.monotonic() < deadline:
+            if self.sub.poll(50):
+                out.append(self.sub.recv_multipart())
+        while self.sub.poll(200):
+            out.append(self.sub.recv_multipart())
+        return [m for m in out if m != [b"probe"]]
+
+    def remove_from(self, loop: Any) -> None:
+        """Taken off ``loop`` when closed (rcl's callback must go before the subscription)."""
+        self._loops.append(loop)
+
+    def close(self) -> None:
+        for loop in self._loops:
+            loop.remove(self.pump)
+        self.sub.close()
+        self.pub.close()
+        self.zmq.term()
+        self.node.destroy_node()
+
+
+@pytest.fixture
+def channels(native: Any, ros_context: Any) -> Iterator[Callable[..., Channel]]:
+    made: list[Channel] = []
+
+    def make(name: str, send: int | None = None) -> Channel:
+        channel = Channel(native, ros_context, f"{name}_{uuid.uuid4().hex[:8]}", send)
+        made.append(channel)
+        return channel
+
+    yield make
+    for channel in made:
+        channel.close()
+
+
+def run_until(loop: Any, done: Callable[[list[Any]], bool], what: str) -> list[Any]:
+    """Runs the loop (100 ms at a time) until ``done(everything moved so far)``."""
+    moved: list[Any] = []
+    deadline = time.monotonic() + WAIT
+    while not done(moved):
+        if time.monotonic() > deadline:
+            pytest.fail(f"timed out waiting for {what}")
+        moved += loop.run(100)[1]
+    return moved
+
+
+def test_methods_of_uninitialised_objects_raise(native: Any) -> None:
+    pump = native.RosPump.__new__(native.RosPump)
+    for call in (pump.counts, lambda: pump.set_active(set()), lambda: pump.ignore([])):
+        with pytest.raises(RuntimeError, match="not initialised"):
+            call()
+    loop = native.RosLoop.__new__(native.RosLoop)
+    for call in (lambda: loop.run(0), loop.wake, loop.size, lambda: loop.add(pump)):
+        with pytest.raises(RuntimeError, match="not initialised"):
+            call()
+    with pytest.raises(TypeError, match="initialised RosPump"):
+        native.RosLoop().add(pump)
+
+
+def test_init_twice_raises(native: Any, channels: Callable[..., Channel]) -> None:
+    channel = channels("twice")
+    with pytest.raises(RuntimeError, match="initialised once"):
+        channel.pump.__init__(_functions(), 1, 1, [], 0.0)
+    loop = native.RosLoop()
+    with pytest.raises(RuntimeError, match="initialised once"):
+        loop.__init__()
+
+
+def test_messages_of_several_channels_are_sent_whole(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
+    loop = native.RosLoop()
+    first, second = channels("first"), channels("second")
+    for channel in (first, second):
+        loop.add(channel.pump)
+        channel.remove_from(loop)
+    assert loop.size() == 2
+    for index in range(5):
+        first.publish(f"one {index}")
+        second.publish(f"two {index}")
+    run_until(loop, lambda _m: first.pump.counts()[3] == 5 == second.pump.counts()[3], "5 each")
+    for channel in (first, second):
+        messages = channel.messages(5)
+        assert len(messages) == 5
+        assert all(m[0] == TOPIC and m[1] == SENDER and m[3] == TYPE for m in messages)
+    assert loop.remove(first.pump) is True
+    assert loop.remove(first.pump) is False  # once only
+    first.publish("not taken")
+    second.publish("taken")
+    run_until(loop, lambda _m: second.pump.counts()[3] == 6, "the channel left")
+    assert first.pump.counts()[0] == 5
+
+
+def test_a_terminated_context_takes_the_channel_off_and_the_loop_goes_on(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
+    loop = native.RosLoop()
+    doomed, other = channels("doomed"), channels("other")
+    for channel in (doomed, other):
+        loop.add(channel.pump)
+        channel.remove_from(loop)
+    _libzmq().zmq_ctx_shutdown(ctypes.c_void_p(doomed.zmq.underlying))
+    doomed.publish("into a terminated context")
+    moved = run_until(loop, lambda m: any(p is doomed.pump and f for p, _r, f in m), "failure")
+    assert [f for p, _r, f in moved if p is doomed.pump][-1] == zmq.ETERM
+    received, _own, _rate, published, _take, send_failures = doomed.pump.counts()
+    assert (received, published, send_failures) == (1, 0, 1)
+    doomed.publish("after the failure")  # not taken: the loop does not wake for it
+    other.publish("still carried")
+    run_until(loop, lambda _m: other.pump.counts()[3] == 1, "the other channel")
+    assert doomed.pump.counts()[0] == 1
+    assert loop.remove(doomed.pump) is True
+
+
+def _refusing(frame: int, code: int, times: int) -> tuple[Any, list[int]]:
+    """A zmq_send that refuses its ``frame``-th call (from 1) ``times`` times with ``code``."""
+    real = _libzmq().zmq_send
+    real.restype = ctypes.c_int
+    real.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int]
+    calls: list[int] = []
+
+    def send(sock: int, data: int, length: int, flags: int) -> int:
+        calls.append(flags)
+        if len(calls) >= frame and len(calls) < frame + times:
+            ctypes.set_errno(code)
+            return -1
+        return int(real(sock, data, length, flags))
+
+    return SEND(send), calls
+
+
+def test_a_frame_refused_mid_message_is_not_published_and_leaves_no_part(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
+    send, calls = _refusing(frame=7, code=errno.EAGAIN, times=1)  # the 3rd frame of the 2nd
+    address = ctypes.cast(send, ctypes.c_void_p).value
+    channel = channels("mid_message", send=address)
+    loop = native.RosLoop()
+    loop.add(channel.pump)
+    channel.remove_from(loop)
+    for index in range(3):
+        channel.publish(f"message {index}")
+    moved = run_until(loop, lambda m: any(f for _p, _r, f in m), "the failure")
+    assert [f for _p, _r, f in moved if f] == [errno.EAGAIN]
+    received, _own, _rate, published, _take, send_failures = channel.pump.counts()
+    assert (published, send_failures) == (1, 1)
+    assert received == 2  # the channel took nothing after its socket was left uncertain
+    assert all(flags & zmq.DONTWAIT for flags in calls)
+    assert [(len(m), m[2]) for m in channel.messages(1)] == [(4, b"\x12\tmessage 0")]
+    loop.remove(channel.pump)
+
+
+def test_an_interrupted_frame_is_sent_again(native: Any, channels: Callable[..., Channel]) -> None:
+    send, _calls = _refusing(frame=3, code=errno.EINTR, times=2)
+    channel = channels("interrupted", send=ctypes.cast(send, ctypes.c_void_p).value)
+    loop = native.RosLoop()
+    loop.add(channel.pump)
+    channel.remove_from(loop)
+    channel.publish("once")
+    run_until(loop, lambda _m: channel.pump.counts()[3] == 1, "the message")
+    messages = channel.messages(1)
+    assert [len(m) for m in messages] == [4]
+    assert messages[0][2] == b"\x12\x04once"
+    assert channel.pump.counts()[5] == 0
+    loop.remove(channel.pump)
+
+
+def test_a_round_gives_each_channel_its_budget_and_a_wake_ends_the_run_after_it(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
+    loop = native.RosLoop()
+    flooded = [channels("flood_a"), channels("flood_b")]
+    for channel in flooded:
+        for index in range(100):
+            channel.publish(f"flood {index}")
+    time.sleep(0.5)  # the samples reach both subscriptions' queues (100 deep)
+    for channel in flooded:
+        loop.add(channel.pump)  # each add also wakes the loop
+        channel.remove_from(loop)
+    status, _moved = loop.run(60_000)
+    assert status == 1  # woken: returned after one round, the backlog still queued
+    assert [channel.pump.counts()[0] for channel in flooded] == [64, 64]
+    run_until(loop, lambda _m: all(c.pump.counts()[0] == 100 for c in flooded), "the rest")
+
+
+def test_channels_join_and_leave_while_the_loop_runs_and_the_others_keep_flowing(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
+    loop = native.RosLoop()
+    steady, churned = channels("steady"), channels("churned")
+    loop.add(steady.pump)
+    steady.remove_from(loop)
+    churned.remove_from(loop)
+    stop = threading.Event()
+
+    def run() -> None:
+        while not stop.is_set():
+            loop.run(20)
+
+    runner = threading.Thread(target=run, name="test-loop", daemon=True)
+    runner.start()
+    try:
+        for index in range(50):
+            assert loop.add(churned.pump) is None
+            for k in range(20):
+                churned.publish(f"churn {index} {k}")
+            steady.publish(f"steady {index}")
+            assert loop.remove(churned.pump) is True
+        deadline = time.monotonic() + WAIT
+        while steady.pump.counts()[3] < 50 and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        stop.set()
+        runner.join()
+    assert steady.pump.counts()[3] == 50
+    assert loop.size() == 1
+    texts = [m[2] for m in steady.messages(50)]
+    assert texts == [
+        b"\x12" + bytes([len(t)]) + t for t in (f"steady {i}".encode() for i in range(50))
+    ]
