@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 
 from ros_gz_bridge_py.app.rclpy_check import rclpy_problem
-from ros_gz_bridge_py.app.startup import pause_collector
+from ros_gz_bridge_py.app.startup import one_blas_thread, pause_collector
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 
@@ -18,6 +18,7 @@ def _exit_without_rclpy(program: str) -> None:
 
 
 def parameter_bridge_main() -> None:
+    one_blas_thread()
     pause_collector()
     _exit_without_rclpy("parameter_bridge")
     with StopSignal() as stop:
@@ -33,6 +34,7 @@ def bridge_types_main() -> None:
 
 
 def image_bridge_main() -> None:
+    one_blas_thread()
     pause_collector()
     _exit_without_rclpy("image_bridge")
     with StopSignal() as stop:

@@ -10,11 +10,16 @@ rclpy); once the channels exist, :func:`resume_collector` collects start-up's ga
 freezes what survives: those objects live as long as the process, and later collections no
 longer walk them. A bridge embedded in a program of its own (``main()`` called directly) never
 pauses the collector, and resuming it then does nothing.
+
+The entry points also keep numpy's OpenBLAS to the calling thread (:func:`one_blas_thread`):
+at import it starts a server thread per further core, which the bridge never uses (its arrays
+are copied, never multiplied), and a fleet's bridge counts every thread.
 """
 
 from __future__ import annotations
 
 import gc
+import os
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the entry points import this module before rclpy
@@ -27,6 +32,12 @@ def finish_start_up(node: BridgeNode) -> None:
     """The channels exist: start ``node``'s own services and resume the collector."""
     node.start_services()
     resume_collector()
+
+
+def one_blas_thread() -> None:
+    """OpenBLAS without threads of its own unless the user asked for them (entry points only,
+    before anything imports numpy)."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def pause_collector() -> None:

@@ -8,14 +8,19 @@ an rclpy node of this process; the bridge a real ``parameter_bridge`` process.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.native import extension
 from tests.bridge.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge, started
-from tests.gzpeer import PeerProcess, require_peer, start_peer, unique_name, wait_until
+from tests.gzpeer import (
+    PeerProcess,
+    require_peer,
+    start_peer,
+    threads_of,
+    unique_name,
+    wait_until,
+)
 
 __all__ = ["ros_side", "started"]
 
@@ -27,14 +32,6 @@ SMALL, LARGE = 2, 32
 LIGHT_COUNT, LIGHT_SHARE = 100, 0.9
 #: What the flood sends, as fast as the peer can.
 FLOOD_TEXT = "x" * 2000
-
-
-def threads_of(process: PeerProcess) -> int:
-    for line in Path(f"/proc/{process.pid}/status").read_text().splitlines():
-        if line.startswith("Threads:"):
-            return int(line.split()[1])
-    msg = "no Threads line"
-    raise AssertionError(msg)
 
 
 def bridge_of(topics: list[str], started: list[PeerProcess]) -> PeerProcess:
