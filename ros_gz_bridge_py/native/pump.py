@@ -210,6 +210,12 @@ class ChannelPump:
         return int(self._pump.counts()[0])
 
     @property
+    def dropped_sender(self) -> str:
+        """The sender of the last payload dropped ("" before any)."""
+        sender: bytes = self._pump.traffic()[1]
+        return sender.decode(errors="replace")
+
+    @property
     def dropped(self) -> int:
         """Payloads dropped so far: the oldest, before any work on them (over the queue's count
         or bytes), and those that could not be handed to Python (no memory for a copy)."""

@@ -6,6 +6,7 @@ delays only its own topic and never a backend's I/O thread; when full, the oldes
 dropped and counted, the policy of ROS "keep last N". Every backend keeps them in a
 :class:`DropOldestQueue`: the ZeroMQ reader fills and drains it on its own thread
 (``zmq/reader.py``), the others through a :class:`DeliveryQueue`, which drains it on a thread.
+A queue that drops says so in one throttled warning (:class:`DropWarning`).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast
 
@@ -32,8 +34,13 @@ Deliver = Callable[[Payload, "MessageInfo"], None]
 #: One received message waiting in a queue: its payload and what the callback is told.
 Delivery = tuple[Payload, "MessageInfo"]
 
-#: Bytes a delivery queue may hold (at least one item is always kept): ten 1080p frames.
+#: Bytes a delivery queue holds by default (at least one item is always kept): ten 1080p RGB
+#: frames or two 4K RGBA ones, so a camera stream whose consumer pauses for a frame or two
+#: loses nothing, while a flood of large messages costs one channel at most this much
+#: (the bridge's ``max_queued_bytes`` parameter sets it; README, "Node parameters").
 MAX_QUEUED_BYTES = 64 * 1024 * 1024
+#: Seconds between two warnings of one queue's drops.
+DROP_WARN_PERIOD = 10.0
 
 
 def raw_deliverer(
@@ -92,6 +99,35 @@ def require_queue_size(size: int) -> None:
     if size < 1:
         msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
         raise ValueError(msg)
+
+
+class DropWarning:
+    """The warning of one subscription queue that drops its oldest messages: at most one line
+    per :data:`DROP_WARN_PERIOD` seconds, naming the topic, the sender whose message was
+    dropped last, how many so far and the queue's bounds (one thread at a time)."""
+
+    def __init__(self, topic: str, size: int, max_bytes: int) -> None:
+        self._topic = topic
+        self._size = size
+        self._max_bytes = max_bytes
+        self._last = -DROP_WARN_PERIOD
+
+    def dropped(self, total: int, sender: str) -> None:
+        """``total`` messages dropped so far, the last of them from ``sender``."""
+        now = time.monotonic()
+        if now - self._last < DROP_WARN_PERIOD:
+            return
+        self._last = now
+        _LOG.warning(
+            "%s: %d message(s) dropped so far, oldest first, the last from %s: its queue holds "
+            "at most %d messages and %d bytes (parameter max_queued_bytes); they arrive "
+            "faster than they are bridged",
+            self._topic,
+            total,
+            sender or "this process",
+            self._size,
+            self._max_bytes,
+        )
 
 
 class QueueClosedError(Exception):

@@ -7,7 +7,9 @@ keeps hundreds of MB resident that nothing will reuse (measured: 5 messages of 6
 bridge at 649 MB, from 169 MB). A :class:`BurstTrimmer` calls ``malloc_trim(0)`` once a
 subscription that received at least :data:`TRIM_AFTER_BYTES` has been idle for
 :data:`IDLE_BEFORE_TRIM` seconds: a steady stream never pauses that long, so it keeps its
-buffers; a burst's memory goes back. Elsewhere than glibc it does nothing.
+buffers; a burst's memory goes back. Elsewhere than glibc it does nothing. The Python path's
+readers tell it each message (``zmq/reader.py``); the native loop, which reads in C, tells it
+each channel's running total of bytes read at every count (``native/loop.py``).
 """
 
 from __future__ import annotations
@@ -36,11 +38,22 @@ class BurstTrimmer:
         self._trim = trim
         self._bytes = 0
         self._last = 0.0
+        self._total = 0
         self.trims = 0
 
     def received(self, size: int) -> None:
         self._bytes += size
         self._last = time.monotonic()
+
+    def read_so_far(self, total: int, now: float) -> None:
+        """``total`` bytes received since the start: what came since the last call counts as
+        received, nothing new as idle."""
+        if total > self._total:
+            self._bytes += total - self._total
+            self._total = total
+            self._last = now
+        else:
+            self.idle(now)
 
     def idle(self, now: float | None = None) -> None:
         """Call when nothing is waiting: trims after a burst that has ended."""

@@ -32,3 +32,17 @@ def test_small_traffic_is_never_trimmed() -> None:
 
 def test_trim_heap_runs_here() -> None:
     assert isinstance(trim_heap(), bool)  # glibc: malloc_trim(0); elsewhere a no-op
+
+
+def test_running_totals_trim_once_a_burst_has_stopped_growing() -> None:
+    """The native loop's form: each count gives the bytes read so far."""
+    trimmer = BurstTrimmer(lambda: None)
+    trimmer.read_so_far(TRIM_AFTER_BYTES // 2, 10.0)
+    trimmer.read_so_far(TRIM_AFTER_BYTES, 10.5)
+    trimmer.read_so_far(TRIM_AFTER_BYTES, 10.5 + IDLE_BEFORE_TRIM / 2)  # a short pause
+    assert trimmer.trims == 0
+    trimmer.read_so_far(TRIM_AFTER_BYTES, 10.5 + IDLE_BEFORE_TRIM)
+    assert trimmer.trims == 1
+    trimmer.read_so_far(TRIM_AFTER_BYTES + 1, 20.0)  # a trickle afterwards: no new burst
+    trimmer.read_so_far(TRIM_AFTER_BYTES + 1, 30.0)
+    assert trimmer.trims == 1
