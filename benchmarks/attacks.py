@@ -41,7 +41,7 @@ from typing import Any
 import zmq
 
 from benchmarks.harness import cpu_seconds, rss_mb
-from benchmarks.soak import soak_env
+from benchmarks.soak import ATTACKS_SECTION, soak_env
 from ros_gz_bridge_py.app.settings import NATIVE_ENV
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.names import fully_qualified_name
@@ -61,7 +61,7 @@ ODOM_TEXT = (
 START_LIMIT = 60.0
 #: Seconds between two RSS samples of the bridge (for its peak).
 SAMPLE_EVERY = 0.01
-SECTION = "## Attacks"
+SECTION = ATTACKS_SECTION
 PATHS = ("native", "python")
 
 
