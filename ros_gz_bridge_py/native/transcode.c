@@ -895,9 +895,10 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
 /* The largest CDR message written for a payload of `n` bytes (docs/native.md §4): a message
  * of defaults has a fixed part (RGB_OUTPUT_FLOOR covers every pair's), and beyond it each
  * payload byte may give at most RGB_OUTPUT_RATIO bytes; more is an amplification (a Pose_V of
- * empty poses gives 28-40 times its size), left to Python, which refuses it too. */
+ * empty poses gives 28-40 times its size), left to Python, which refuses it too; and never
+ * more than RGB_OUTPUT_MAX. */
 static size_t output_limit(size_t n) {
-    if (n > (RGB_MAX_OUTPUT - RGB_OUTPUT_FLOOR) / RGB_OUTPUT_RATIO) return RGB_MAX_OUTPUT;
+    if (n > (RGB_OUTPUT_MAX - RGB_OUTPUT_FLOOR) / RGB_OUTPUT_RATIO) return RGB_OUTPUT_MAX;
     return RGB_OUTPUT_FLOOR + RGB_OUTPUT_RATIO * n;
 }
 
