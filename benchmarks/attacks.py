@@ -111,9 +111,10 @@ class Attack:
     per_second: float
 
 
-def attacks() -> list[Attack]:
+def attacks(padding_mb: int = 32) -> list[Attack]:
+    padded = padded_odometry(padding_mb << 20)
     return [
-        Attack("padded_odometry", ODOM, "ignition.msgs.Odometry", padded_odometry(32 << 20), 0.0),
+        Attack("padded_odometry", ODOM, "ignition.msgs.Odometry", padded, 0.0),
         Attack("empty_poses", TF, "ignition.msgs.Pose_V", empty_poses(4 << 20), 2.0),
         Attack(
             "unknown_fields", ODOM, "ignition.msgs.Odometry", small_unknown_fields(768 << 10), 20
@@ -377,11 +378,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--after", type=float, default=10.0)
     parser.add_argument("--report", type=Path, default=ROOT / "SOAK.md")
     parser.add_argument("--paths", nargs="+", choices=("native", "python"), default=PATHS)
+    parser.add_argument("--padding-mb", type=int, default=32, help="padded_odometry's padding")
     args = parser.parse_args(argv)
     runs = []
     for native in (path == "native" for path in args.paths):
         run = AttackRun(native, seconds=args.seconds, after=args.after)
-        run.run(attacks())
+        run.run(attacks(args.padding_mb))
         runs.append(run)
         print(json.dumps([vars(o) for o in run.outcomes], indent=1), flush=True)
     command = "python -m benchmarks.attacks" + (" " + " ".join(argv) if argv else "")
