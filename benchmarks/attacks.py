@@ -90,8 +90,8 @@ def padded_odometry(size: int) -> bytes:
 
 
 def empty_poses(count: int) -> bytes:
-    """A Pose_V of ``count`` empty poses (field 1, length 0: two bytes each)."""
-    return b"\x0a\x00" * count
+    """A Pose_V of ``count`` empty poses (field 2, length 0: two bytes each)."""
+    return b"\x12\x00" * count
 
 
 def small_unknown_fields(size: int) -> bytes:
