@@ -157,6 +157,7 @@ class GzToRosChannel(Channel):
         self._publish = _closed_publish
         own = self.ctx.own_publications(self.ros_topic)
         if self._pump is not None:
+            self._pump.close()  # its fallback thread publishes no more
             own.remove_numbered(self._pump)
             self._pump = None
         if self._publisher is not None:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from ros_gz_bridge_py.libc import libc_function
+from ros_gz_bridge_py.libc import libc_function, shrink_thread_arena
 
 #: Bytes received since the last trim that make a quiet pause worth a trim.
 TRIM_AFTER_BYTES = 64 * 1024 * 1024
@@ -32,16 +32,25 @@ RATE_WINDOW = 0.25
 
 
 def trim_heap() -> bool:
-    """``malloc_trim(0)``: free heap pages of every arena back to the system (glibc only)."""
+    """``malloc_trim(0)``: free heap pages of every arena back to the system (glibc only),
+    after the free top of the calling thread's own arena (``libc.shrink_thread_arena``):
+    call it on the thread that handled the burst."""
     trim = libc_function("malloc_trim")
-    return trim is not None and bool(trim(0))
+    if trim is None:
+        return False
+    shrink_thread_arena()
+    return bool(trim(0))
 
 
 class BurstTrimmer:
-    """Counts received bytes; :meth:`idle` trims once after a large burst (one thread)."""
+    """Counts received bytes; :meth:`idle` trims once after a burst of ``trim_after`` bytes or
+    more (one thread, the one that handled the burst)."""
 
-    def __init__(self, trim: Callable[[], object] = trim_heap) -> None:
+    def __init__(
+        self, trim: Callable[[], object] = trim_heap, trim_after: int = TRIM_AFTER_BYTES
+    ) -> None:
         self._trim = trim
+        self._trim_after = trim_after
         self._bytes = 0  # since the last trim
         self._window_bytes = 0
         self._window_start: float | None = None
@@ -66,7 +75,7 @@ class BurstTrimmer:
         """Call when nothing is waiting: trims after a burst that has ended."""
         now = time.monotonic() if now is None else now
         self._close_window(now)
-        if self._bytes >= TRIM_AFTER_BYTES and now - self._last >= IDLE_BEFORE_TRIM:
+        if self._bytes >= self._trim_after and now - self._last >= IDLE_BEFORE_TRIM:
             self._bytes = 0
             self.trims += 1
             self._trim()
