@@ -18,7 +18,7 @@ LOOPBACK := ../shared/tools/loopback-env
 # Keep ROS, Gazebo Transport and Zenoh traffic on this host (see DEVELOPERS.md).
 WITH_LOOPBACK := if [ -f $(LOOPBACK) ]; then source $(LOOPBACK); else source tools/loopback-env; fi;
 
-.PHONY: setup-demo setup test lint typecheck unit demo bench soak fuzz clean
+.PHONY: setup-demo setup test lint typecheck unit demo bench soak attacks fuzz clean
 
 # The package's bytecode, brought up to date on every run (0.2 s when it is): an editable install
 # has none, and where PYTHONDONTWRITEBYTECODE is set (as on the project machines) every bridge
@@ -74,6 +74,10 @@ bench: $(BENCH_STAMP)
 soak: setup
 	$(WITH_LOOPBACK) $(PY) -m benchmarks.soak --seconds $${SOAK_SECONDS:-600}
 	$(MAKE) --no-print-directory fuzz
+
+# Hostile payloads beside real publishers, on both paths: the Attacks section of SOAK.md.
+attacks: setup
+	$(WITH_LOOPBACK) $(PY) -m benchmarks.attacks
 
 # The native transcoders under libFuzzer with ASan and UBSan, then MSan, for FUZZ_SECONDS in all
 # (600 by default; `make test` runs 60): tests/unit/native/test_fuzz.py, corpus in .build/fuzz.

@@ -53,6 +53,8 @@ FUZZ_EVERY = 15.0
 FUZZ_COUNT = 300
 SAMPLE_EVERY = 2.0
 ODOM_TEXT = "header { stamp { sec: 7 } } pose { position { x: 1.5 } }"
+#: The section of SOAK.md that ``benchmarks/attacks.py`` writes; a soak keeps it.
+ATTACKS_SECTION = "## Attacks"
 
 
 @dataclass
@@ -318,7 +320,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--report", type=Path, default=ROOT / "SOAK.md")
     args = parser.parse_args(argv)
     figures = Soak(args.seconds).run()
-    args.report.write_text(report(figures))
+    old = args.report.read_text() if args.report.exists() else ""
+    start = old.find(f"\n{ATTACKS_SECTION}\n")
+    args.report.write_text(report(figures) + (old[start:] if start >= 0 else ""))
     print(f"wrote {args.report}")
     return 0 if figures.bridge_alive and figures.bridge_exit == 0 else 1
 

@@ -43,6 +43,7 @@ from ros_gz_bridge_py.app.image_bridge_args import (
 from ros_gz_bridge_py.app.settings import (
     ImageBridgeParameters,
     Switches,
+    checked_max_queued_bytes,
     checked_max_rate,
     declare_image_bridge_parameters,
     read_switches,
@@ -119,11 +120,18 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -
         )
         return None
     max_rate, problem = checked_max_rate(params.shared)
-    if problem:
-        logger.error(problem)
+    max_queued_bytes, queue_problem = checked_max_queued_bytes(params.shared)
+    for message in (problem, queue_problem):
+        if message:
+            logger.error(message)
     bridge = Bridge(
         node,
-        options=params.shared.bridge_options(switches, gz_version=gz_version, max_rate=max_rate),
+        options=params.shared.bridge_options(
+            switches,
+            gz_version=gz_version,
+            max_rate=max_rate,
+            max_queued_bytes=max_queued_bytes,
+        ),
         gz_options=params.shared.gz_node_options(),
     )
     bridge.add_all(specs)

@@ -31,6 +31,7 @@ from ros_gz_bridge_py.app.check import Sides, run_check
 from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
     Switches,
+    checked_max_queued_bytes,
     checked_max_rate,
     declare_parameter_bridge_parameters,
     read_switches,
@@ -402,8 +403,10 @@ def build_bridge(
         logger.error(str(err))
         gz_version = ""
     max_rate, problem = checked_max_rate(params.shared)
-    if problem:
-        logger.error(problem)
+    max_queued_bytes, queue_problem = checked_max_queued_bytes(params.shared)
+    for message in (problem, queue_problem):
+        if message:
+            logger.error(message)
     bridge = Bridge(
         node,
         options=params.shared.bridge_options(
@@ -411,6 +414,7 @@ def build_bridge(
             gz_version=gz_version,
             service_timeout=params.service_timeout,
             max_rate=max_rate,
+            max_queued_bytes=max_queued_bytes,
         ),
         gz_options=params.shared.gz_node_options(),
     )

@@ -29,6 +29,7 @@ from ros_gz_bridge_py.core.options import BULK_THREAD_NICE, BridgeOptions
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.transport import NodeOptions
+from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
@@ -160,6 +161,9 @@ class SharedParameters:
     #: Ours: messages per second every channel passes at most unless its entry says (0: no
     #: limit). Declared with any type (``10`` or ``10.0``); :func:`checked_max_rate` reads it.
     max_rate: object = 0.0
+    #: Ours: payload bytes each Gazebo->ROS channel's queue holds at most (beyond its count);
+    #: :func:`checked_max_queued_bytes` reads it.
+    max_queued_bytes: int = MAX_QUEUED_BYTES
 
     def gz_node_options(self) -> NodeOptions:
         return NodeOptions(implementation=self.gz_transport_implementation or None)
@@ -171,6 +175,7 @@ class SharedParameters:
         gz_version: str,
         service_timeout: float = DEFAULT_TIMEOUT,
         max_rate: float = 0.0,
+        max_queued_bytes: int = MAX_QUEUED_BYTES,
     ) -> BridgeOptions:
         """The bridge's options: these parameters, ``switches``, and ``gz_version`` as checked
         by :func:`~ros_gz_bridge_py.config.gz_version.check_gz_version`."""
@@ -183,6 +188,7 @@ class SharedParameters:
             **{name: getattr(switches, name) for name in MESSAGE_PATH_SWITCHES},
             gz_version=gz_version,
             max_rate=max_rate,
+            max_queued_bytes=max_queued_bytes,
         )
 
 
@@ -268,6 +274,17 @@ def checked_max_rate(shared: SharedParameters) -> tuple[float, str]:
         return as_rate("max_rate", shared.max_rate), ""
     except ConfigError as err:
         return 0.0, f"parameter {err.message}; no limit is applied"
+
+
+def checked_max_queued_bytes(shared: SharedParameters) -> tuple[int, str]:
+    """(the ``max_queued_bytes`` parameter, "") or (the default, what is wrong with it, for
+    the log): a queue must be able to hold something."""
+    if shared.max_queued_bytes >= 1:
+        return shared.max_queued_bytes, ""
+    return MAX_QUEUED_BYTES, (
+        f"parameter max_queued_bytes is {shared.max_queued_bytes}; it must be at least 1 "
+        f"(bytes a channel's queue holds); using {MAX_QUEUED_BYTES}"
+    )
 
 
 def declare_image_bridge_parameters(

@@ -7,7 +7,11 @@ a gigabyte from a few megabytes. Beyond ``OUTPUT_FLOOR`` bytes (the fixed part o
 message), a list may write at most ``OUTPUT_RATIO`` bytes per byte of the message it came
 from; a larger one is refused before its items are made. The native transcoder applies the
 same bound to its whole output (``RGB_OUTPUT_FLOOR``, ``RGB_OUTPUT_RATIO`` in native/wire.h;
-docs/native.md §4), so what it writes Python accepts too.
+docs/native.md §4), so what it writes Python accepts too. Whatever the message, no list may
+write more than ``MAX_OUTPUT`` (``RGB_OUTPUT_MAX``): the largest Gazebo message the bridge
+takes by default (``GZ_TRANSPORT_MAX_MESSAGE_SIZE``, 128 MiB), so the ROS messages it builds
+are never larger than the largest it accepts (a 4K image of 8 bytes a pixel, 66 MB, takes the
+bulk path and is not a list of items anyway).
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ from ros_gz_bridge_py.ros.cdr_writer import writer_for
 
 OUTPUT_FLOOR = 64 * 1024
 OUTPUT_RATIO = 16
+MAX_OUTPUT = 128 * 1024 * 1024
 #: The CDR bytes of an item whose class rclpy must write: a guess on the small side.
 _UNKNOWN_ITEM_BYTES = 8
 
@@ -58,12 +63,12 @@ def check_list(gz_items: Sized, least: int, ros_type: str) -> None:
         received = message.ByteSize()  # one pass in C
     else:  # a list converted outside a whole message: its elements, a tag and a length each
         received = sum(item.ByteSize() + 2 for item in gz_items)  # type: ignore[attr-defined]
-    limit = OUTPUT_FLOOR + OUTPUT_RATIO * received
+    limit = min(OUTPUT_FLOOR + OUTPUT_RATIO * received, MAX_OUTPUT)
     if least_total > limit:
         msg = (
             f"a list of {count} {ros_type} items from a message of {received} bytes would "
             f"take at least {least_total} bytes, over the limit of {limit} ({OUTPUT_FLOOR} + "
-            f"{OUTPUT_RATIO} per byte received): refused as an amplification; send elements "
-            "with their fields set, or fewer of them"
+            f"{OUTPUT_RATIO} per byte received, at most {MAX_OUTPUT}): refused as an "
+            "amplification; send elements with their fields set, or fewer of them"
         )
         raise ConversionError(msg)

@@ -31,7 +31,6 @@ from ros_gz_bridge_py.native.pump import ChannelPump
 from ros_gz_bridge_py.ros.qos import PUBLISHER_OVERRIDES, gz_to_ros_publisher_qos
 from ros_gz_bridge_py.ros.serialized_publisher import SerializedPublisher, object_publisher
 from ros_gz_bridge_py.transport import MessageInfo, Subscription
-from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 
 def has_top_level_header(ros_class: type[Any]) -> bool:
@@ -135,7 +134,7 @@ class GzToRosChannel(Channel):
                 publisher=self._publisher,
                 programs=self._programs,
                 capacity=max(self._qos.depth, MIN_DELIVERY_QUEUE),
-                max_bytes=MAX_QUEUED_BYTES,
+                max_bytes=self.ctx.options.max_queued_bytes,
                 max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
                 refused=self._convert_and_publish,
                 counted=self._counted,
@@ -158,6 +157,7 @@ class GzToRosChannel(Channel):
         self._publish = _closed_publish
         own = self.ctx.own_publications(self.ros_topic)
         if self._pump is not None:
+            self._pump.close()  # its fallback thread publishes no more
             own.remove_numbered(self._pump)
             self._pump = None
         if self._publisher is not None:
@@ -174,6 +174,7 @@ class GzToRosChannel(Channel):
             self.spec.gz_type,
             ignore_local=True,
             queue_size=depth,
+            queue_bytes=self.ctx.options.max_queued_bytes,
             copy=False,
             on_delivery_start=(lambda: yield_cpu_to_light_topics(self.ctx.options.bulk_nice))
             if bulk

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from ros_gz_bridge_py.config.gz_version import GARDEN
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 #: How much lower the CPU priority (nice) of bulk-path delivery threads is, by default.
 BULK_THREAD_NICE = 10
@@ -48,6 +49,9 @@ class BridgeOptions:
     explain: bool = True
     #: Messages per second a channel passes at most unless its entry says (0: no limit).
     max_rate: float = 0.0
+    #: Payload bytes each Gazebo->ROS channel's queue holds at most (beyond its count of
+    #: messages); past it the oldest are dropped and counted (one message is always kept).
+    max_queued_bytes: int = MAX_QUEUED_BYTES
 
     @property
     def garden(self) -> bool:

@@ -13,6 +13,11 @@ runs, for the members that need it and no others:
   :data:`COUNT_EVERY` seconds while messages flow, so the status table stays current; an idle
   bridge turns once every :data:`QUIET_COUNT_EVERY` seconds, whatever its number of channels.
 
+At each count every member's bytes so far (read, and done with in Python) go to its own
+``BurstTrimmer`` (``transport/heap.py``): once a channel that read a burst of large messages
+has been quiet for a second, freed memory goes back to the system; a steady stream of large
+messages is never quiet that long.
+
 Members are added and removed on the loop's own thread (a command posted from any thread,
 which :meth:`SharedLoop.detach` waits for), so the C loop never runs a pump whose socket is
 being closed. The thread starts with the first member and ends with the last.
@@ -29,12 +34,17 @@ from collections.abc import Callable
 from typing import Any, Protocol
 
 from ros_gz_bridge_py.native import extension
+from ros_gz_bridge_py.transport.heap import BurstTrimmer
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 #: Seconds between two counts of the moving members while messages flow.
 COUNT_EVERY = 0.25
 #: The same while nothing moved at the last count.
 QUIET_COUNT_EVERY = 1.0
+#: Bytes a channel reads before a quiet second is worth a trim: fewer than a Python reader's,
+#: because the transcoder's index and output for a large message can be many times its size
+#: (4 Pose_V of 4 M empty poses, 32 MB, left 72 MB on the loop thread's own heap).
+LOOP_TRIM_AFTER = 8 * 1024 * 1024
 
 
 class LoopMember(Protocol):
@@ -43,6 +53,11 @@ class LoopMember(Protocol):
     @property
     def pump(self) -> Any:
         """The C Pump."""
+        ...
+
+    @property
+    def bytes_so_far(self) -> int:
+        """Payload bytes read, and then handled by Python where it took them (for the trim)."""
         ...
 
     def loop_turn(self, events: int) -> float | None:
@@ -67,6 +82,7 @@ class SharedLoop:
         self._members: dict[Any, LoopMember] = {}  # by pump
         self._deadlines: dict[LoopMember, float] = {}
         self._handles: dict[LoopMember, Any] = {}
+        self._trimmers: dict[Any, BurstTrimmer] = {}  # by pump
         self._touched: list[Any] = []
 
     # --- from any thread ----------------------------------------------------------------------
@@ -123,11 +139,13 @@ class SharedLoop:
             raise
         self._members[member.pump] = member
         self._handles[member] = handle
+        self._trimmers[member.pump] = BurstTrimmer(trim_after=LOOP_TRIM_AFTER)
 
     def _remove(self, member: LoopMember) -> None:
         if self._members.pop(member.pump, None) is None:
             return
         self._loop.remove(member.pump)
+        self._trimmers.pop(member.pump, None)
         self._deadlines.pop(member, None)
         self._asked.discard(member)
         self._handles.pop(member).__exit__(None, None, None)
@@ -172,6 +190,8 @@ class SharedLoop:
         moved = self._loop.moved()
         for pump in moved:
             self._turn(self._members.get(pump), 0)
+        for pump, trimmer in list(self._trimmers.items()):
+            trimmer.read_so_far(self._members[pump].bytes_so_far, now)
         return now + (COUNT_EVERY if moved else QUIET_COUNT_EVERY)
 
     def _turn(self, member: LoopMember | None, events: int) -> None:

@@ -60,6 +60,8 @@ struct foreign {
 #define MAX_ROUTES 1024
 /* Routes a full table keeps: the most recently used (and those a waiting message names). */
 #define KEEP_ROUTES (MAX_ROUTES / 2)
+/* Bytes of a dropped payload's sender kept for the warning that names it (longer: cut). */
+#define DROP_SENDER_MAX 256
 
 /* What a (sender, type) pair of frames gets: a program, or nothing (another spelling taken). */
 struct route {
@@ -110,6 +112,9 @@ struct PumpObject {
     unsigned long long received, rate_limited, published, dropped, skipped;
     unsigned long long lost; /* messages for Python that could not be copied (no memory) */
     unsigned long long taken; /* messages read from the socket, whatever became of them */
+    unsigned long long bytes_read; /* their payload bytes (the loop's trim after a burst) */
+    uint8_t drop_sender[DROP_SENDER_MAX]; /* the sender of the last payload dropped */
+    size_t drop_sender_len;
     pthread_mutex_t lock; /* the windows and the sequence (read by is_own from any thread) */
     uint64_t sequence;
     struct window windows[HISTORY];
@@ -209,6 +214,9 @@ static void hand_frames(PumpObject *self, int kind, int route, int status, zmq_m
 
 static void drop_oldest(PumpObject *self) {
     struct queued *oldest = &self->ring[self->head];
+    const struct route *r = &self->routes[oldest->route];
+    self->drop_sender_len = r->sender_len < DROP_SENDER_MAX ? r->sender_len : DROP_SENDER_MAX;
+    memcpy(self->drop_sender, r->sender, self->drop_sender_len);
     self->queued_bytes -= self->f.msg_size(&oldest->payload);
     self->f.msg_close(&oldest->payload);
     self->head = (self->head + 1) % self->capacity;
@@ -254,6 +262,7 @@ static int read_message(PumpObject *self, void *sock) {
         }
     }
     self->taken++;
+    if (n > 2) self->bytes_read += self->f.msg_size(&frames[2]);
     int route = -1;
     if (n == 4 && !extra && self->f.msg_size(&frames[0]) == self->topic_len &&
         !memcmp(self->f.msg_data(&frames[0]), self->topic, self->topic_len)) {
@@ -674,6 +683,13 @@ static PyObject *pump_counts(PumpObject *self, PyObject *unused) {
                          self->dropped, self->skipped, self->lost);
 }
 
+/* traffic() -> (payload bytes read so far, sender of the last payload dropped: b"" if none) */
+static PyObject *pump_traffic(PumpObject *self, PyObject *unused) {
+    (void)unused;
+    return Py_BuildValue("(Ky#)", self->bytes_read, (char *)self->drop_sender,
+                         (Py_ssize_t)self->drop_sender_len);
+}
+
 static PyObject *pump_begin_publication(PumpObject *self, PyObject *unused) {
     (void)unused;
     return PyLong_FromUnsignedLongLong(begin_publication(self));
@@ -708,6 +724,8 @@ static PyMethodDef pump_methods[] = {
      "take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused"},
     {"counts", (PyCFunction)pump_counts, METH_NOARGS,
      "(received, rate_limited, published, dropped, skipped, lost) so far"},
+    {"traffic", (PyCFunction)pump_traffic, METH_NOARGS,
+     "(payload bytes read so far, sender of the last payload dropped)"},
     {"begin_publication", (PyCFunction)pump_begin_publication, METH_NOARGS,
      "a publication made from Python on the same publisher: its sequence number"},
     {"end_publication", (PyCFunction)pump_end_publication, METH_VARARGS,

@@ -5,9 +5,12 @@ ROS publisher exists, with one program per spelling of the channel's Gazebo type
 the publisher's life (its publication sequence numbers are the loop guard's, whichever path
 published). The ZeroMQ reader attaches it to the process's one loop (``loop.py``) instead of
 reading its socket on a thread of its own (``transport/zmq/reader.py``); what the C loop hands
-back is done here in Python, on the loop's thread: the payloads no program took go through the
-channel's Python path (``refused``), which converts them or says why not, with the Python
-path's own error reasons, and the frames of a sender not yet known go to the reader.
+back is done here in Python: the payloads no program took go through the channel's Python path
+(``refused``), which converts them or says why not, with the Python path's own error reasons,
+on a thread of the channel's own behind a drop-oldest queue (the channel's count and bytes),
+so that a payload that is slow to refuse (a Pose_V of 4 M empty poses: a second of parsing)
+holds up no other native channel; the frames of a sender not yet known go to the reader, on the
+loop's thread.
 
 libzmq and rcl are not linked: their functions are taken from the libraries pyzmq and rclpy
 already loaded (docs/native.md §5).
@@ -28,6 +31,8 @@ from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.loop import shared_loop
 from ros_gz_bridge_py.transport import MessageInfo
 from ros_gz_bridge_py.transport.api import NativeHost
+from ros_gz_bridge_py.transport.delivery import DeliveryQueue, payload_size
+from ros_gz_bridge_py.transport.heap import BurstTrimmer
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 _ZMQ_FUNCTIONS = (
@@ -41,6 +46,10 @@ _ZMQ_FUNCTIONS = (
 )
 #: Handed back by the C pump: frames it has no route for, or a payload no program took.
 _UNROUTED, _REFUSED = 0, 1
+#: Payload bytes the fallback thread handles before a quiet second is worth a trim: far fewer
+#: than a reader's, because the Python path can build objects many times a payload's size (a
+#: Pose_V of 4 M empty poses: 8 MB, some 300 MB parsed, left on the thread's own heap).
+FALLBACK_TRIM_AFTER = 1024 * 1024
 
 
 def loaded_libraries() -> list[str]:
@@ -125,6 +134,12 @@ class ChannelPump:
         self._loop = shared_loop()
         self._host: NativeHost | None = None
         self._refused = refused
+        self._capacity = capacity
+        self._max_bytes = max_bytes
+        #: The refused payloads on their way to ``refused`` (made at the first).
+        self._fallback: DeliveryQueue[tuple[bytes, MessageInfo]] | None = None
+        self._fallback_bytes = 0  # of the payloads it handled
+        self._fallback_trimmer = BurstTrimmer(trim_after=FALLBACK_TRIM_AFTER)
         self._counted = counted
         self._partition = partition
         self._name = name
@@ -178,7 +193,7 @@ class ChannelPump:
                 unrouted.append(item[1])
             else:
                 _kind, sender, msg_type, payload, _status = item
-                self._refused(payload, self._info(sender, msg_type))
+                self._fall_back(payload, self._info(sender, msg_type))
         if self._host is None:
             return None
         return self._host.native_turn(
@@ -186,6 +201,39 @@ class ChannelPump:
             monitor=bool(events & loop.monitor_event),
             broken=bool(events & loop.broken_event),
         )
+
+    def _fall_back(self, payload: bytes, info: MessageInfo) -> None:
+        """``payload`` to the channel's Python path, on the fallback thread."""
+        if self._fallback is None:
+            self._fallback = DeliveryQueue(
+                self._capacity,
+                self._handle_refused,
+                f"gz-fallback {self._name}",
+                weigh=payload_size,
+                max_bytes=self._max_bytes,
+                on_idle=self._fallback_trimmer.idle,
+            )
+        self._fallback.put((payload, info))
+
+    def _handle_refused(self, item: tuple[bytes, MessageInfo]) -> None:
+        """On the fallback thread: the channel's Python path, then the bytes it handled."""
+        try:
+            self._refused(*item)
+        finally:
+            self._fallback_bytes += len(item[0])
+            self._fallback_trimmer.received(len(item[0]))
+
+    @property
+    def bytes_so_far(self) -> int:
+        """Payload bytes read from the socket, plus those the fallback thread handled: a burst
+        is over when both stop growing (``loop.py`` trims then)."""
+        read: int = self._pump.traffic()[0]
+        return read + self._fallback_bytes
+
+    def close(self) -> None:
+        """Stop the fallback thread (after the payload it is converting). Idempotent."""
+        if self._fallback is not None:
+            self._fallback.close()
 
     def _info(self, sender: bytes, msg_type: bytes) -> MessageInfo:
         info = self._infos.get((sender, msg_type))
@@ -210,11 +258,19 @@ class ChannelPump:
         return int(self._pump.counts()[0])
 
     @property
+    def dropped_sender(self) -> str:
+        """The sender of the last payload dropped ("" before any)."""
+        sender: bytes = self._pump.traffic()[1]
+        return sender.decode(errors="replace")
+
+    @property
     def dropped(self) -> int:
         """Payloads dropped so far: the oldest, before any work on them (over the queue's count
-        or bytes), and those that could not be handed to Python (no memory for a copy)."""
+        or bytes, natively or on the way to the Python path), and those that could not be
+        handed to Python (no memory for a copy)."""
         counts = self._pump.counts()
-        return int(counts[3] + counts[5])
+        fallback = self._fallback.dropped if self._fallback is not None else 0
+        return int(counts[3] + counts[5]) + fallback
 
     # --- the loop guard -------------------------------------------------------------------
 

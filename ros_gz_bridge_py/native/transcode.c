@@ -733,6 +733,79 @@ static int header_entry(void *ctx, const struct field *f) {
 /* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
 static const uint8_t *word_bytes(const int32_t *words) { return (const uint8_t *)(words + 1); }
 
+/* The fewest bytes the ops of a body (checked by check_ops) write for one element, whatever
+ * its values: a CDR string or sequence writes at least its 4-byte length, a number or a fixed
+ * list its size; alignment is not counted. A sequence of `count` elements thus writes at least
+ * `count` times this, which lets OP_SEQ_MSG see at once that it would pass the output bound
+ * (a Pose_V of 4 M empty poses wrote 128 MiB of transforms, 0.9 s, before giving up). */
+static size_t least_bytes(const int32_t *op, const int32_t *end) {
+    size_t least = 0;
+    while (op < end && *op != OP_END) {
+        int32_t code = *op++;
+        switch (code) {
+        case OP_NUM:
+            op += 1 + op[0]; /* the path */
+            least += rgb_ros_size(op[2]);
+            op += 4;
+            break;
+        case OP_CONST:
+            least += rgb_ros_size(op[0]);
+            op += 3;
+            break;
+        case OP_STR:
+            op += 1 + op[0];
+            least += 4;
+            op += 1;
+            break;
+        case OP_CONST_STR:
+            least += 4;
+            op += rgb_text_span(op[0]);
+            break;
+        case OP_HEADER_STR:
+            op += 1 + op[0];
+            least += 4;
+            op += 1;
+            op += rgb_text_span(op[0]);
+            op += rgb_text_span(op[0]);
+            break;
+        case OP_FIXED_LIST:
+            op += 1 + op[0];
+            least += (size_t)op[3] * rgb_ros_size(op[2]);
+            op += 4;
+            break;
+        case OP_SEQ_MSG:
+            op += 1 + op[0];
+            least += 4;
+            op += 2 + op[1];
+            break;
+        case OP_COLUMN:
+        case OP_COLUMN_STR:
+            op += 1 + op[0];
+            op += 1;
+            op += 1 + op[0];
+            op += 1;
+            if (code == OP_COLUMN) op += 2;
+            least += 4;
+            break;
+        case OP_CLOCK:
+            op += 1 + op[0];
+            least += 4; /* one int32 or uint32 */
+            op += 1;
+            break;
+        case OP_WALL_STAMP:
+            least += 8;
+            break;
+        case OP_CONST_BLOCK:
+            least += (size_t)op[1];
+            op += 1 + rgb_text_span(op[1]);
+            break;
+        default:
+            return least; /* rgb_load admits no other op */
+        }
+    }
+    return least;
+}
+
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v) {
     struct rgb_out *out = c->out;
     while (op < end && *op != OP_END) {
@@ -819,6 +892,10 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             size_t count;
             status = count_of(c, at, number, &count);
             if (status) return status;
+            size_t least = least_bytes(body, body + body_len);
+            size_t limit = out->limit && out->limit < RGB_MAX_OUTPUT ? out->limit : RGB_MAX_OUTPUT;
+            if (least && (out->len > limit || count > (limit - out->len) / least))
+                return RGB_FALLBACK; /* it could not fit: Python decides (and refuses) */
             status = sequence_start(out, count, 0);
             if (status) return status;
             struct messages m = {c, body, body + body_len, element_type(c, at, number)};
@@ -895,9 +972,10 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
 /* The largest CDR message written for a payload of `n` bytes (docs/native.md §4): a message
  * of defaults has a fixed part (RGB_OUTPUT_FLOOR covers every pair's), and beyond it each
  * payload byte may give at most RGB_OUTPUT_RATIO bytes; more is an amplification (a Pose_V of
- * empty poses gives 28-40 times its size), left to Python, which refuses it too. */
+ * empty poses gives 28-40 times its size), left to Python, which refuses it too; and never
+ * more than RGB_OUTPUT_MAX. */
 static size_t output_limit(size_t n) {
-    if (n > (RGB_MAX_OUTPUT - RGB_OUTPUT_FLOOR) / RGB_OUTPUT_RATIO) return RGB_MAX_OUTPUT;
+    if (n > (RGB_OUTPUT_MAX - RGB_OUTPUT_FLOOR) / RGB_OUTPUT_RATIO) return RGB_OUTPUT_MAX;
     return RGB_OUTPUT_FLOOR + RGB_OUTPUT_RATIO * n;
 }
 

@@ -58,6 +58,10 @@ enum { WIRE_VARINT = 0, WIRE_I64 = 1, WIRE_LEN = 2, WIRE_SGROUP = 3, WIRE_EGROUP
  * (docs/native.md §4; converters/limits.py applies the same to the Python path). */
 #define RGB_OUTPUT_FLOOR ((size_t)64 << 10)
 #define RGB_OUTPUT_RATIO 16
+/* ... and never more than this, whatever the payload: the largest Gazebo message the bridge
+ * takes by default (GZ_TRANSPORT_MAX_MESSAGE_SIZE), so no ROS message it builds is larger than
+ * the largest it accepts (converters/_limits.py MAX_OUTPUT). */
+#define RGB_OUTPUT_MAX ((size_t)128 << 20)
 
 /* The wire size of a ROS basic type (0: not one). */
 static inline size_t rgb_ros_size(int32_t kind) {

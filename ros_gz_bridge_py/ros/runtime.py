@@ -28,11 +28,10 @@ from typing import Any
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import get_default_context
 
-from ros_gz_bridge_py.libc import libc_function
+from ros_gz_bridge_py.libc import libc_function, set_trim_threshold
 from ros_gz_bridge_py.ros.speed import apply_fastdds_profile, remove_zombie_segments
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
-M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3
 MMAP_THRESHOLD_BYTES = 64 * 1024 * 1024
 TRIM_THRESHOLD_BYTES = 256 * 1024 * 1024
@@ -69,7 +68,7 @@ def tune_allocator() -> bool:
     if mallopt is None:
         return False
     ok_mmap = mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES)
-    ok_trim = mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES)
+    ok_trim = set_trim_threshold(TRIM_THRESHOLD_BYTES)
     return bool(ok_mmap and ok_trim)
 
 

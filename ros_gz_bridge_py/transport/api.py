@@ -196,6 +196,11 @@ class NativeLoop(Protocol):
         """Messages it dropped."""
         ...
 
+    @property
+    def dropped_sender(self) -> str:
+        """The sender of the last message it dropped ("" before any)."""
+        ...
+
 
 #: Service handler: ``handler(request bytes) -> (success, response bytes)``.
 ServiceHandler = Callable[[bytes], tuple[bool, bytes]]

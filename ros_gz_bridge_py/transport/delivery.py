@@ -6,6 +6,7 @@ delays only its own topic and never a backend's I/O thread; when full, the oldes
 dropped and counted, the policy of ROS "keep last N". Every backend keeps them in a
 :class:`DropOldestQueue`: the ZeroMQ reader fills and drains it on its own thread
 (``zmq/reader.py``), the others through a :class:`DeliveryQueue`, which drains it on a thread.
+A queue that drops says so in one throttled warning (:class:`DropWarning`).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast
 
@@ -32,8 +34,15 @@ Deliver = Callable[[Payload, "MessageInfo"], None]
 #: One received message waiting in a queue: its payload and what the callback is told.
 Delivery = tuple[Payload, "MessageInfo"]
 
-#: Bytes a delivery queue may hold (at least one item is always kept): ten 1080p frames.
+#: Bytes a delivery queue holds by default (at least one item is always kept): ten 1080p RGB
+#: frames or two 4K RGBA ones, so a camera stream whose consumer pauses for a frame or two
+#: loses nothing, while a flood of large messages costs one channel at most this much
+#: (the bridge's ``max_queued_bytes`` parameter sets it; README, "Node parameters").
 MAX_QUEUED_BYTES = 64 * 1024 * 1024
+#: Seconds between two warnings of one queue's drops.
+DROP_WARN_PERIOD = 10.0
+#: Seconds between two ``on_idle`` calls of an idle :class:`DeliveryQueue`.
+IDLE_EVERY = 0.25
 
 
 def raw_deliverer(
@@ -92,6 +101,35 @@ def require_queue_size(size: int) -> None:
     if size < 1:
         msg = f"queue_size must be at least 1 (or None for no queue), got {size}"
         raise ValueError(msg)
+
+
+class DropWarning:
+    """The warning of one subscription queue that drops its oldest messages: at most one line
+    per :data:`DROP_WARN_PERIOD` seconds, naming the topic, the sender whose message was
+    dropped last, how many so far and the queue's bounds (one thread at a time)."""
+
+    def __init__(self, topic: str, size: int, max_bytes: int) -> None:
+        self._topic = topic
+        self._size = size
+        self._max_bytes = max_bytes
+        self._last = -DROP_WARN_PERIOD
+
+    def dropped(self, total: int, sender: str) -> None:
+        """``total`` messages dropped so far, the last of them from ``sender``."""
+        now = time.monotonic()
+        if now - self._last < DROP_WARN_PERIOD:
+            return
+        self._last = now
+        _LOG.warning(
+            "%s: %d message(s) dropped so far, oldest first, the last from %s: its queue holds "
+            "at most %d messages and %d bytes (parameter max_queued_bytes); they arrive "
+            "faster than they are bridged",
+            self._topic,
+            total,
+            sender or "this process",
+            self._size,
+            self._max_bytes,
+        )
 
 
 class QueueClosedError(Exception):
@@ -175,7 +213,8 @@ _CLOSED = object()
 class DeliveryQueue(Generic[T]):
     """A :class:`DropOldestQueue` whose items ``handler`` takes on a daemon thread of its own.
 
-    ``on_start`` runs on that thread before it takes the first item.
+    ``on_start`` runs on that thread before it takes the first item; ``on_idle`` every
+    :data:`IDLE_EVERY` seconds while no item comes (e.g. a trim after a burst).
     """
 
     def __init__(
@@ -187,10 +226,12 @@ class DeliveryQueue(Generic[T]):
         weigh: Callable[[T], int],
         max_bytes: int = MAX_QUEUED_BYTES,
         on_start: Callable[[], None] | None = None,
+        on_idle: Callable[[], None] | None = None,
     ) -> None:
         self._queue: DropOldestQueue[T] = DropOldestQueue(size, weigh=weigh, max_bytes=max_bytes)
         self._handler = handler
         self._on_start = on_start
+        self._on_idle = on_idle
         self._closed = False
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
@@ -215,11 +256,18 @@ class DeliveryQueue(Generic[T]):
         if self._on_start is not None:
             self._on_start()
         get = self._queue.get
+        idle = self._on_idle
+        wait = IDLE_EVERY if idle is not None else None
         while True:
             try:
-                item = get()
+                item = get(timeout=wait)
+            except queue.Empty:
+                if idle is not None:
+                    idle()
+                continue
             except QueueClosedError:
                 return
             if self._closed:
                 return
             self._handler(item)
+            del item  # a large payload is not kept while the queue waits for the next

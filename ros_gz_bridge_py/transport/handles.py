@@ -7,12 +7,20 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Protocol
 
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, canonical_type
 from ros_gz_bridge_py.transport.api import MessageInfo, NativeLoop, RejectCallback, Rejection
-from ros_gz_bridge_py.transport.delivery import Deliver, DeliveryQueue, Payload, payload_size
+from ros_gz_bridge_py.transport.delivery import (
+    MAX_QUEUED_BYTES,
+    Deliver,
+    DeliveryQueue,
+    DropWarning,
+    Payload,
+    payload_size,
+)
 from ros_gz_bridge_py.transport.wire_types import WireTypeCache
 
 if TYPE_CHECKING:
@@ -251,21 +259,34 @@ def offer_key(fqn: str, request_type: str, response_type: str) -> tuple[str, str
 class ThreadDelivery:
     """A queued subscription's :class:`DeliveryQueue` (the default :class:`Delivery`)."""
 
-    def __init__(self, sub: Subscription, size: int, on_start: Callable[[], None] | None) -> None:
+    def __init__(
+        self,
+        sub: Subscription,
+        size: int,
+        on_start: Callable[[], None] | None,
+        max_bytes: int = MAX_QUEUED_BYTES,
+    ) -> None:
         self._queue: DeliveryQueue[tuple[Payload, MessageInfo]] = DeliveryQueue(
             size,
             lambda item: sub.run(*item),
             f"gz-sub {sub.topic}",
             weigh=payload_size,
+            max_bytes=max_bytes,
             on_start=on_start,
         )
+        self._warning = DropWarning(sub.topic, size, max_bytes)
+        self._lock = threading.Lock()  # offers come from any thread
 
     @property
     def dropped(self) -> int:
         return self._queue.dropped
 
     def offer(self, payload: Payload, info: MessageInfo) -> int:
-        return self._queue.put((payload, info))
+        dropped = self._queue.put((payload, info))
+        if dropped:
+            with self._lock:
+                self._warning.dropped(self._queue.dropped, info.publisher_address)
+        return dropped
 
     def close(self) -> None:
         self._queue.close()

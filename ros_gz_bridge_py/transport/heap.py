@@ -5,9 +5,13 @@ The executables raise glibc's mmap and trim thresholds (``ros/runtime.py``: buff
 reuses its buffers instead of page-faulting them anew. After a burst of large messages that
 keeps hundreds of MB resident that nothing will reuse (measured: 5 messages of 60 MB left a
 bridge at 649 MB, from 169 MB). A :class:`BurstTrimmer` calls ``malloc_trim(0)`` once a
-subscription that received at least :data:`TRIM_AFTER_BYTES` has been idle for
-:data:`IDLE_BEFORE_TRIM` seconds: a steady stream never pauses that long, so it keeps its
-buffers; a burst's memory goes back. Elsewhere than glibc it does nothing.
+subscription that received at least :data:`TRIM_AFTER_BYTES` has been quiet for
+:data:`IDLE_BEFORE_TRIM` seconds: quiet is less than :data:`QUIET_RATE` bytes a second, so a
+light stream on the same topic (a real 50 Hz Odometry publisher beside a rogue's 32 MB
+frames) does not hold a burst's memory, while a steady stream of large messages, never quiet
+that long, keeps its buffers. Elsewhere than glibc it does nothing. The Python path's readers
+tell it each message (``zmq/reader.py``); the native loop, which reads in C, tells it each
+channel's running total of bytes read at every count (``native/loop.py``).
 """
 
 from __future__ import annotations
@@ -15,39 +19,78 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from ros_gz_bridge_py.libc import libc_function
+from ros_gz_bridge_py.libc import libc_function, shrink_thread_arena
 
-#: Bytes received since the last trim that make an idle pause worth a trim.
+#: Bytes received since the last trim that make a quiet pause worth a trim.
 TRIM_AFTER_BYTES = 64 * 1024 * 1024
-#: Seconds without a message after which a burst counts as over.
+#: Seconds of quiet after which a burst counts as over.
 IDLE_BEFORE_TRIM = 1.0
+#: Bytes a second below which a subscription is quiet: 1 MiB/s is a 20 kB message at 50 Hz.
+QUIET_RATE = 1024 * 1024
+#: Seconds over which the rate is measured (at least).
+RATE_WINDOW = 0.25
 
 
 def trim_heap() -> bool:
-    """``malloc_trim(0)``: free heap pages of every arena back to the system (glibc only)."""
+    """``malloc_trim(0)``: free heap pages of every arena back to the system (glibc only),
+    after the free top of the calling thread's own arena (``libc.shrink_thread_arena``):
+    call it on the thread that handled the burst."""
     trim = libc_function("malloc_trim")
-    return trim is not None and bool(trim(0))
+    if trim is None:
+        return False
+    shrink_thread_arena()
+    return bool(trim(0))
 
 
 class BurstTrimmer:
-    """Counts received bytes; :meth:`idle` trims once after a large burst (one thread)."""
+    """Counts received bytes; :meth:`idle` trims once after a burst of ``trim_after`` bytes or
+    more (one thread, the one that handled the burst)."""
 
-    def __init__(self, trim: Callable[[], object] = trim_heap) -> None:
+    def __init__(
+        self, trim: Callable[[], object] = trim_heap, trim_after: int = TRIM_AFTER_BYTES
+    ) -> None:
         self._trim = trim
-        self._bytes = 0
-        self._last = 0.0
+        self._trim_after = trim_after
+        self._bytes = 0  # since the last trim
+        self._window_bytes = 0
+        self._window_start: float | None = None
+        self._last = 0.0  # when the last window above QUIET_RATE ended
+        self._total = 0
         self.trims = 0
 
-    def received(self, size: int) -> None:
+    def received(self, size: int, now: float | None = None) -> None:
         self._bytes += size
-        self._last = time.monotonic()
+        self._window_bytes += size
+        self._close_window(time.monotonic() if now is None else now)
+
+    def read_so_far(self, total: int, now: float) -> None:
+        """``total`` bytes received since the start (what came since the last call is
+        received now), then :meth:`idle`."""
+        if total > self._total:
+            self.received(total - self._total, now)
+            self._total = total
+        self.idle(now)
 
     def idle(self, now: float | None = None) -> None:
         """Call when nothing is waiting: trims after a burst that has ended."""
-        if self._bytes < TRIM_AFTER_BYTES:
-            return
         now = time.monotonic() if now is None else now
-        if now - self._last >= IDLE_BEFORE_TRIM:
+        self._close_window(now)
+        if self._bytes >= self._trim_after and now - self._last >= IDLE_BEFORE_TRIM:
             self._bytes = 0
             self.trims += 1
             self._trim()
+
+    def _close_window(self, now: float) -> None:
+        """Ends the rate window once it is :data:`RATE_WINDOW` long; a loud one moves the
+        start of the quiet to its end."""
+        start = self._window_start
+        if start is None:
+            self._window_start = now
+            return
+        span = now - start
+        if span < RATE_WINDOW:
+            return
+        if self._window_bytes > QUIET_RATE * span:
+            self._last = now
+        self._window_bytes = 0
+        self._window_start = now

@@ -37,6 +37,7 @@ from ros_gz_bridge_py.transport.api import (
     TransportStats,
 )
 from ros_gz_bridge_py.transport.delivery import (
+    MAX_QUEUED_BYTES,
     Deliver,
     Payload,
     raw_deliverer,
@@ -181,6 +182,7 @@ class GzNode(abc.ABC):
         *,
         ignore_local: bool = False,
         queue_size: int | None = None,
+        queue_bytes: int = MAX_QUEUED_BYTES,
         copy: bool = True,
         on_delivery_start: Callable[[], None] | None = None,
         on_reject: RejectCallback | None = None,
@@ -190,7 +192,8 @@ class GzNode(abc.ABC):
 
         ``queue_size`` None runs ``callback`` on the thread that receives (the backend's);
         N gives the subscription its own delivery thread behind a drop-oldest queue of N
-        messages, which first runs ``on_delivery_start`` (e.g. to set its own priority).
+        messages, which first runs ``on_delivery_start`` (e.g. to set its own priority), and
+        of at most ``queue_bytes`` payload bytes (but always one message).
         ``copy=False`` hands over the backend's buffer (``bytes`` or a read-only
         ``memoryview``) instead of copying it into ``bytes``. ``on_reject(reason, detail)`` is
         told of each message of the topic the transport could not use (a malformed frame,
@@ -209,7 +212,7 @@ class GzNode(abc.ABC):
         deliver = raw_deliverer(self.count, callback, copy=copy)
         return self._add_subscription(
             topic, msg_type, deliver, ignore_local, queue_size, on_delivery_start, on_reject,
-            native,
+            native, queue_bytes,
         )  # fmt: skip
 
     def subscribe_typed(
@@ -241,6 +244,7 @@ class GzNode(abc.ABC):
         on_start: Callable[[], None] | None,
         on_reject: RejectCallback | None,
         native: NativeLoop | None = None,
+        queue_bytes: int = MAX_QUEUED_BYTES,
     ) -> Subscription:
         self._check_open()
         sub = self.subscription_class(
@@ -249,7 +253,7 @@ class GzNode(abc.ABC):
         sub.on_reject = on_reject
         sub.native = native
         if queue_size is not None:
-            sub.delivery = self._open_delivery(sub, queue_size, on_start)
+            sub.delivery = self._open_delivery(sub, queue_size, on_start, queue_bytes)
         with self._subscriptions_lock:
             self._subscriptions[sub.fqn] = (*self._subscriptions.get(sub.fqn, ()), sub)
         try:
@@ -275,10 +279,10 @@ class GzNode(abc.ABC):
         return self._subscriptions.get(fqn, ())
 
     def _open_delivery(
-        self, sub: Subscription, size: int, on_start: Callable[[], None] | None
+        self, sub: Subscription, size: int, on_start: Callable[[], None] | None, max_bytes: int
     ) -> Delivery:
         """The queued delivery of ``sub``: by default a thread behind a drop-oldest queue."""
-        return ThreadDelivery(sub, size, on_start)
+        return ThreadDelivery(sub, size, on_start, max_bytes)
 
     # --- services ---------------------------------------------------------------------------
 

@@ -46,7 +46,7 @@ MB = 1_000_000
 class BridgeUnderAttack:
     """A bridge process bridging ``topic`` Gazebo -> ROS, and its /diagnostics so far."""
 
-    def __init__(self, ros_side: RosSide, stem: str) -> None:
+    def __init__(self, ros_side: RosSide, stem: str, *parameters: str) -> None:
         self.topic = unique_name(stem)
         self.fqn = fully_qualified_name(TransportSettings.from_env().partition, "", self.topic)
         self.node_name = unique_name(f"{stem}_bridge").lstrip("/")
@@ -60,7 +60,13 @@ class BridgeUnderAttack:
         )
         self.process: PeerProcess = start_bridge(
             f"{self.topic}@std_msgs/msg/String[{STRING}",
-            ros_args=["-r", f"__node:={self.node_name}", "-p", "status_period:=0.5"],
+            ros_args=[
+                "-r",
+                f"__node:={self.node_name}",
+                "-p",
+                "status_period:=0.5",
+                *(arg for parameter in parameters for arg in ("-p", parameter)),
+            ],
             creating=1,
         )
         self.ros_inbox, self._ros_subscription = ros_side.subscribe(String, self.topic)
@@ -149,6 +155,34 @@ def test_a_rogue_publishers_200_mb_frames_are_refused_counted_and_cost_no_memory
     assert values["errors: over the size limit"] == "4"
     assert highest - start < 100 * MB
     assert "over the size limit" in bridge.process.output()
+
+
+@pytest.mark.parametrize("native", [True, False], ids=["native", "python"])
+def test_a_flood_past_max_queued_bytes_is_dropped_counted_and_told(
+    ros_side: RosSide, monkeypatch: pytest.MonkeyPatch, native: bool
+) -> None:
+    """A bridge whose queues hold 2 MB (``max_queued_bytes``) takes 100 messages of 1 MB from
+    a rogue publisher, handed over far faster than it publishes them: the oldest are dropped,
+    counted in the channel's drops on /diagnostics, and one warning names the topic and the
+    rogue's address (before the parameter, the queue held 64 MiB: up to 64 of them)."""
+    if not native:
+        monkeypatch.setenv("ROS_GZ_BRIDGE_NATIVE", "off")
+    bridge = BridgeUnderAttack(ros_side, f"bytes_{native}", "max_queued_bytes:=2000000")
+    rogue = RoguePublisher(bridge.fqn, STRING, sndhwm=1000)
+    payload = GzString(data="x" * MB).SerializeToString()
+    try:
+        assert rogue.wait_subscribed(WAIT)
+        time.sleep(0.3)  # the subscription reaches the rogue before the bridge reads the pipe
+        for _ in range(100):
+            rogue.send(payload)
+        wait_until(lambda: int(bridge.values().get("dropped", "0")) > 0, WAIT, "drops counted")
+    finally:
+        rogue.close()
+        bridge.close()
+    output = bridge.process.output()
+    assert "message(s) dropped so far" in output
+    assert f"the last from {rogue.address}" in output
+    assert "at most 1000 messages and 2000000 bytes (parameter max_queued_bytes)" in output
 
 
 def test_undecodable_and_malformed_messages_are_counted_exactly(

@@ -378,3 +378,27 @@ def test_an_entry_that_cannot_be_bridged_is_refused_whole(rig: Rig) -> None:
     rig.world.run(rig.bridge.close)
     with pytest.raises(BridgeError, match="closed"):
         rig.add(string_spec(topic, Direction.GZ_TO_ROS))
+
+
+@pytest.mark.parametrize(("max_queued_bytes", "dropping"), [(3_000_000, True), (64 << 20, False)])
+def test_max_queued_bytes_bounds_each_channel_queue(
+    make_rig: Any, max_queued_bytes: int, dropping: bool
+) -> None:
+    """50 serialized messages of 1 MB handed over at once (microseconds each, against a
+    millisecond to convert and publish one): a bridge whose queues hold 3 MB drops some,
+    counted in the channel's drops; with the default 64 MiB none is dropped (before
+    ``max_queued_bytes``, every bridge took all 50)."""
+    rig: Rig = make_rig(options(max_queued_bytes=max_queued_bytes))
+    topic = unique("bytes")
+    spec = TopicBridgeSpec(topic, topic, "std_msgs/msg/String", "gz.msgs.StringMsg",
+                           Direction.GZ_TO_ROS)  # fmt: skip
+    channel = gz_to_ros(rig.add(spec))
+    publisher = rig.gazebo().advertise(topic, "gz.msgs.StringMsg")
+    payload = message_class("gz.msgs.StringMsg")(data="x" * 1_000_000).SerializeToString()
+    for _ in range(50):
+        publisher.publish_raw(payload)
+    wait_until(
+        lambda: channel.stats.published + channel.dropped == 50,
+        "all 50 published or dropped",
+    )
+    assert (channel.dropped > 0) == dropping, channel.dropped

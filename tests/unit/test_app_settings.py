@@ -26,6 +26,7 @@ from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
     SharedParameters,
     Switches,
+    checked_max_queued_bytes,
     checked_max_rate,
     declare_image_bridge_parameters,
     declare_parameter_bridge_parameters,
@@ -34,6 +35,7 @@ from ros_gz_bridge_py.app.settings import (
 from ros_gz_bridge_py.core.bridge import BridgeOptions
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.transport import NodeOptions
+from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 #: Each on/off switch and the field it sets.
 OFF_SWITCHES = {
@@ -155,7 +157,9 @@ def test_bridge_options_from_parameters_and_switches() -> None:
         gz_version="GARDEN",
     )
     switches = Switches(bulk_path=False, rcl_serialized_publish=False, bulk_nice=2, cdr_write=False)
-    options = shared.bridge_options(switches, gz_version="garden", service_timeout=1.5)
+    options = shared.bridge_options(
+        switches, gz_version="garden", service_timeout=1.5, max_queued_bytes=5_000_000
+    )
     assert options == BridgeOptions(
         lazy=True,
         heartbeat=0.25,
@@ -168,6 +172,7 @@ def test_bridge_options_from_parameters_and_switches() -> None:
         light_read=True,
         cdr_write=False,
         gz_version="garden",
+        max_queued_bytes=5_000_000,
     )
 
 
@@ -238,6 +243,7 @@ def test_parameter_bridge_values(ros_context: Context) -> None:
             Parameter("bridge_names", value=["a", "b"]),
             Parameter("status_period", value=2),
             Parameter("max_rate", value=10),
+            Parameter("max_queued_bytes", value=8_000_000),
             Parameter("auto_bridge", value=True),
             Parameter("auto_bridge_allow", value=["^/model/"]),
             Parameter("auto_bridge_deny", value=["camera", "lidar"]),
@@ -249,7 +255,9 @@ def test_parameter_bridge_values(ros_context: Context) -> None:
     finally:
         node.destroy_node()
     assert params == ParameterBridgeParameters(
-        SharedParameters("/b.yaml", True, 200, True, "base", "zenoh", "fortress", True, 10),
+        SharedParameters(
+            "/b.yaml", True, 200, True, "base", "zenoh", "fortress", True, 10, 8_000_000
+        ),
         service_timeout=0.5,
         bridge_names=("a", "b"),
         status_period=2,
@@ -272,6 +280,14 @@ def test_max_rate_parameter_is_checked(value: object, expected: tuple[float, str
         assert "no limit is applied" in problem
     else:
         assert (rate, problem) == expected
+
+
+@pytest.mark.parametrize("value", [0, -1])
+def test_a_queue_of_no_bytes_is_reported_and_the_default_used(value: int) -> None:
+    size, problem = checked_max_queued_bytes(SharedParameters(max_queued_bytes=value))
+    assert size == MAX_QUEUED_BYTES
+    assert f"parameter max_queued_bytes is {value}; it must be at least 1" in problem
+    assert checked_max_queued_bytes(SharedParameters(max_queued_bytes=1)) == (1, "")
 
 
 @pytest.mark.ros

@@ -55,7 +55,7 @@ class DataIntake:
         return sum(reader.received for reader in self.readers)
 
     def open_reader(
-        self, sub: Subscription, size: int, on_start: Callable[[], None] | None
+        self, sub: Subscription, size: int, on_start: Callable[[], None] | None, max_bytes: int
     ) -> SubscriptionReader:
         """A queued subscription's own SUB socket and thread (``reader.py``)."""
         node = self._node
@@ -63,6 +63,7 @@ class DataIntake:
             self._context, fqn=sub.fqn, partition=node.partition, accepts=sub.accepts_from,
             takes=sub.accepts, deliver=sub.run, reject=sub.reject, size=size,
             settings=node.settings, count=node.count, on_start=on_start, native=sub.native,
+            max_bytes=max_bytes,
         )  # fmt: skip
         self.readers.append(reader)
         return reader

@@ -272,10 +272,10 @@ class ZmqGzNode(GzNode):
                 _LOG.debug("publish on %s failed: %s", publisher.topic, error)
 
     def _open_delivery(
-        self, sub: Subscription, size: int, on_start: Callable[[], None] | None
+        self, sub: Subscription, size: int, on_start: Callable[[], None] | None, max_bytes: int
     ) -> SubscriptionReader:
         """A queued subscription reads its topic's SUB socket on its own thread (reader.py)."""
-        return self._intake.open_reader(sub, size, on_start)
+        return self._intake.open_reader(sub, size, on_start, max_bytes)
 
     def _open_subscription(self, sub: Subscription) -> None:
         # Waited for: whether the shared socket subscribes to the topic depends on the topic's

@@ -48,6 +48,7 @@ from ros_gz_bridge_py.transport.delivery import (
     MAX_QUEUED_BYTES,
     Delivery,
     DropOldestQueue,
+    DropWarning,
     Payload,
     payload_size,
 )
@@ -114,6 +115,7 @@ class SubscriptionReader:
             size, weigh=payload_size, max_bytes=max_bytes
         )
         self._count = count
+        self._warning = DropWarning(fqn, size, max_bytes)
         self._trimmer = BurstTrimmer()
         self._on_start = on_start
         self._infos: dict[tuple[Frame, Frame, Frame], Verdict] = {}
@@ -243,6 +245,7 @@ class SubscriptionReader:
         if dropped:
             self._native_dropped += dropped
             self._count("messages_dropped", dropped)
+            self._warning.dropped(self.dropped, native.dropped_sender)
         now = time.monotonic()
         connections = self._connections
         if monitor or connections.is_due(now):
@@ -366,6 +369,7 @@ class SubscriptionReader:
         dropped = self._pending.put(item)
         if dropped:
             self._count("messages_dropped", dropped)
+            self._warning.dropped(self.dropped, item[1].publisher_address)
 
 
 def receive_message(sock: Any) -> list[Frame]:

@@ -10,11 +10,12 @@ message: an Odometry followed by 768 KiB of small unknown fields took 60-72 ms n
 
 from __future__ import annotations
 
+import struct
 from typing import Any
 
 import pytest
 
-from ros_gz_bridge_py.converters._limits import OUTPUT_FLOOR, OUTPUT_RATIO
+from ros_gz_bridge_py.converters._limits import MAX_OUTPUT, OUTPUT_FLOOR, OUTPUT_RATIO
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 from tests.unit.native import gz_payloads as gzp
@@ -112,6 +113,23 @@ def test_large_messages_within_the_bound_pass(ros_type: str) -> None:
     assert transcoder.check(_empty_poses(400), well_formed=True) == OK
     pose = distinctive("gz.msgs.Pose_V").pose[0].SerializeToString()
     assert transcoder.check(gzp.length_delimited(2, pose) * 20_000, well_formed=True) == OK
+
+
+def test_no_output_exceeds_the_cap_on_either_path() -> None:
+    """Poses that each carry one coordinate are within the ratio (56 bytes written for 13 read),
+    but 2.4 M of them (31 MB) would make a PoseArray of 134 MB: past MAX_OUTPUT both paths
+    refuse it (before the cap, both wrote it)."""
+    transcoder = _pair("geometry_msgs/msg/PoseArray", "gz.msgs.Pose_V")
+    x = gzp.tag(2, 1) + struct.pack("<d", 1.5)  # Vector3d.x, a double
+    pose = gzp.length_delimited(4, x)  # Pose.position
+    count = MAX_OUTPUT // 56 + 1000
+    payload = gzp.length_delimited(2, pose) * count  # Pose_V.pose
+    assert OUTPUT_FLOOR + OUTPUT_RATIO * len(payload) > 56 * count  # within the ratio
+    status, cdr = transcoder.program.to_cdr(payload)
+    assert (status, cdr) == (FALLBACK, None)
+    gz = message_class("gz.msgs.Pose_V").FromString(payload)
+    with pytest.raises(ConversionError, match=rf"{count} Pose items .* at most {MAX_OUTPUT}"):
+        transcoder.pair.to_ros(gz)
 
 
 def test_every_distinctive_message_is_within_the_bound() -> None:

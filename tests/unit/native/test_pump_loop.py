@@ -130,6 +130,7 @@ def test_the_queue_is_bounded_in_bytes(native: Any, publisher: Any) -> None:
         rig.connected()
         rig.settle()
         before = rig.pump.counts()
+        read_before, no_sender = rig.pump.traffic()
         payload = message_class("gz.msgs.StringMsg")(data="x" * size).SerializeToString()
         for _ in range(count):
             rig.send(LEGIT, payload)
@@ -141,6 +142,9 @@ def test_the_queue_is_bounded_in_bytes(native: Any, publisher: Any) -> None:
         assert dropped > 0
         assert (received + dropped, lost) == (count, 0)
         assert published == received
+        # what the loop's trim after a burst and the drop warning read
+        assert no_sender == b""
+        assert rig.pump.traffic() == (read_before + count * len(payload), LEGIT)
     finally:
         rig.close()
 

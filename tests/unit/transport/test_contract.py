@@ -284,6 +284,40 @@ def test_queue_drops_the_oldest_on_its_own_thread(pair: tuple[GzNode, GzNode]) -
         a.subscribe(topic, slow, GZ, on_delivery_start=lambda: None)
 
 
+def test_a_queue_is_bounded_in_bytes_as_well_as_messages(
+    pair: tuple[GzNode, GzNode], caplog: pytest.LogCaptureFixture
+) -> None:
+    """A queue of 1000 messages and 3 MB behind a callback that holds the first message: 40
+    messages of 1 MB from the other node leave the newest 3 in the queue; the others are
+    dropped, counted and told in one warning that names the topic (before: the byte bound was
+    the fixed 64 MiB, so the queue took every one of them)."""
+    a, b = pair
+    topic = unique("bytes")
+    release, handling = threading.Event(), threading.Event()
+    got: list[str] = []
+    payload = 1_000_000
+
+    def slow(data: bytes, _info: MessageInfo) -> None:
+        handling.set()
+        release.wait(LIMIT)
+        got.append(StringMsg.FromString(data).data[:3])
+
+    sub = a.subscribe(topic, slow, GZ, queue_size=1000, queue_bytes=3 * (payload + 10))
+    pub = b.advertise(topic, GZ)
+    assert publish_until(lambda: pub.publish(StringMsg(data="hld")), handling.is_set)
+    sent = 40
+    for index in range(sent):
+        pub.publish(StringMsg(data=f"{index:03d}".ljust(payload, "x")))
+        time.sleep(0.005)
+    assert wait_until(lambda: sub.dropped >= sent - 3)
+    release.set()
+    assert wait_until(lambda: got[-3:] == ["037", "038", "039"])
+    # a second "hld" may have crossed the first: then it was dropped too
+    assert sent - 3 <= sub.dropped == a.stats.messages_dropped <= sent - 2
+    assert f"{topic}: " in caplog.text or f"{a.fqn(topic)}: " in caplog.text
+    assert "parameter max_queued_bytes" in caplog.text
+
+
 def test_callback_errors_are_counted_not_raised(pair: tuple[GzNode, GzNode]) -> None:
     a, b = pair
     topic = unique("raising")

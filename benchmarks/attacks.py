@@ -1,0 +1,396 @@
+"""The attack suite: hostile payloads from a rogue publisher beside real ones, with figures.
+
+``python -m benchmarks.attacks`` runs each attack against a bridge on the native path (the
+default) and on the Python path (``ROS_GZ_BRIDGE_NATIVE=off``) and writes the figures to the
+"Attacks" section of SOAK.md; ``tests/faults/test_attacks.py`` runs a few seconds of each and
+asserts the bounds that are not timing.
+
+What runs, all on loopback, on discovery ports of its own: the bridge (``/amp_clock`` Clock,
+``/amp_odom`` Odometry and ``/amp_tf`` TFMessage from Pose_V, Gazebo -> ROS); the real
+Fortress peer publishing Clock at 500 Hz and Odometry at 50 Hz (its ``child_frame_id`` is
+``real``, so its messages are told from the rogue's on ROS); one rclpy process counting what
+reaches ROS (``tests/faults/attack_ros.py``). A rogue ZeroMQ publisher that advertises itself
+through valid discovery (``tests/rogue.py``) then sends, one attack after the other:
+
+- ``padded_odometry``: an Odometry padded with a 32 MB unknown field, as fast as ZeroMQ sends
+  them (the rogue's send queue holds two and its sends wait for room: it never buffers more,
+  and it sends no faster than the bridge's side of the connection takes them);
+- ``empty_poses``: a Pose_V of 4 M empty poses (8 MB), twice a second, on ``/amp_tf``;
+- ``unknown_fields``: an Odometry followed by 768 KiB of 3-byte unknown fields, 20 a second.
+
+Per attack: the messages the rogue sent, the real /clock and Odometry messages that reached ROS
+during it (percent of the publishers' nominal rates), the bridge's CPU during it, its peak RSS
+above its resting size (before the first attack), and its RSS ``after`` seconds after the attack,
+above the same resting size.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import threading
+import time
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import zmq
+
+from benchmarks.harness import cpu_seconds, rss_mb
+from benchmarks.soak import ATTACKS_SECTION, soak_env
+from ros_gz_bridge_py.app.settings import NATIVE_ENV
+from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.transport.names import fully_qualified_name
+from tests.bridge.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
+from tests.gzpeer import peer_binary
+from tests.rogue import RoguePublisher
+
+ROOT = Path(__file__).resolve().parent.parent
+ROS_SIDE = ROOT / "tests" / "faults" / "attack_ros.py"
+CLOCK, ODOM, TF = "/amp_clock", "/amp_odom", "/amp_tf"
+CLOCK_HZ, ODOM_HZ = 500, 50
+ODOM_TEXT = (
+    'header { stamp { sec: 7 } data { key: "child_frame_id" value: "real" } } '
+    "pose { position { x: 1.5 } }"
+)
+#: Seconds to wait for the bridge, the peers and the ROS side to be connected.
+START_LIMIT = 60.0
+#: Seconds between two RSS samples of the bridge (for its peak).
+SAMPLE_EVERY = 0.01
+SECTION = ATTACKS_SECTION
+PATHS = ("native", "python")
+
+
+def _varint(value: int) -> bytes:
+    out = bytearray()
+    while True:
+        byte = value & 0x7F
+        value >>= 7
+        if value:
+            out.append(byte | 0x80)
+        else:
+            out.append(byte)
+            return bytes(out)
+
+
+def _odometry() -> bytes:
+    odom = message_class("gz.msgs.Odometry")()
+    odom.header.stamp.sec = 9
+    odom.pose.position.x = 2.5
+    return bytes(odom.SerializeToString())
+
+
+def padded_odometry(size: int) -> bytes:
+    """An Odometry and one unknown length-delimited field (number 1000) of ``size`` bytes."""
+    return _odometry() + _varint(1000 << 3 | 2) + _varint(size) + bytes(size)
+
+
+def empty_poses(count: int) -> bytes:
+    """A Pose_V of ``count`` empty poses (field 2, length 0: two bytes each)."""
+    return b"\x12\x00" * count
+
+
+def small_unknown_fields(size: int) -> bytes:
+    """An Odometry followed by ``size`` bytes of unknown varint fields (number 1000, 3 bytes
+    each with a one-byte value)."""
+    field_bytes = _varint(1000 << 3) + b"\x01"
+    return _odometry() + field_bytes * (size // len(field_bytes))
+
+
+@dataclass(frozen=True)
+class Attack:
+    name: str
+    topic: str
+    msg_type: str
+    payload: bytes
+    #: Messages per second; 0: as fast as ZeroMQ takes them.
+    per_second: float
+
+
+def attacks(padding_mb: int = 32) -> list[Attack]:
+    padded = padded_odometry(padding_mb << 20)
+    return [
+        Attack("padded_odometry", ODOM, "ignition.msgs.Odometry", padded, 0.0),
+        Attack("empty_poses", TF, "ignition.msgs.Pose_V", empty_poses(4 << 20), 2.0),
+        Attack(
+            "unknown_fields", ODOM, "ignition.msgs.Odometry", small_unknown_fields(768 << 10), 20
+        ),
+    ]
+
+
+@dataclass
+class Outcome:
+    """What one attack did to one bridge."""
+
+    attack: str
+    path: str
+    seconds: float
+    sent: int
+    clock_percent: float
+    odom_percent: float
+    cpu_percent: float
+    resting_mb: float
+    peak_above_mb: float
+    after_above_mb: float
+    #: The largest serialized message of each topic on ROS so far.
+    largest: dict[str, int] = field(default_factory=dict)
+    bridge_alive: bool = True
+
+
+class PeakRss:
+    """Samples a process's RSS on a thread, keeping the peak."""
+
+    def __init__(self, pid: int) -> None:
+        self._pid = pid
+        self.peak = rss_mb(pid)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.wait(SAMPLE_EVERY):
+            self.peak = max(self.peak, rss_mb(self._pid))
+
+    def stop(self) -> float:
+        self._stop.set()
+        self._thread.join()
+        return self.peak
+
+
+class AttackRun:
+    """One bridge (one path) and its real peers, attacked in turn."""
+
+    def __init__(self, native: bool, *, seconds: float, after: float) -> None:
+        self.path = "native" if native else "python"
+        self.seconds = seconds
+        self.after = after
+        self.env = soak_env()
+        # the bridge runs this tree's package, whichever checkout the venv was installed from
+        path = self.env.get("PYTHONPATH")
+        self.env["PYTHONPATH"] = f"{ROOT}{os.pathsep}{path}" if path else str(ROOT)
+        if not native:
+            self.env[NATIVE_ENV] = "off"
+        self.group = ProcessGroup()
+        self.outcomes: list[Outcome] = []
+        self.status_table = ""
+        self.resting = 0.0
+
+    def run(self, chosen: list[Attack]) -> list[Outcome]:
+        saved = dict(os.environ)
+        os.environ.update(self.env)  # the rogue's discovery reads the environment
+        try:
+            self._start()
+            self.resting = self._resting()
+            for attack in chosen:
+                self.outcomes.append(self._attack(attack))
+                if not self.outcomes[-1].bridge_alive:
+                    break
+            self._status()
+        finally:
+            self.group.stop()
+            os.environ.clear()
+            os.environ.update(saved)
+        return self.outcomes
+
+    def _start(self) -> None:
+        clock_file = ROOT / ".build" / f"attack-clock-{uuid.uuid4().hex[:6]}.pb"
+        clock_file.parent.mkdir(exist_ok=True)
+        clock_file.write_bytes(message_class("gz.msgs.Clock")().SerializeToString())
+        lifetime = str(int(2 * START_LIMIT + 3 * (self.seconds + self.after + 30)))
+        self.bridge = self.group.start(
+            [
+                str(PARAMETER_BRIDGE),
+                f"{CLOCK}@rosgraph_msgs/msg/Clock[gz.msgs.Clock",
+                f"{ODOM}@nav_msgs/msg/Odometry[gz.msgs.Odometry",
+                f"{TF}@tf2_msgs/msg/TFMessage[gz.msgs.Pose_V",
+            ],
+            self.env,
+        )
+        peer = str(peer_binary())
+        self.group.start(
+            [
+                peer, "kind-pub", CLOCK, "ignition.msgs.Clock", str(clock_file), lifetime,
+                "--stamp", "sim", "--hz", str(CLOCK_HZ), "--wait", str(START_LIMIT),
+            ],
+            self.env,
+        )  # fmt: skip
+        self.group.start(
+            [
+                peer,
+                "pub",
+                ODOM,
+                "ignition.msgs.Odometry",
+                str(ODOM_HZ),
+                "0",
+                ODOM_TEXT,
+                "--wait",
+                "0",
+            ],
+            self.env,
+        )
+        spec = {"clock": CLOCK, "odom": ODOM, "tf": TF, "seconds": float(lifetime)}
+        self.ros = self.group.start([sys.executable, str(ROS_SIDE), json.dumps(spec)], self.env)
+        deadline = time.monotonic() + START_LIMIT
+        while time.monotonic() < deadline:
+            counts = self._counts()
+            if counts.get("clock", 0) > CLOCK_HZ and counts.get("odom_real", 0) > ODOM_HZ:
+                time.sleep(2.0)  # the bridge settles at its resting size
+                return
+            time.sleep(0.25)
+        msg = f"the {self.path} bridge did not carry the real publishers within {START_LIMIT} s"
+        raise RuntimeError(msg + "\n" + self.bridge.output()[-3000:])
+
+    def _resting(self) -> float:
+        """The bridge's RSS at rest: the least of five samples 0.2 s apart."""
+        samples = []
+        for _ in range(5):
+            samples.append(rss_mb(self.bridge.pid))
+            time.sleep(0.2)
+        return min(samples)
+
+    def _counts(self, before: float | None = None) -> dict[str, Any]:
+        """The ROS side's newest counts (at or before ``before``)."""
+        records = [json.loads(line) for line in lines(self.ros, "COUNTS ")]
+        if before is not None:
+            records = [r for r in records if r["t"] <= before]
+        return records[-1] if records else {}
+
+    def _counts_at(self, moment: float) -> dict[str, Any]:
+        time.sleep(max(0.0, moment + 0.3 - time.monotonic()))  # printed every 0.25 s
+        return self._counts(before=moment + 0.25)
+
+    def _attack(self, attack: Attack) -> Outcome:
+        pid = self.bridge.pid
+        resting = self.resting
+        fqn = fully_qualified_name(self.env["GZ_PARTITION"], "", attack.topic)
+        rogue = RoguePublisher(fqn, attack.msg_type, sndhwm=2)
+        rogue.xpub.setsockopt(zmq.XPUB_NODROP, 1)  # a full queue makes send wait, not drop
+        rogue.xpub.setsockopt(zmq.SNDTIMEO, 1000)
+        sent = 0
+        try:
+            if not rogue.wait_subscribed(20.0):
+                msg = f"the {self.path} bridge never connected to the rogue on {attack.topic}"
+                raise RuntimeError(msg)
+            peak = PeakRss(pid)
+            start, cpu_start = time.monotonic(), cpu_seconds(pid)
+            view = memoryview(attack.payload)
+            period = 1.0 / attack.per_second if attack.per_second else 0.0
+            next_send = start
+            while (now := time.monotonic()) < start + self.seconds:
+                if period and now < next_send:
+                    time.sleep(min(next_send - now, 0.01))
+                    continue
+                try:
+                    rogue.send(view)
+                except zmq.Again:  # the bridge took nothing for a second
+                    continue
+                sent += 1
+                next_send += period
+            end, cpu_end = time.monotonic(), cpu_seconds(pid)
+        finally:
+            rogue.close()
+        time.sleep(self.after)
+        after = rss_mb(pid) if self.bridge.poll() is None else 0.0
+        highest = peak.stop()
+        first, last = self._counts_at(start), self._counts_at(end)
+        span = end - start
+
+        def percent(key: str, hz: int) -> float:
+            return round(100 * (int(last[key]) - int(first[key])) / (hz * span), 1)
+
+        return Outcome(
+            attack=attack.name,
+            path=self.path,
+            seconds=round(span, 1),
+            sent=sent,
+            clock_percent=percent("clock", CLOCK_HZ),
+            odom_percent=percent("odom_real", ODOM_HZ),
+            cpu_percent=round(100 * (cpu_end - cpu_start) / span, 1),
+            resting_mb=round(resting, 1),
+            peak_above_mb=round(highest - resting, 1),
+            after_above_mb=round(after - resting, 1),
+            largest=dict(self._counts().get("largest", {})),
+            bridge_alive=self.bridge.poll() is None,
+        )
+
+    def _status(self) -> None:
+        """The bridge's status table (SIGUSR1), for the report."""
+        if self.bridge.poll() is not None:
+            return
+        self.bridge.send_signal(10)  # SIGUSR1
+        time.sleep(1.0)
+        output = self.bridge.output().splitlines()
+        heads = [i for i, line in enumerate(output) if line.startswith("LEVEL ")]
+        self.status_table = "\n".join(output[heads[-1] :]) if heads else ""
+
+
+def report(runs: list[AttackRun], seconds: float, after: float, command: str) -> str:
+    """The Attacks section of SOAK.md."""
+    commit = subprocess.run(
+        ["git", "rev-parse", "--short", "HEAD"],
+        check=False,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    ).stdout.strip()
+    load = " ".join(f"{value:.2f}" for value in os.getloadavg())
+    rows = [
+        SECTION,
+        "",
+        f"Generated by `{command}` at commit {commit} on "
+        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; load average at the end "
+        f"{load} (2 cores, shared). Each attack lasts {seconds:g} s; RSS after is {after:g} s "
+        "after it. `benchmarks/attacks.py` says what runs. Goals: real /clock and Odometry "
+        ">= 95% delivered, peak RSS <= 300 MB above resting, RSS after within 50 MB of resting.",
+        "",
+        "| attack | path | sent | /clock % | Odometry % | bridge CPU % | resting MB "
+        "| peak above MB | after above MB | largest on ROS (bytes) |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for run in runs:
+        for o in run.outcomes:
+            largest = ", ".join(f"{k} {v}" for k, v in o.largest.items())
+            rows.append(
+                f"| {o.attack} | {o.path} | {o.sent} | {o.clock_percent} | {o.odom_percent} "
+                f"| {o.cpu_percent} | {o.resting_mb} | {o.peak_above_mb} | {o.after_above_mb} "
+                f"| {largest} |"
+            )
+    for run in runs:
+        rows += ["", f"The {run.path} bridge's status table at the end:", "", "```"]
+        rows += [run.status_table, "```"]
+    return "\n".join(rows) + "\n"
+
+
+def write_section(path: Path, section: str) -> None:
+    """Replace (or add) the Attacks section at the end of ``path``."""
+    text = "\n" + path.read_text() if path.exists() else ""
+    head = text.split(f"\n{SECTION}\n", 1)[0].strip("\n")
+    path.write_text(f"{head}\n\n{section}" if head else section)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.attacks")
+    parser.add_argument("--seconds", type=float, default=6.0)
+    parser.add_argument("--after", type=float, default=10.0)
+    parser.add_argument("--report", type=Path, default=ROOT / "SOAK.md")
+    parser.add_argument("--paths", nargs="+", choices=("native", "python"), default=PATHS)
+    parser.add_argument("--padding-mb", type=int, default=32, help="padded_odometry's padding")
+    args = parser.parse_args(argv)
+    runs = []
+    for native in (path == "native" for path in args.paths):
+        run = AttackRun(native, seconds=args.seconds, after=args.after)
+        run.run(attacks(args.padding_mb))
+        runs.append(run)
+        print(json.dumps([vars(o) for o in run.outcomes], indent=1), flush=True)
+    command = "python -m benchmarks.attacks" + (" " + " ".join(argv) if argv else "")
+    write_section(args.report, report(runs, args.seconds, args.after, command))
+    print(f"wrote {args.report}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
