@@ -10,6 +10,10 @@ namespace {
 
 // How long Stop waits after the last publish before the count is printed.
 constexpr double kFlushSeconds = 0.3;
+// How long the flood waits once a subscriber is known, before its first message: discovery
+// tells of the subscriber before its ZeroMQ subscription reaches this publisher, and what is
+// sent in between is dropped (as pub's --settle does).
+constexpr double kSettleSeconds = 0.2;
 
 std::unique_ptr<google::protobuf::Message> ReadMessage(const Args &args) {
   const std::string type = args.Text("flood-type", "");
@@ -37,6 +41,7 @@ Flood::~Flood() { Stop(); }
 
 void Flood::Run() {
   while (!pub_.HasConnections() && !stop_) SleepFor(0.01);
+  SleepFor(kSettleSeconds);
   const std::int64_t period = hz_ > 0 ? static_cast<std::int64_t>(1e9 / hz_) : 0;
   std::string payload;
   std::int64_t next = MonotonicNs();
