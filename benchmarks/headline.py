@@ -1,7 +1,8 @@
-"""The headline of BENCHMARKS.md: issue 15's figures at a glance, and the plots.
+"""The headline of BENCHMARKS.md: issue 15's figures at a glance, issue 28's fleet, and the plots.
 
 Usage: ``.venv/bin/python -m benchmarks.headline`` (``benchmarks.run`` calls it last). It
-reads what ``sustained``, ``costs`` and ``starvation`` stored in ``benchmarks/results.json``,
+reads what ``sustained``, ``costs``, ``starvation`` and ``fleet`` stored in
+``benchmarks/results.json``,
 writes the ``headline`` section at the top of BENCHMARKS.md and draws the plots it links.
 Each figure is shown with the commit and date of the run it came from, and each verdict is
 computed from the figure beside it when the headline is written, never stored.
@@ -11,7 +12,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks import plots, starvation
+from benchmarks import fleet, plots, starvation
 from benchmarks.costs import (
     GZ_TO_ROS,
     ROS_TO_GZ,
@@ -285,12 +286,56 @@ def _from(stored: Stored | None) -> str:
     return "" if stored is None else f" ({stored.measured()})"
 
 
+def fleet_lines(stored: Stored | None) -> list[str]:
+    """Issue 28's fleet: per size the CPU per delivered message against 0.8x the quoted C++
+    figure, the threads against C++'s, start-up at 25 robots, the bridge at rest."""
+    if stored is None:
+        return ["- not measured yet (`benchmarks.fleet`)"]
+    numbers = stored.numbers
+    lines = []
+    for robots, quoted in fleet.ISSUE_28.items():
+        us = numbers.get(f"fleet{robots}.us_per_message")
+        threads = numbers.get(f"fleet{robots}.threads")
+        if us is None or threads is None:
+            continue
+        goal = fleet.GOAL_CPU_RATIO * quoted.cpp_us_per_message()
+        lines.append(
+            f"- {robots} robots ({1 + 4 * robots} entries): {us:.1f} µs of CPU per delivered "
+            f"message (goal <= {goal:.1f}, 0.8x C++'s {quoted.cpp_us_per_message():.1f} quoted): "
+            f"{verdict(us <= goal, f'{us - goal:.1f} µs')}; {threads:.0f} threads (C++ "
+            f"{quoted.threads_cpp}): "
+            f"{verdict(threads <= fleet.GOAL_THREADS, f'{threads - fleet.GOAL_THREADS:.0f}')}"
+        )
+    startup = numbers.get(f"fleet{fleet.GOAL_STARTUP_ROBOTS}.startup_s")
+    if startup is not None:
+        lines.append(
+            f"- start-up of {fleet.GOAL_STARTUP_ROBOTS} robots under traffic, to every topic "
+            f"flowing: {startup:.2f} s (C++ {fleet.GOAL_STARTUP_S:g} s quoted): "
+            f"{verdict(startup <= fleet.GOAL_STARTUP_S, f'{startup - fleet.GOAL_STARTUP_S:.2f} s')}"
+        )
+    idle = [key for key in numbers if key.startswith("idle") and key.endswith(".cpu_percent")]
+    for key in idle:
+        robots = int(key.removeprefix("idle").split(".")[0])
+        percent, goal = numbers[key], fleet.GOAL_IDLE_PERCENT
+        judged = verdict(percent < goal, f"{percent - goal:.2f} points")
+        lines.append(
+            f"- at rest, {1 + 4 * robots} entries: {percent:.2f}% of a core (goal < {goal:g}%): "
+            f"{judged}"
+        )
+    return lines
+
+
 def section(
-    sustained: Stored | None, costs: Stored | None, clock: Stored | None, plots_text: str
+    sustained: Stored | None,
+    costs: Stored | None,
+    clock: Stored | None,
+    plots_text: str,
+    fleet_run: Stored | None = None,
 ) -> str:
-    """The headline, from the stored runs of ``sustained``, ``costs`` and ``starvation``."""
+    """The headline, from the stored runs of ``sustained``, ``costs``, ``starvation`` and
+    ``fleet``."""
     rows = [*image_rows(sustained), clock_row(clock), *cpu_rows(costs)]
-    named = {"sustained": sustained, "costs": costs, "starvation": clock}
+    named = {"sustained": sustained, "costs": costs, "starvation": clock, "fleet": fleet_run}
     present = {name: stored for name, stored in named.items() if stored is not None}
     runs = [f"- `{name}`: {stored.run_line()}" for name, stored in present.items()]
     notes = clock_notes(clock)
@@ -330,6 +375,10 @@ the hop.
 Where /clock was lost under the flood{_from(clock)}:
 {chr(10).join(notes) if notes else "- not measured yet (`benchmarks.starvation`)"}
 {cpu_text}
+A fleet in one process (issue 28){_from(fleet_run)}; the C++ figures are quoted from issue 28,
+not measured here (details in "A fleet in one process" below):
+{chr(10).join(fleet_lines(fleet_run))}
+
 Measured (2 cores shared with other work: every figure is noisy, the load averages say how
 busy the machine was):
 {chr(10).join(runs)}
@@ -339,7 +388,8 @@ busy the machine was):
 def main(argv: list[str] | None = None) -> int:
     del argv  # no options
     sustained, costs, clock = load("sustained"), load("costs"), load("starvation")
-    write_section("headline", section(sustained, costs, clock, draw(sustained, costs)), first=True)
+    text = section(sustained, costs, clock, draw(sustained, costs), load("fleet"))
+    write_section("headline", text, first=True)
     return 0
 
 

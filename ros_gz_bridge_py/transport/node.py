@@ -1,14 +1,16 @@
 """The Gazebo Transport node contract, and what every backend shares (in the manner of
 python-can's ``BusABC``).
 
-:class:`GzNode` is named so it cannot be mistaken for rclpy's ``Node``. It owns what is the
-same in every backend: the counters, the fully qualified names, the table of local
-subscriptions, local (intra-process) delivery, the choice of wire spellings per message
-(docs/protocol.md §9), ``has_connections``, blocking service calls, waiting for publishers,
-and an idempotent ``close``. A backend implements narrow hooks: open and close its publishers,
-subscriptions and service offers, send one message in one spelling, call a service, and tell
-what its discovery knows. The contract every backend must honour is tested by one suite,
-``tests/unit/transport/test_contract.py``; a new backend is written by passing it.
+:class:`GzNode` is named so it cannot be mistaken for rclpy's ``Node``. It owns what is the same
+in every backend: the counters, the fully qualified names, the table of local subscriptions,
+local (intra-process) delivery, the choice of wire spellings per message (docs/protocol.md §9),
+``has_connections`` and an idempotent ``close``; its service half (blocking calls, handlers,
+``node_services.py``) and its discovery half (the graph's queries, waiting for publishers,
+``node_graph.py``) are mixed in from modules of their own. A backend implements narrow hooks:
+open and close its publishers, subscriptions and service offers, send one message in one
+spelling, call a service, and tell what its discovery knows. The contract every backend must
+honour is tested by one suite, ``tests/unit/transport/test_contract.py``; a new backend is
+written by passing it.
 """
 
 from __future__ import annotations
@@ -17,23 +19,17 @@ import abc
 import collections
 import logging
 import threading
-import time
 import uuid
 from collections.abc import Callable
 from typing import Any, ClassVar, Self
 
-from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
+from ros_gz_bridge_py.errors import TransportError
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling, spellings
 from ros_gz_bridge_py.transport.api import (
     Callback,
-    GraphEndpoint,
     MessageInfo,
     NativeLoop,
     RejectCallback,
-    ReplyCallback,
-    ServiceCall,
-    ServiceHandler,
-    TopicInfo,
     TransportStats,
 )
 from ros_gz_bridge_py.transport.delivery import (
@@ -46,18 +42,19 @@ from ros_gz_bridge_py.transport.delivery import (
 from ros_gz_bridge_py.transport.handles import (
     Delivery,
     Publisher,
-    ServiceOffer,
     Subscription,
     ThreadDelivery,
 )
 from ros_gz_bridge_py.transport.names import fully_qualified_name
+from ros_gz_bridge_py.transport.node_graph import GraphView
+from ros_gz_bridge_py.transport.node_services import ServiceEnds
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.wire_types import SubscriberBook
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 
 
-class GzNode(abc.ABC):
+class GzNode(ServiceEnds, GraphView):
     """A Gazebo Transport participant: advertise, subscribe, provide and call services.
 
     Thread-safe: publishing, ``has_connections``, ``stats`` and every public method may be
@@ -67,8 +64,6 @@ class GzNode(abc.ABC):
 
     #: The spelling taken for peers whose Gazebo line nothing tells (None: our own).
     default_peer_spelling: ClassVar[Spelling | None] = None
-    #: The backend's record of a service call (its own state added to :class:`ServiceCall`).
-    call_class: ClassVar[type[ServiceCall]] = ServiceCall
     #: The backend's subscription handle (a subclass where it keeps more per subscription).
     subscription_class: ClassVar[type[Subscription]] = Subscription
     #: Whether a queued subscription's ``native`` loop reads its messages (ZeroMQ only).
@@ -82,6 +77,7 @@ class GzNode(abc.ABC):
     ) -> None:
         """Raises:
         LocalProtocolError: the partition or namespace is invalid."""
+        GraphView.__init__(self)
         self.settings = settings or TransportSettings.from_env()
         self.partition = self.settings.partition if partition is None else partition
         self.namespace = namespace
@@ -95,9 +91,6 @@ class GzNode(abc.ABC):
         # Read by publishing threads without a lock: entries are replaced, never mutated.
         self._subscriptions: dict[str, tuple[Subscription, ...]] = {}
         self._subscriptions_lock = threading.Lock()
-        # Discovery changes, for wait_for_publishers: a counter and its condition.
-        self._changed = threading.Condition()
-        self._generation = 0
         self.closed = False
 
     # --- names and counters ---------------------------------------------------------------
@@ -284,164 +277,6 @@ class GzNode(abc.ABC):
         """The queued delivery of ``sub``: by default a thread behind a drop-oldest queue."""
         return ThreadDelivery(sub, size, on_start, max_bytes)
 
-    # --- services ---------------------------------------------------------------------------
-
-    def advertise_service(
-        self, service: str, request_type: str, response_type: str, handler: ServiceHandler
-    ) -> ServiceOffer:
-        """Provide ``service``: calls of either spelling of the two types reach ``handler``,
-        which runs on a backend thread; an exception means failure.
-
-        Raises:
-            LocalProtocolError: the name is not a valid Gazebo service name.
-            TransportError: the node is closed.
-        """
-        self._check_open()
-        return self._open_offer(service, self.fqn(service), (request_type, response_type), handler)
-
-    def unadvertise_service(self, offer: ServiceOffer) -> None:
-        """Withdraw ``offer`` (called by its ``close``)."""
-        if not self.closed:
-            self._close_offer(offer)
-
-    def request(
-        self, service: str, request: bytes, request_type: str, response_type: str, timeout: float
-    ) -> tuple[bool, bytes]:
-        """Call a service and wait for the reply (one-way calls return (True, b"") once sent).
-
-        Raises:
-            TransportTimeoutError: no reply within ``timeout`` seconds.
-            TransportError: called from the node's own thread, which would wait for itself.
-        """
-        if self._on_node_thread():
-            msg = "request() would block the node's own thread; use request_async() in callbacks"
-            raise TransportError(msg)
-        done = threading.Event()
-        result: list[tuple[bool | None, bytes]] = []
-
-        def on_reply(ok: bool | None, payload: bytes) -> None:
-            result.append((ok, payload))
-            done.set()
-
-        self.request_async(service, request, request_type, response_type, timeout, on_reply)
-        done.wait()
-        ok, payload = result[0]
-        if ok is None:
-            msg = f"service {service!r} did not answer within {timeout} s"
-            raise TransportTimeoutError(msg)
-        return ok, payload
-
-    def call_handler(self, offer: ServiceOffer, request: bytes) -> tuple[bool, bytes]:
-        """Run ``offer``'s handler: (False, b"") when it raises (counted) or fails."""
-        try:
-            ok, payload = offer.handler(request)
-        except Exception:
-            self.count("callback_errors")
-            _LOG.exception("service handler for %s raised", offer.service)
-            return False, b""
-        return ok, payload if ok else b""
-
-    def finish_call(self, callback: ReplyCallback, ok: bool | None, payload: bytes) -> None:
-        """Run a ``request_async`` callback, counting (never raising) its errors."""
-        try:
-            callback(ok, payload)
-        except Exception:
-            self.count("callback_errors")
-            _LOG.exception("service reply callback raised")
-
-    def request_async(  # noqa: PLR0917 - positional order fixed by the API contract
-        self,
-        service: str,
-        request: bytes,
-        request_type: str,
-        response_type: str,
-        timeout: float,
-        callback: ReplyCallback,
-    ) -> None:
-        """Call a provider of either spelling of the two types; ``callback(ok, reply)`` runs
-        exactly once: (True/False, reply) on a reply, (None, b"") on timeout, (True, b"")
-        once sent for a one-way call (response ``gz.msgs.Empty``)."""
-        self._check_open()
-        deadline = time.monotonic() + timeout
-        call = self.call_class(
-            self.fqn(service), bytes(request), request_type, response_type, deadline, callback
-        )
-        self._start_call(call)
-
-    # --- discovery ---------------------------------------------------------------------------
-
-    def graph_changed(self) -> None:
-        """Backends call this when discovery learned something (wakes wait_for_publishers)."""
-        with self._changed:
-            self._generation += 1
-            self._changed.notify_all()
-
-    def wait_for_publishers(
-        self, topic: str, timeout: float, msg_type: str | None = None
-    ) -> list[TopicInfo]:
-        """Publishers of ``topic`` (of ``msg_type`` if given) as soon as one is known; [] when
-        none is within ``timeout``."""
-        deadline = time.monotonic() + timeout
-        while True:
-            seen = self._generation
-            found = [
-                i for i in self.topic_info(topic) if msg_type is None or i.msg_type == msg_type
-            ]
-            remaining = deadline - time.monotonic()
-            if found or remaining <= 0:
-                return found
-            self._wait_for_change(seen, remaining)
-
-    def _wait_for_change(self, seen: int, timeout: float) -> None:
-        with self._changed:
-            self._changed.wait_for(lambda: self._generation != seen, timeout)
-
-    @abc.abstractmethod
-    def topic_list(self) -> list[str]:
-        """Topics with publishers in this partition, like ``gz topic -l``."""
-
-    @abc.abstractmethod
-    def topic_info(self, topic: str) -> list[TopicInfo]:
-        """Publishers of ``topic``, like ``gz topic -i -t``."""
-
-    @abc.abstractmethod
-    def service_list(self) -> list[str]:
-        """Services with providers in this partition, like ``gz service -l``."""
-
-    @abc.abstractmethod
-    def service_info(self, service: str) -> list[TopicInfo]:
-        """Providers of ``service``; ``msg_type`` is ``"<request type>&<response type>"``."""
-
-    @abc.abstractmethod
-    def observe(self, topic: str) -> list[GraphEndpoint]:
-        """Every publisher and subscriber of ``topic`` (resolved as our own would be) that
-        other processes have, in every partition discovery reaches."""
-
-    @abc.abstractmethod
-    def graph(self) -> list[GraphEndpoint]:
-        """Every publisher and subscriber that other processes have, of every topic, in every
-        partition discovery reaches: :meth:`observe` for all topics at once (discovered
-        bridging reads it; filter by ``partition``). A subscriber whose type its protocol
-        does not tell (gz-transport 11/12) has ``msg_type`` ``""``."""
-
-    def peer_spelling(self, process_uuid: str) -> Spelling | None:
-        """How peer ``process_uuid``'s Gazebo line spells message types, when discovery tells
-        it (docs/protocol.md §9.2)."""
-        return self.subscriber_book.spelling(process_uuid)
-
-    @abc.abstractmethod
-    def peer_processes(self) -> int:
-        """How many other Gazebo Transport processes this node hears."""
-
-    @abc.abstractmethod
-    def listening(self) -> str:
-        """Where this node looks for peers (backend, partition, addresses), for users."""
-
-    @abc.abstractmethod
-    def ask_subscribers(self) -> None:
-        """Ask peers to list their subscriptions where the protocol has a way (ZeroMQ with
-        gz-transport 13+ peers); the answers show in :meth:`observe`."""
-
     # --- life -------------------------------------------------------------------------------
 
     def _check_open(self) -> None:
@@ -489,25 +324,6 @@ class GzNode(abc.ABC):
     @abc.abstractmethod
     def _close_subscription(self, sub: Subscription, *, last: bool) -> None:
         """Stop receiving for ``sub`` (``last``: no other local subscription of its topic)."""
-
-    @abc.abstractmethod
-    def _open_offer(
-        self, service: str, fqn: str, types: tuple[str, str], handler: ServiceHandler
-    ) -> ServiceOffer:
-        """Create and announce a service offer."""
-
-    @abc.abstractmethod
-    def _close_offer(self, offer: ServiceOffer) -> None:
-        """Withdraw ``offer``."""
-
-    @abc.abstractmethod
-    def _start_call(self, call: Any) -> None:  # Any: each backend takes its call_class
-        """Start ``call`` (a :attr:`call_class`); its callback runs once, through
-        :meth:`finish_call`."""
-
-    @abc.abstractmethod
-    def _on_node_thread(self) -> bool:
-        """True when the caller runs on the node's own thread (where blocking is forbidden)."""
 
     @abc.abstractmethod
     def _shutdown(self) -> None:

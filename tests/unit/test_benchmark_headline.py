@@ -100,3 +100,36 @@ def test_verdicts_follow_the_figures_shown() -> None:
     # A p99 of 150 ms at 120 Hz leaves 30 Hz as the highest sustainable rate.
     assert "| **30 Hz** |" in row(missed, "Highest sustainable")
     assert ">= 120 Hz: **missed** by 90 Hz" in row(missed, "Highest sustainable")
+
+
+def fleet_run(us_at_10: float, threads: int, idle_percent: float) -> Stored:
+    return stored(
+        {
+            "commit": "eee5555",
+            "when": "2026-11-28 06:00 UTC",
+            "load_before": 0.5,
+            "load_after": 0.7,
+            "flows": {},
+            "numbers": {
+                "fleet10.us_per_message": us_at_10,
+                "fleet10.threads": threads,
+                "fleet25.startup_s": 0.7,
+                "idle50.cpu_percent": idle_percent,
+            },
+        }
+    )
+
+
+def test_the_fleet_verdicts_follow_the_figures_shown() -> None:
+    # C++ at 10 robots, quoted: 78.0 µs per delivered message, so the goal is 62.4 µs.
+    met = headline.section(None, None, None, "", fleet_run(37.1, 20, 0.9))
+    missed = headline.section(None, None, None, "", fleet_run(70.0, 60, 1.5))
+
+    assert "- 10 robots (41 entries): 37.1 µs" in met
+    assert "(goal <= 62.4, 0.8x C++'s 78.0 quoted): **met**; 20 threads (C++ 20): **met**" in met
+    assert "**missed** by 7.6 µs; 60 threads (C++ 20): **missed** by 40" in missed
+    assert "- at rest, 201 entries: 0.90% of a core (goal < 1%): **met**" in met
+    assert "1.50% of a core (goal < 1%): **missed** by 0.50 points" in missed
+    assert "to every topic flowing: 0.70 s (C++ 2.6 s quoted): **met**" in met
+    assert "A fleet in one process (issue 28) (commit eee5555, 2026-11-28 06:00 UTC)" in met
+    assert "- not measured yet (`benchmarks.fleet`)" in headline.section(None, None, None, "")
