@@ -68,3 +68,15 @@ def libc_function(name: str) -> Any | None:
     """The C function ``name`` of this process's C library, or None where there is none."""
     symbols = _own_symbols()
     return None if symbols is None else getattr(symbols, name, None)
+
+
+#: ``prctl``'s option that names the calling thread (linux/prctl.h).
+PR_SET_NAME = 15
+
+
+def name_os_thread(name: str) -> None:
+    """Give the calling thread ``name`` in the OS too (``top -H``, /proc/<pid>/task/*/comm; at
+    most 15 bytes), where the C library has ``prctl``."""
+    prctl = libc_function("prctl")
+    if prctl is not None:
+        prctl(PR_SET_NAME, name.encode()[:15], 0, 0, 0)

@@ -33,6 +33,7 @@ import time
 from collections.abc import Callable
 from typing import Any, Protocol
 
+from ros_gz_bridge_py.libc import name_os_thread
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.transport.heap import BurstTrimmer
 
@@ -151,6 +152,7 @@ class SharedLoop:
         self._handles.pop(member).__exit__(None, None, None)
 
     def _run(self) -> None:
+        name_os_thread("gz-native")
         next_count = time.monotonic() + COUNT_EVERY
         while True:
             with self._lock:

@@ -18,7 +18,7 @@ import time
 from collections.abc import Callable
 from typing import Any, Protocol
 
-from ros_gz_bridge_py.libc import libc_function
+from ros_gz_bridge_py.libc import name_os_thread
 from ros_gz_bridge_py.native import extension
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
@@ -28,7 +28,6 @@ TURN = 0.25
 #: so this is only a safety net, and an idle loop costs one wake-up per QUIET_TURN whatever the
 #: number of channels.
 QUIET_TURN = 2.0
-_PR_SET_NAME = 15
 
 
 class LoopChannel(Protocol):
@@ -97,7 +96,7 @@ class RosLoop:
         return int(self._loop.size())
 
     def _run(self) -> None:
-        _name_os_thread(self._thread.name)
+        name_os_thread(self._thread.name)
         moved: list[tuple[Any, list[bytes], int]] = []
         while True:
             try:
@@ -131,14 +130,6 @@ def _guarded(channel: LoopChannel, work: Callable[..., None], *args: Any) -> Non
         work(*args)
     except Exception:
         _LOG.exception("unexpected error in the native loop of %s", channel)
-
-
-def _name_os_thread(name: str) -> None:
-    """Give the calling thread ``name`` in the OS too (``top -H``, /proc/<pid>/task/*/comm),
-    where the C library has ``prctl``."""
-    prctl = libc_function("prctl")
-    if prctl is not None:
-        prctl(_PR_SET_NAME, name.encode()[:15], 0, 0, 0)
 
 
 _shared: RosLoop | None = None
