@@ -37,7 +37,7 @@ from benchmarks.report import write_section
 from benchmarks.results import store
 from tests import fleet_sim
 from tests.bridge.e2e_harness import status_rows
-from tests.gzpeer import PeerProcess, start_peer, start_process, wait_for_line
+from tests.gzpeer import PeerProcess, start_peer, start_process, threads_of, wait_for_line
 
 #: Where the quoted figures come from.
 QUOTED = "quoted from issue 28 (2026-11-28), measured by its author on 2 cores, not here"
@@ -128,12 +128,25 @@ class Round:
         return self.cpu / 100 * self.window_s / self.messages * 1e6 if self.messages else 0.0
 
 
-def _threads(pid: int) -> int:
-    with open(f"/proc/{pid}/status", encoding="ascii") as status:
-        for line in status:
-            if line.startswith("Threads:"):
-                return int(line.split()[1])
-    return 0
+def _window(sub: PeerProcess, measured: PeerProcess, seconds: float) -> Window:
+    """``seconds`` of the subscriber's counts and of the CPU of ``measured`` and ``sub``."""
+    before = _counts(sub)
+    windows = [CpuWindow(measured.pid), CpuWindow(sub.pid)]
+    for window in windows:
+        window.begin()
+    began = time.monotonic()
+    time.sleep(seconds)
+    for window in windows:
+        window.end()
+    return Window(
+        seconds=time.monotonic() - began,
+        before=before,
+        after=_counts(sub),
+        cpu=windows[0].percent or 0.0,
+        sub_cpu=windows[1].percent or 0.0,
+        threads=threads_of(measured),
+        rss=rss_mb(measured.pid),
+    )
 
 
 def _counts(sub: PeerProcess) -> dict[str, int]:
@@ -190,24 +203,15 @@ def bridge_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
     flowing, silent = _wait_flowing(sub)
     silent_status = tuple(status_rows(bridge, silent)) if silent else ()
     time.sleep(SETTLE)
-    before = _counts(sub)
-    windows = [CpuWindow(bridge.pid), CpuWindow(sub.pid)]
-    for window in windows:
-        window.begin()
-    began = time.monotonic()
-    time.sleep(seconds)
-    for window in windows:
-        window.end()
-    window_s = time.monotonic() - began
-    after = _counts(sub)
-    threads, rss = _threads(bridge.pid), rss_mb(bridge.pid)
+    measured = _window(sub, bridge, seconds)
+    before, after = measured.before, measured.after
     bridge.stop(grace=10)
     commands_sent = _counts(sub)["cmd_vel"]
     simulator.stop(grace=10)
     simulated = time.monotonic() - simulating
     sent = [int(m) for m in _numbers(simulator, "SENT ")]
     received = sum(_numbers(simulator, "RECEIVED "))
-    delivered = _delivered(robots, before, after, window_s)
+    delivered = _delivered(robots, before, after, measured.seconds)
     delivered["cmd_vel"] = received / commands_sent if commands_sent else 0.0
     in_window: float = sum(after[t] - before[t] for t in after if t != "cmd_vel")
     in_window += (after["cmd_vel"] - before["cmd_vel"]) * delivered["cmd_vel"]
@@ -215,16 +219,16 @@ def bridge_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
     return Round(
         robots,
         ceiling=False,
-        window_s=window_s,
-        cpu=windows[0].percent or 0.0,
+        window_s=measured.seconds,
+        cpu=measured.cpu,
         delivered=delivered,
         messages=in_window,
-        threads=threads,
-        rss=rss,
+        threads=measured.threads,
+        rss=measured.rss,
         startup_s=None if flowing is None else flowing - started,
         silent=silent,
         silent_status=silent_status,
-        sub_cpu=windows[1].percent or 0.0,
+        sub_cpu=measured.sub_cpu,
         simulator_share=sum(sent) / schedule,
     )
 
@@ -241,29 +245,34 @@ def ceiling_round(robots: int, seconds: float, env: Mapping[str, str]) -> Round:
     publisher = start_process(command, env)
     silent = _wait_flowing(sub)[1]
     time.sleep(SETTLE)
-    before = _counts(sub)
-    windows = [CpuWindow(publisher.pid), CpuWindow(sub.pid)]
-    for window in windows:
-        window.begin()
-    began = time.monotonic()
-    time.sleep(seconds)
-    for window in windows:
-        window.end()
-    window_s = time.monotonic() - began
-    after = _counts(sub)
-    threads, rss = _threads(publisher.pid), rss_mb(publisher.pid)
+    measured = _window(sub, publisher, seconds)
     return Round(
         robots,
         ceiling=True,
-        window_s=window_s,
-        cpu=windows[0].percent or 0.0,
-        delivered=_delivered(robots, before, after, window_s),
-        messages=sum(after[t] - before[t] for t in after if t != "cmd_vel"),
-        threads=threads,
-        rss=rss,
-        sub_cpu=windows[1].percent or 0.0,
+        window_s=measured.seconds,
+        cpu=measured.cpu,
+        delivered=_delivered(robots, measured.before, measured.after, measured.seconds),
+        messages=sum(
+            measured.after[t] - measured.before[t] for t in measured.after if t != "cmd_vel"
+        ),
+        threads=measured.threads,
+        rss=measured.rss,
+        sub_cpu=measured.sub_cpu,
         silent=silent,
     )
+
+
+@dataclass(frozen=True)
+class Window:
+    """One measured window of a round."""
+
+    seconds: float
+    before: dict[str, int]
+    after: dict[str, int]
+    cpu: float
+    sub_cpu: float
+    threads: int
+    rss: float
 
 
 @dataclass(frozen=True)
@@ -294,7 +303,7 @@ def idle_round(robots: int, seconds: float) -> Idle:
         window.begin()
         time.sleep(seconds)
         window.end()
-        result = Idle(robots, window.percent or 0.0, _threads(bridge.pid), rss_mb(bridge.pid))
+        result = Idle(robots, window.percent or 0.0, threads_of(bridge), rss_mb(bridge.pid))
     finally:
         stop_all()
     print(result, file=sys.stderr, flush=True)
