@@ -31,7 +31,11 @@ static struct rgb_out out;
 static size_t transcode(const struct rgb_program *program, const uint8_t *payload, size_t n) {
     size_t steps = 0;
     enum rgb_status status = rgb_to_cdr_counted(program, payload, n, &out, &steps);
-    if (status > RGB_FALLBACK) abort();
+    if (status > RGB_TOO_LARGE) abort();
+    /* a refusal as too large only where even Python's most generous bound is passed */
+    if (status == RGB_TOO_LARGE &&
+        (out.refused.least == 0 || out.refused.items <= out.refuse_above / out.refused.least))
+        abort();
     if (status == RGB_OK && (out.len < 4 || memcmp(out.data, "\0\1\0\0", 4) != 0)) abort();
     /* the output bound (wire.h) */
     if (status == RGB_OK && out.len > RGB_OUTPUT_FLOOR + RGB_OUTPUT_RATIO * n) abort();

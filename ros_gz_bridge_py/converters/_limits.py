@@ -63,12 +63,23 @@ def check_list(gz_items: Sized, least: int, ros_type: str) -> None:
         received = message.ByteSize()  # one pass in C
     else:  # a list converted outside a whole message: its elements, a tag and a length each
         received = sum(item.ByteSize() + 2 for item in gz_items)  # type: ignore[attr-defined]
-    limit = min(OUTPUT_FLOOR + OUTPUT_RATIO * received, MAX_OUTPUT)
-    if least_total > limit:
-        msg = (
-            f"a list of {count} {ros_type} items from a message of {received} bytes would "
-            f"take at least {least_total} bytes, over the limit of {limit} ({OUTPUT_FLOOR} + "
-            f"{OUTPUT_RATIO} per byte received, at most {MAX_OUTPUT}): refused as an "
-            "amplification; send elements with their fields set, or fewer of them"
-        )
-        raise ConversionError(msg)
+    if least_total > _limit(received):
+        raise amplification_error(count, f"{ros_type} items", received, least_total)
+
+
+def _limit(received: int) -> int:
+    return min(OUTPUT_FLOOR + OUTPUT_RATIO * received, MAX_OUTPUT)
+
+
+def amplification_error(count: int, items: str, received: int, least_total: int) -> ConversionError:
+    """Why a list of ``count`` ``items`` (e.g. "Pose items") from a message of ``received``
+    bytes, which would take at least ``least_total`` bytes, is refused (the native transcoder's
+    refusals say the same, docs/native.md §4)."""
+    limit = _limit(received)
+    msg = (
+        f"a list of {count} {items} from a message of {received} bytes would "
+        f"take at least {least_total} bytes, over the limit of {limit} ({OUTPUT_FLOOR} + "
+        f"{OUTPUT_RATIO} per byte received, at most {MAX_OUTPUT}): refused as an "
+        "amplification; send elements with their fields set, or fewer of them"
+    )
+    return ConversionError(msg)

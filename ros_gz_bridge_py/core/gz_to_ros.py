@@ -137,6 +137,7 @@ class GzToRosChannel(Channel):
                 max_bytes=self.ctx.options.max_queued_bytes,
                 max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
                 refused=self._convert_and_publish,
+                failed=self._conversion_failed,
                 counted=self._counted,
                 partition=self.ctx.gz_node.partition,
                 name=self.spec.gz_topic,

@@ -62,7 +62,11 @@ done:
     return result;
 }
 
-/* to_cdr(payload) -> (status, bytes or None) */
+static Py_ssize_t clamp_ssize(size_t n) {
+    return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n;
+}
+
+/* to_cdr(payload) -> (status, bytes, (items, least) for RGB_TOO_LARGE, or None) */
 static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
     if (self->words == NULL) {
         PyErr_SetString(PyExc_ValueError, "program not loaded");
@@ -76,7 +80,10 @@ static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
     PyBuffer_Release(&payload);
     self->steps = steps > PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)steps;
     PyObject *result;
-    if (status != RGB_OK)
+    if (status == RGB_TOO_LARGE)
+        result = Py_BuildValue("(i(nn))", (int)status, clamp_ssize(self->out.refused.items),
+                               clamp_ssize(self->out.refused.least));
+    else if (status != RGB_OK)
         result = Py_BuildValue("(iO)", (int)status, Py_None);
     else
         result = Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
@@ -86,7 +93,8 @@ static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
 
 static PyMethodDef program_methods[] = {
     {"to_cdr", (PyCFunction)program_to_cdr, METH_O,
-     "to_cdr(payload) -> (status, cdr or None): 0 ok, 1 undecodable, 2 conversion, 3 fallback"},
+     "to_cdr(payload) -> (status, cdr or None): 0 ok, 1 undecodable, 2 conversion, 3 fallback; "
+     "4 too large, with (items, least bytes of one) for None"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -173,7 +181,7 @@ static PyObject *encoder_to_pb(EncoderObject *self, PyObject *arg) {
     }
     Py_buffer cdr;
     if (PyObject_GetBuffer(arg, &cdr, PyBUF_SIMPLE)) return NULL;
-    struct rgb_out out = {NULL, 0, 0, 0, NULL, 0};
+    struct rgb_out out = {.data = NULL};
     enum rgb_status status = rgb_to_pb(&self->encoder, cdr.buf, (size_t)cdr.len, &out);
     PyBuffer_Release(&cdr);
     PyObject *result;

@@ -8,7 +8,9 @@ class Program:
     #: The bytes of output buffer and scratch kept for the next ``to_cdr``.
     kept_bytes: int
     def __init__(self, schema: bytes, ops: bytes) -> None: ...
-    def to_cdr(self, payload: bytes | bytearray | memoryview, /) -> tuple[int, bytes | None]: ...
+    def to_cdr(
+        self, payload: bytes | bytearray | memoryview, /
+    ) -> tuple[int, bytes | tuple[int, int] | None]: ...
 
 class Encoder:
     """One pair's ROS -> Gazebo transcoder (docs/native.md §6)."""

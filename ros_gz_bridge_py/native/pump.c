@@ -76,12 +76,15 @@ struct queued {
     int route;
 };
 
-/* A message handed to Python: its frames (unrouted), or its payload (refused). */
+/* A message handed to Python: its frames (unrouted), its payload (refused), or why it is too
+ * large (RGB_TOO_LARGE: no copy, Python only words the refusal). */
+enum { HANDED_UNROUTED = 0, HANDED_REFUSED = 1, HANDED_TOO_LARGE = 2 };
 struct handed {
-    int kind; /* 0 unrouted frames, 1 payload of route `route` refused with `status` */
+    int kind;
     int route, status, nframes;
     uint8_t *data[MAX_FRAMES];
     size_t size[MAX_FRAMES];
+    size_t items, least, payload_size; /* HANDED_TOO_LARGE */
 };
 
 struct window {
@@ -212,6 +215,22 @@ static void hand_frames(PumpObject *self, int kind, int route, int status, zmq_m
     }
 }
 
+/* Hands Python the figures of a payload refused as too large (route `route`): its list's items,
+ * the least bytes of one, its own size. */
+static void hand_too_large(PumpObject *self, int route, size_t payload_size) {
+    struct handed *h = hand(self);
+    if (h == NULL) {
+        self->lost++;
+        return;
+    }
+    h->kind = HANDED_TOO_LARGE;
+    h->route = route;
+    h->status = RGB_TOO_LARGE;
+    h->items = self->out.refused.items;
+    h->least = self->out.refused.least;
+    h->payload_size = payload_size;
+}
+
 static void drop_oldest(PumpObject *self) {
     struct queued *oldest = &self->ring[self->head];
     const struct route *r = &self->routes[oldest->route];
@@ -280,7 +299,7 @@ static int read_message(PumpObject *self, void *sock) {
     if (route >= 0) /* a spelling already taken from this publisher: not ours */
         self->skipped++;
     else
-        hand_frames(self, 0, -1, 0, frames, n);
+        hand_frames(self, HANDED_UNROUTED, -1, 0, frames, n);
     for (int i = 0; i < n; i++) self->f.msg_close(&frames[i]);
     return 1;
 }
@@ -318,7 +337,10 @@ static void deliver(PumpObject *self, struct queued *q) {
         self->f.reset_error();
         status = RGB_FALLBACK; /* Python publishes it, or says why it cannot */
     }
-    hand_frames(self, 1, q->route, (int)status, &q->payload, 1);
+    if (status == RGB_TOO_LARGE)
+        hand_too_large(self, q->route, size);
+    else
+        hand_frames(self, HANDED_REFUSED, q->route, (int)status, &q->payload, 1);
 }
 
 /* ---- what the loop calls (loop.c; no GIL) ------------------------------------------------ */
@@ -647,8 +669,13 @@ static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     Py_RETURN_NONE;
 }
 
-/* take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused:
- * what the loop left to Python since the last call. */
+/* take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused,
+ * [(2, sender, type, items, least, payload_size)] too large: what the loop left to Python
+ * since the last call. */
+static Py_ssize_t size_ssize(size_t n) {
+    return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n;
+}
+
 static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
     (void)unused;
     if (usable(self, 1) < 0) return NULL;
@@ -656,7 +683,7 @@ static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
     for (size_t i = 0; handed != NULL && i < self->nhanded; i++) {
         struct handed *h = &self->handover[i];
         PyObject *item;
-        if (h->kind == 0) {
+        if (h->kind == HANDED_UNROUTED) {
             PyObject *frames = PyList_New(0);
             for (int k = 0; frames != NULL && k < h->nframes; k++) {
                 PyObject *frame = PyBytes_FromStringAndSize((char *)h->data[k], (Py_ssize_t)h->size[k]);
@@ -664,9 +691,15 @@ static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
                 Py_XDECREF(frame);
             }
             item = frames == NULL ? NULL : Py_BuildValue("(iN)", 0, frames);
+        } else if (h->kind == HANDED_TOO_LARGE) {
+            struct route *r = &self->routes[h->route];
+            item = Py_BuildValue("(iy#y#nnn)", HANDED_TOO_LARGE, (char *)r->sender,
+                                 (Py_ssize_t)r->sender_len, (char *)r->type,
+                                 (Py_ssize_t)r->type_len, size_ssize(h->items),
+                                 size_ssize(h->least), size_ssize(h->payload_size));
         } else {
             struct route *r = &self->routes[h->route];
-            item = Py_BuildValue("(iy#y#y#i)", 1, (char *)r->sender, (Py_ssize_t)r->sender_len,
+            item = Py_BuildValue("(iy#y#y#i)", HANDED_REFUSED, (char *)r->sender, (Py_ssize_t)r->sender_len,
                                  (char *)r->type, (Py_ssize_t)r->type_len, (char *)h->data[0],
                                  (Py_ssize_t)h->size[0], h->status);
         }
@@ -721,7 +754,8 @@ static PyMethodDef pump_methods[] = {
      "or skip them; False where no program takes msg_type"},
     {"forget", (PyCFunction)pump_forget, METH_NOARGS, "forget routes and queued messages"},
     {"take_handed", (PyCFunction)pump_take_handed, METH_NOARGS,
-     "take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused"},
+     "take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused, "
+     "[(2, sender, type, items, least, payload_size)] too large"},
     {"counts", (PyCFunction)pump_counts, METH_NOARGS,
      "(received, rate_limited, published, dropped, skipped, lost) so far"},
     {"traffic", (PyCFunction)pump_traffic, METH_NOARGS,

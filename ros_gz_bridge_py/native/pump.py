@@ -27,6 +27,7 @@ from typing import Any
 
 import zmq  # noqa: F401 - loads pyzmq's libzmq, which libzmq_path finds
 
+from ros_gz_bridge_py.converters._limits import amplification_error
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.loop import shared_loop
 from ros_gz_bridge_py.transport import MessageInfo
@@ -44,8 +45,9 @@ _ZMQ_FUNCTIONS = (
     "zmq_msg_more",
     "zmq_getsockopt",
 )
-#: Handed back by the C pump: frames it has no route for, or a payload no program took.
-_UNROUTED, _REFUSED = 0, 1
+#: Handed back by the C pump: frames it has no route for, a payload no program took, or the
+#: figures of a payload refused as too large (no payload: Python would parse it item by item).
+_UNROUTED, _REFUSED, _TOO_LARGE = 0, 1, 2
 #: Payload bytes the fallback thread handles before a quiet second is worth a trim: far fewer
 #: than a reader's, because the Python path can build objects many times a payload's size (a
 #: Pose_V of 4 M empty poses: 8 MB, some 300 MB parsed, left on the thread's own heap).
@@ -100,6 +102,7 @@ class ChannelPump:
 
     ``programs``: the compiled program of each wire spelling the channel takes.
     ``refused(payload, info)``: the channel's Python path for one admitted payload.
+    ``failed(error)``: counts a payload the C pump refused itself (on the loop's thread).
     """
 
     def __init__(
@@ -112,6 +115,7 @@ class ChannelPump:
         max_bytes: int,
         max_rate: float,
         refused: Callable[[bytes, MessageInfo], None],
+        failed: Callable[[Exception], None],
         counted: Callable[[int, int, int], None],
         partition: str,
         name: str,
@@ -134,6 +138,7 @@ class ChannelPump:
         self._loop = shared_loop()
         self._host: NativeHost | None = None
         self._refused = refused
+        self._failed = failed
         self._capacity = capacity
         self._max_bytes = max_bytes
         #: The refused payloads on their way to ``refused`` (made at the first).
@@ -191,6 +196,9 @@ class ChannelPump:
         for item in handed:
             if item[0] == _UNROUTED:
                 unrouted.append(item[1])
+            elif item[0] == _TOO_LARGE:
+                _kind, _sender, _type, items, least, size = item
+                self._failed(amplification_error(items, "items", size, items * least))
             else:
                 _kind, sender, msg_type, payload, _status = item
                 self._fall_back(payload, self._info(sender, msg_type))

@@ -893,6 +893,11 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             status = count_of(c, at, number, &count);
             if (status) return status;
             size_t least = least_bytes(body, body + body_len);
+            if (least && count > out->refuse_above / least) {
+                out->refused.items = count;
+                out->refused.least = least;
+                return RGB_TOO_LARGE; /* Python refuses it too, after a parse of every item */
+            }
             size_t limit = out->limit && out->limit < RGB_MAX_OUTPUT ? out->limit : RGB_MAX_OUTPUT;
             if (least && (out->len > limit || count > (limit - out->len) / least))
                 return RGB_FALLBACK; /* it could not fit: Python decides (and refuses) */
@@ -979,6 +984,17 @@ static size_t output_limit(size_t n) {
     return RGB_OUTPUT_FLOOR + RGB_OUTPUT_RATIO * n;
 }
 
+/* The most that Python's bound on a list (converters/_limits.py: the floor, and the ratio
+ * times the size protobuf gives the parsed message) can allow for a payload of `n` bytes. That
+ * size is at most twice `n` (a negative int32 sent in 5 bytes is re-encoded in 10; anything
+ * else keeps its size or shrinks), and least_bytes counts no more than Python's smallest item
+ * (no padding, no string terminators), so a list over this is refused by Python as well: it is
+ * refused here without handing Python a payload to parse item by item (docs/native.md §4). */
+static size_t refusal_limit(size_t n) {
+    if (n > (RGB_OUTPUT_MAX - RGB_OUTPUT_FLOOR) / (2 * RGB_OUTPUT_RATIO)) return RGB_OUTPUT_MAX;
+    return RGB_OUTPUT_FLOOR + 2 * RGB_OUTPUT_RATIO * n;
+}
+
 void rgb_out_trim(struct rgb_out *out) { rgb_trim(out); }
 
 enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
@@ -989,6 +1005,7 @@ enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint
     rgb_trim(out); /* the last message's output is no longer used */
     out->len = 0;
     out->limit = output_limit(payload_len);
+    out->refuse_above = refusal_limit(payload_len);
     struct at root = {v, NO_NODE};
     int status = validate(&c, v, program->root, 0);
     if (!status) status = index_message(&c, v, program->root, &root.node);

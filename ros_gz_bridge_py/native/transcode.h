@@ -17,6 +17,8 @@ enum rgb_status {
     RGB_UNDECODABLE = 1, /* not a valid protobuf encoding of the message type */
     RGB_CONVERSION = 2,  /* a valid message the converter refuses */
     RGB_FALLBACK = 3,    /* valid or not: the Python path decides */
+    RGB_TOO_LARGE = 4,   /* valid, but a list in it would make a ROS message over the output
+                            bound however Python counts it: refused, not built (out->refused) */
 };
 
 /* A loaded program: the caller's words (kept alive by the caller) after rgb_load checked
@@ -37,6 +39,10 @@ struct rgb_out {
     size_t limit;       /* most bytes this call may write (0: RGB_MAX_OUTPUT); set per call */
     void *scratch;      /* rgb_to_cdr's index of the payload's messages, reused between calls */
     size_t scratch_cap; /* its bytes */
+    size_t refuse_above; /* a list whose least bytes pass this is RGB_TOO_LARGE; set per call */
+    struct {
+        size_t items, least; /* RGB_TOO_LARGE: the list's items, the least CDR bytes of one */
+    } refused;
 };
 
 /* Checks the words; 0 when they make a program, else -1 with a reason in *why. */

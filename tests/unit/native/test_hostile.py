@@ -14,12 +14,18 @@ import struct
 from typing import Any
 
 import pytest
+from geometry_msgs.msg import Pose, TransformStamped
 
-from ros_gz_bridge_py.converters._limits import MAX_OUTPUT, OUTPUT_FLOOR, OUTPUT_RATIO
+from ros_gz_bridge_py.converters._limits import (
+    MAX_OUTPUT,
+    OUTPUT_FLOOR,
+    OUTPUT_RATIO,
+    least_item_bytes,
+)
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 from tests.unit.native import gz_payloads as gzp
-from tests.unit.native.test_transcode import FALLBACK, IDS, OK, PAIRS, Transcoder
+from tests.unit.native.test_transcode import FALLBACK, IDS, OK, PAIRS, TOO_LARGE, Transcoder
 from tools.native_fuzz_programs import distinctive
 
 #: A small unknown field: a two-byte tag (field 2000) and a one-byte varint.
@@ -91,16 +97,41 @@ def _empty_poses(count: int) -> bytes:
     return gzp.length_delimited(2, b"") * count  # Pose_V.pose
 
 
+#: The ROS item of each list a Pose_V becomes.
+ITEMS = {"tf2_msgs/msg/TFMessage": TransformStamped, "geometry_msgs/msg/PoseArray": Pose}
+
+
 @pytest.mark.parametrize(
-    "ros_type", ["tf2_msgs/msg/TFMessage", "geometry_msgs/msg/PoseArray"]
-)  # fmt: skip
-def test_a_pose_v_of_empty_poses_is_refused_on_both_paths(ros_type: str) -> None:
+    ("ros_type", "count"),
+    [("tf2_msgs/msg/TFMessage", 200_000), ("geometry_msgs/msg/PoseArray", 2_500_000)],
+)
+def test_empty_poses_past_the_bound_are_refused_natively(ros_type: str, count: int) -> None:
+    """400 KB of empty poses would make 14 MB of transforms, 5 MB would make 140 MB of poses:
+    the native path refuses them itself (RGB_TOO_LARGE) with the figures of its refusal, and
+    only where the Python path refuses them too (its least item is never smaller), so no
+    payload is handed to Python to be parsed item by item (4 M poses took 300 MB there)."""
     transcoder = _pair(ros_type, "gz.msgs.Pose_V")
-    payload = _empty_poses(200_000)  # 400 KB that would become 11-16 MB
-    status, cdr = transcoder.program.to_cdr(payload)
-    assert (status, cdr) == (FALLBACK, None)
+    payload = _empty_poses(count)
+    status, figures = transcoder.program.to_cdr(payload)
+    assert status == TOO_LARGE
+    assert isinstance(figures, tuple)
+    items, least = figures
+    assert items == count
+    assert 0 < least <= least_item_bytes(ITEMS[ros_type])
     gz = message_class("gz.msgs.Pose_V").FromString(payload)
-    with pytest.raises(ConversionError, match=r"200000 \w+ items .* over the limit"):
+    with pytest.raises(ConversionError, match=rf"{count} \w+ items .* over the limit"):
+        transcoder.pair.to_ros(gz)
+
+
+def test_empty_poses_near_the_bound_are_left_to_python() -> None:
+    """Between the bound and the most Python's bound allows (its size of a message can be up to
+    twice the payload's), the native path is not sure: it leaves the payload to Python, which
+    refuses this one."""
+    transcoder = _pair("geometry_msgs/msg/PoseArray", "gz.msgs.Pose_V")
+    payload = _empty_poses(200_000)  # 400 KB that would become 11 MB
+    assert transcoder.program.to_cdr(payload) == (FALLBACK, None)
+    gz = message_class("gz.msgs.Pose_V").FromString(payload)
+    with pytest.raises(ConversionError, match=r"200000 Pose items .* over the limit"):
         transcoder.pair.to_ros(gz)
 
 
@@ -125,8 +156,8 @@ def test_no_output_exceeds_the_cap_on_either_path() -> None:
     count = MAX_OUTPUT // 56 + 1000
     payload = gzp.length_delimited(2, pose) * count  # Pose_V.pose
     assert OUTPUT_FLOOR + OUTPUT_RATIO * len(payload) > 56 * count  # within the ratio
-    status, cdr = transcoder.program.to_cdr(payload)
-    assert (status, cdr) == (FALLBACK, None)
+    status, figures = transcoder.program.to_cdr(payload)
+    assert (status, figures) == (TOO_LARGE, (count, 56))
     gz = message_class("gz.msgs.Pose_V").FromString(payload)
     with pytest.raises(ConversionError, match=rf"{count} Pose items .* at most {MAX_OUTPUT}"):
         transcoder.pair.to_ros(gz)

@@ -48,11 +48,12 @@ def require_extension() -> ModuleType:
 
 
 _native = require_extension()
-OK, UNDECODABLE, CONVERSION, FALLBACK = 0, 1, 2, 3
+OK, UNDECODABLE, CONVERSION, FALLBACK, TOO_LARGE = 0, 1, 2, 3, 4
 #: Python's outcome when the converter or the writer refuses a message for another reason than
 #: a ConversionError (a number out of range: rclpy then publishes or refuses it).
-REFUSED = 4
+REFUSED = 5
 NAMES = {OK: "OK", UNDECODABLE: "UNDECODABLE", CONVERSION: "CONVERSION", FALLBACK: "FALLBACK"}
+NAMES[TOO_LARGE] = "TOO_LARGE"
 NAMES[REFUSED] = "REFUSED"
 RANDOM_MESSAGES = 200
 #: Most single-bit flips tried per payload (all of them for smaller payloads).
@@ -109,6 +110,8 @@ class Transcoder:
             assert cdr == reference, f"{where}\nnative {cdr!r}\nPython {reference!r}"
         elif status in (UNDECODABLE, CONVERSION):
             assert outcome == status, where
+        elif status == TOO_LARGE:  # refused natively only where Python refuses too
+            assert outcome == CONVERSION, where
         else:
             assert status == FALLBACK, where
             assert not (well_formed and outcome == OK), f"well-formed message fell back: {where}"
