@@ -22,9 +22,10 @@ from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.bulk.path import gz_to_ros_cdr
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.converters.census import census_for
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext
-from ros_gz_bridge_py.errors import UndecodableError
+from ros_gz_bridge_py.errors import ConversionError, UndecodableError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.native.channel import native_programs
 from ros_gz_bridge_py.native.pump import ChannelPump
@@ -56,6 +57,12 @@ class GzToRosChannel(Channel):
         #: Wire type -> (pair, gz message class) to read it with.
         self._readers = {
             name: (pair, message_class(pair.gz_type)) for name, pair in layouts.items()
+        }
+        #: Wire type -> the census of its lists, counted before the parse (converters/census.py).
+        self._censuses = {
+            name: census
+            for name, pair in layouts.items()
+            if (census := census_for(pair.to_ros, pair.gz_type)) is not None
         }
         self._qos = gz_to_ros_publisher_qos(self.ros_topic, spec.qos_profile, spec.publisher_queue)
         self._publisher: Any = None
@@ -203,6 +210,13 @@ class GzToRosChannel(Channel):
         """The Python path of one admitted message: decode, convert, publish, or count why
         not."""
         pair, gz_class = self._readers.get(info.msg_type, (self.pair, self._gz_class))
+        census = self._censuses.get(info.msg_type)
+        if census is not None:
+            try:
+                census.check(payload)  # a list too large is refused before it is parsed
+            except ConversionError as err:
+                self._conversion_failed(err)
+                return
         try:
             gz_msg = gz_class.FromString(payload)
         except Exception as err:

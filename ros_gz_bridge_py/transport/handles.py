@@ -19,6 +19,7 @@ from ros_gz_bridge_py.transport.delivery import (
     DeliveryQueue,
     DropWarning,
     Payload,
+    payload_sender,
     payload_size,
 )
 from ros_gz_bridge_py.transport.wire_types import WireTypeCache
@@ -272,6 +273,7 @@ class ThreadDelivery:
             f"gz-sub {sub.topic}",
             weigh=payload_size,
             max_bytes=max_bytes,
+            source=payload_sender,
             on_start=on_start,
         )
         self._warning = DropWarning(sub.topic, size, max_bytes)
@@ -285,7 +287,8 @@ class ThreadDelivery:
         dropped = self._queue.put((payload, info))
         if dropped:
             with self._lock:
-                self._warning.dropped(self._queue.dropped, info.publisher_address)
+                sender = self._queue.dropped_source
+                self._warning.dropped(self._queue.dropped, str(sender) if sender else "")
         return dropped
 
     def close(self) -> None:

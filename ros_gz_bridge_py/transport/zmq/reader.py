@@ -50,12 +50,14 @@ from ros_gz_bridge_py.transport.delivery import (
     DropOldestQueue,
     DropWarning,
     Payload,
+    payload_sender,
     payload_size,
 )
 from ros_gz_bridge_py.transport.heap import BurstTrimmer
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
+from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
 from ros_gz_bridge_py.transport.zmq.sockets import subscriber_socket
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
 
@@ -111,8 +113,11 @@ class SubscriptionReader:
         self._deliver = deliver
         self._reject = reject
         self._limit = settings.max_message_size
+        self._max_bytes = max_bytes
+        self._rcvhwm = settings.rcvhwm
+        self._largest = 0  # payload read so far, for the socket's HWM (_fit_hwm)
         self._pending: DropOldestQueue[Delivery] = DropOldestQueue(
-            size, weigh=payload_size, max_bytes=max_bytes
+            size, weigh=payload_size, max_bytes=max_bytes, source=payload_sender
         )
         self._count = count
         self._warning = DropWarning(fqn, size, max_bytes)
@@ -326,10 +331,22 @@ class SubscriptionReader:
             verdict = self._verdict(frames)
             if isinstance(verdict, MessageInfo):
                 self._received += 1
-                self._trimmer.received(len(frames[2]))
+                size = len(frames[2])
+                self._trimmer.received(size)
+                if size > self._largest:
+                    self._fit_hwm(size)
                 self._keep((frames[2], verdict))
             elif verdict is not None:
                 self._reject(*verdict)
+
+    def _fit_hwm(self, size: int) -> None:
+        """Lowers the socket's receive HWM as payloads grow, so that libzmq's queue in front
+        of ours holds about ``max_bytes`` too, not 1000 messages of any size (``hwm.py``; the
+        native pump does the same, pump.c ``fit_hwm``). On the reader's thread, the socket's."""
+        self._largest = size
+        hwm = hwm_for_bytes(size, self._max_bytes, self._rcvhwm)
+        if hwm != self._sock.getsockopt(zmq.RCVHWM):
+            self._sock.setsockopt(zmq.RCVHWM, hwm)
 
     def _verdict(self, frames: list[Frame]) -> Verdict:
         """What to do with a message (see :data:`Verdict`); cached per topic, sender, type."""
@@ -366,10 +383,12 @@ class SubscriptionReader:
 
     def _keep(self, item: Delivery) -> None:
         """Queue ``item``, dropping the oldest beyond ``size`` messages or ``max_bytes``."""
-        dropped = self._pending.put(item)
+        pending = self._pending
+        dropped = pending.put(item)
         if dropped:
             self._count("messages_dropped", dropped)
-            self._warning.dropped(self.dropped, item[1].publisher_address)
+            sender = pending.dropped_source
+            self._warning.dropped(self.dropped, str(sender) if sender is not None else "")
 
 
 def receive_message(sock: Any) -> list[Frame]:

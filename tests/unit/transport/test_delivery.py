@@ -5,7 +5,7 @@ from __future__ import annotations
 import threading
 import time
 
-from ros_gz_bridge_py.transport.delivery import DeliveryQueue
+from ros_gz_bridge_py.transport.delivery import DeliveryQueue, DropOldestQueue
 
 
 def _blocked_queue(
@@ -97,3 +97,54 @@ def test_on_start_runs_on_the_delivery_thread_before_the_first_item() -> None:
     queue.close()
     assert [name for name, _ in events] == ["start", "item"]
     assert events[0][1] == events[1][1] != threading.get_ident()
+
+
+def _sender_of(item: tuple[str, bytes]) -> str:
+    return item[0]
+
+
+def _weight(item: tuple[str, bytes]) -> int:
+    return len(item[1])
+
+
+def test_bytes_bound_takes_the_heaviest_senders_oldest_first() -> None:
+    """A flood of large messages from one sender between a real publisher's small ones: over
+    the bytes bound, the flooder's oldest go, the small ones all stay, in order."""
+    queue: DropOldestQueue[tuple[str, bytes]] = DropOldestQueue(
+        1000, weigh=_weight, max_bytes=100, source=_sender_of
+    )
+    dropped = 0
+    for i in range(6):
+        dropped += queue.put(("rogue", bytes([i]) * 40))
+        dropped += queue.put(("real", bytes([i])))
+    kept = [queue.get(block=False) for _ in range(len(queue))]
+    assert [item for item in kept if item[0] == "real"] == [("real", bytes([i])) for i in range(6)]
+    assert [item for item in kept if item[0] == "rogue"] == [
+        ("rogue", bytes([4]) * 40),
+        ("rogue", bytes([5]) * 40),
+    ]
+    assert kept[-1] == ("real", bytes([5]))  # the order of what stays is kept
+    assert dropped == queue.dropped == 4
+    assert queue.dropped_source == "rogue"
+
+
+def test_without_a_source_the_bytes_bound_drops_the_oldest_of_all() -> None:
+    queue: DropOldestQueue[tuple[str, bytes]] = DropOldestQueue(1000, weigh=_weight, max_bytes=100)
+    for i in range(6):
+        queue.put(("rogue", bytes([i]) * 40))
+        queue.put(("real", bytes([i])))
+    kept = [queue.get(block=False) for _ in range(len(queue))]
+    assert ("real", bytes([0])) not in kept  # pushed out with the rogue's oldest
+    assert queue.dropped_source is None
+
+
+def test_the_heaviest_sender_is_the_one_holding_most_bytes_not_the_newest() -> None:
+    queue: DropOldestQueue[tuple[str, bytes]] = DropOldestQueue(
+        1000, weigh=_weight, max_bytes=100, source=_sender_of
+    )
+    queue.put(("camera", b"c" * 70))
+    queue.put(("other", b"o" * 20))
+    assert queue.put(("other", b"p" * 20)) == 1  # 110 bytes: the camera's 70 go
+    kept = [queue.get(block=False) for _ in range(len(queue))]
+    assert kept == [("other", b"o" * 20), ("other", b"p" * 20)]
+    assert queue.dropped_source == "camera"
