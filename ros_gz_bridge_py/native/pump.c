@@ -16,7 +16,6 @@
 #include "pump.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -38,7 +37,7 @@ typedef struct {
     void *allocator[5];
 } rcl_serialized;
 
-enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_FD_ = 14, ZMQ_EVENTS_ = 15, ZMQ_RCVHWM_ = 24 };
+enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_FD_ = 14, ZMQ_EVENTS_ = 15 };
 /* libzmq's errno for a terminated context (zmq.h: ZMQ_HAUSNUMERO + 53). */
 #define ETERM_ (156384712 + 53)
 
@@ -50,7 +49,6 @@ struct foreign {
     size_t (*msg_size)(const zmq_msg *msg);
     int (*msg_more)(const zmq_msg *msg);
     int (*getsockopt)(void *socket, int option, void *value, size_t *length);
-    int (*setsockopt)(void *socket, int option, const void *value, size_t length);
     int (*publish)(const void *publisher, const rcl_serialized *message, void *allocation);
     void (*reset_error)(void);
 };
@@ -110,10 +108,6 @@ struct PumpObject {
     struct queued *ring;
     size_t capacity, head, count;
     size_t max_bytes, queued_bytes; /* the ring's bound in payload bytes, and what it holds */
-    /* The socket's receive HWM kept within max_bytes (fit_hwm): the fewest it may be (0: left
-     * alone), the count it was made with (-1: not read yet), the largest payload so far. */
-    int hwm_floor, hwm_configured, hwm;
-    size_t largest;
     struct handed *handover;
     size_t nhanded, handed_cap;
     struct rgb_out out;
@@ -266,30 +260,6 @@ static void keep(PumpObject *self, zmq_msg *payload, int route) {
 /* Reads one message: 1 when one was read, 0 when none was waiting, -1 when the socket cannot
  * be read (its context terminated, or it is closed). The socket's own ZMQ_EVENTS is never
  * asked: a SUB socket answers it by prefetching a message (see loop.c). */
-/* Lowers the socket's receive HWM as payloads grow, so that libzmq's queue in front of it holds
- * about max_bytes too, not a count of messages of any size (1000 padded frames of 32 MB): the
- * policy of transport/zmq/hwm.py hwm_for_bytes (max_bytes / largest, at least hwm_floor, at
- * most the count the socket was made with; 0 there: no count), which the tests compare with
- * this. libzmq applies it to the pipes already open. On the loop's thread, the socket's. */
-static void fit_hwm(PumpObject *self, void *sock, size_t size) {
-    if (self->hwm_floor <= 0 || size <= self->largest) return;
-    self->largest = size;
-    if (self->hwm_configured < 0) {
-        int configured = 0;
-        size_t length = sizeof configured;
-        if (self->f.getsockopt(sock, ZMQ_RCVHWM_, &configured, &length) != 0) return;
-        self->hwm_configured = configured < 0 ? 0 : configured;
-        self->hwm = self->hwm_configured;
-    }
-    size_t fits = self->max_bytes / size;
-    if (fits < (size_t)self->hwm_floor) fits = (size_t)self->hwm_floor;
-    if (self->hwm_configured > 0 && fits > (size_t)self->hwm_configured)
-        fits = (size_t)self->hwm_configured;
-    int hwm = fits > INT_MAX ? INT_MAX : (int)fits;
-    if (hwm != self->hwm && self->f.setsockopt(sock, ZMQ_RCVHWM_, &hwm, sizeof hwm) == 0)
-        self->hwm = hwm;
-}
-
 static int read_message(PumpObject *self, void *sock) {
     zmq_msg frames[MAX_FRAMES];
     int n = 0, more = 1, extra = 0;
@@ -311,11 +281,7 @@ static int read_message(PumpObject *self, void *sock) {
         }
     }
     self->taken++;
-    if (n > 2) {
-        size_t size = self->f.msg_size(&frames[2]);
-        self->bytes_read += size;
-        fit_hwm(self, sock, size);
-    }
+    if (n > 2) self->bytes_read += self->f.msg_size(&frames[2]);
     int route = -1;
     if (n == 4 && !extra && self->f.msg_size(&frames[0]) == self->topic_len &&
         !memcmp(self->f.msg_data(&frames[0]), self->topic, self->topic_len)) {
@@ -555,35 +521,34 @@ static int usable(PumpObject *self, int idle) {
     return 0;
 }
 
-/* Pump(topic, functions, publisher, programs, capacity, max_rate, max_bytes, hwm_floor=0)
- * functions: 10 addresses (zmq_msg_init, zmq_msg_recv, zmq_msg_close, zmq_msg_data,
- * zmq_msg_size, zmq_msg_more, zmq_getsockopt, zmq_setsockopt, rcl_publish_serialized_message,
- * rcutils_reset_error); programs: {wire type (bytes): Program}; hwm_floor: see fit_hwm. */
+/* Pump(topic, functions, publisher, programs, capacity, max_rate, max_bytes)
+ * functions: 9 addresses (zmq_msg_init, zmq_msg_recv, zmq_msg_close, zmq_msg_data,
+ * zmq_msg_size, zmq_msg_more, zmq_getsockopt, rcl_publish_serialized_message,
+ * rcutils_reset_error); programs: {wire type (bytes): Program}. */
 static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"topic", "functions", "publisher", "programs", "capacity",
-                               "max_rate", "max_bytes", "hwm_floor", NULL};
+                               "max_rate", "max_bytes", NULL};
     Py_buffer topic;
     PyObject *functions, *programs;
     unsigned long long publisher;
     Py_ssize_t capacity, max_bytes;
     double max_rate;
-    int hwm_floor = 0;
     if (self->topic != NULL || self->ring != NULL) {
         PyErr_SetString(PyExc_RuntimeError, "a Pump is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*OKO!ndn|i", keywords, &topic, &functions,
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*OKO!ndn", keywords, &topic, &functions,
                                      &publisher, &PyDict_Type, &programs, &capacity, &max_rate,
-                                     &max_bytes, &hwm_floor))
+                                     &max_bytes))
         return -1;
     int result = -1;
-    void *addresses[10];
+    void *addresses[9];
     if (native_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0)
         goto done;
     if (publisher == 0 || capacity < 1 || capacity > (1 << 24) || !(max_rate >= 0) ||
-        max_bytes < 1 || hwm_floor < 0) {
+        max_bytes < 1) {
         PyErr_SetString(PyExc_ValueError,
-                        "publisher, capacity, max_rate, max_bytes or hwm_floor out of range");
+                        "publisher, capacity, max_rate or max_bytes out of range");
         goto done;
     }
     memcpy(&self->f.msg_init, &addresses[0], sizeof(void *));
@@ -593,11 +558,8 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     memcpy(&self->f.msg_size, &addresses[4], sizeof(void *));
     memcpy(&self->f.msg_more, &addresses[5], sizeof(void *));
     memcpy(&self->f.getsockopt, &addresses[6], sizeof(void *));
-    memcpy(&self->f.setsockopt, &addresses[7], sizeof(void *));
-    memcpy(&self->f.publish, &addresses[8], sizeof(void *));
-    memcpy(&self->f.reset_error, &addresses[9], sizeof(void *));
-    self->hwm_floor = hwm_floor;
-    self->hwm_configured = -1;
+    memcpy(&self->f.publish, &addresses[7], sizeof(void *));
+    memcpy(&self->f.reset_error, &addresses[8], sizeof(void *));
     self->publisher = (void *)(uintptr_t)publisher;
     Py_ssize_t n = PyDict_Size(programs);
     self->programs = calloc((size_t)n + 1, sizeof *self->programs);
@@ -704,8 +666,6 @@ static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     clear_routes(self);
     clear_ring(self);
     clear_handover(self);
-    self->hwm_configured = -1; /* a socket of its own: its HWM is read again */
-    self->largest = 0;
     Py_RETURN_NONE;
 }
 

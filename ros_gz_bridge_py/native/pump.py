@@ -34,7 +34,6 @@ from ros_gz_bridge_py.transport import MessageInfo
 from ros_gz_bridge_py.transport.api import NativeHost
 from ros_gz_bridge_py.transport.delivery import DeliveryQueue, payload_size
 from ros_gz_bridge_py.transport.heap import BurstTrimmer
-from ros_gz_bridge_py.transport.zmq.hwm import MIN_HWM
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 _ZMQ_FUNCTIONS = (
@@ -45,7 +44,6 @@ _ZMQ_FUNCTIONS = (
     "zmq_msg_size",
     "zmq_msg_more",
     "zmq_getsockopt",
-    "zmq_setsockopt",
 )
 #: Handed back by the C pump: frames it has no route for, a payload no program took, or the
 #: figures of a payload refused as too large (no payload: Python would parse it item by item).
@@ -136,7 +134,6 @@ class ChannelPump:
             capacity,
             max_rate,
             max_bytes,
-            hwm_floor=MIN_HWM,  # libzmq's queue in front kept within max_bytes too (pump.c)
         )
         self._loop = shared_loop()
         self._host: NativeHost | None = None

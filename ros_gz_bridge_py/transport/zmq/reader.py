@@ -57,7 +57,6 @@ from ros_gz_bridge_py.transport.heap import BurstTrimmer
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
-from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
 from ros_gz_bridge_py.transport.zmq.sockets import subscriber_socket
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
 
@@ -113,9 +112,6 @@ class SubscriptionReader:
         self._deliver = deliver
         self._reject = reject
         self._limit = settings.max_message_size
-        self._max_bytes = max_bytes
-        self._rcvhwm = settings.rcvhwm
-        self._largest = 0  # payload read so far, for the socket's HWM (_fit_hwm)
         self._pending: DropOldestQueue[Delivery] = DropOldestQueue(
             size, weigh=payload_size, max_bytes=max_bytes, source=payload_sender
         )
@@ -331,22 +327,10 @@ class SubscriptionReader:
             verdict = self._verdict(frames)
             if isinstance(verdict, MessageInfo):
                 self._received += 1
-                size = len(frames[2])
-                self._trimmer.received(size)
-                if size > self._largest:
-                    self._fit_hwm(size)
+                self._trimmer.received(len(frames[2]))
                 self._keep((frames[2], verdict))
             elif verdict is not None:
                 self._reject(*verdict)
-
-    def _fit_hwm(self, size: int) -> None:
-        """Lowers the socket's receive HWM as payloads grow, so that libzmq's queue in front
-        of ours holds about ``max_bytes`` too, not 1000 messages of any size (``hwm.py``; the
-        native pump does the same, pump.c ``fit_hwm``). On the reader's thread, the socket's."""
-        self._largest = size
-        hwm = hwm_for_bytes(size, self._max_bytes, self._rcvhwm)
-        if hwm != self._sock.getsockopt(zmq.RCVHWM):
-            self._sock.setsockopt(zmq.RCVHWM, hwm)
 
     def _verdict(self, frames: list[Frame]) -> Verdict:
         """What to do with a message (see :data:`Verdict`); cached per topic, sender, type."""
