@@ -38,7 +38,7 @@ from typing import Any, Protocol
 
 from ros_gz_bridge_py.libc import name_os_thread
 from ros_gz_bridge_py.native import extension
-from ros_gz_bridge_py.transport.heap import BurstTrimmer
+from ros_gz_bridge_py.transport.heap import BurstTrimmer, trim_heap
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 #: Seconds between two counts of the moving members while messages flow.
@@ -74,8 +74,9 @@ class LoopMember(Protocol):
 class SharedLoop:
     """The process's loop thread for native Gazebo -> ROS channels (see the module docstring)."""
 
-    def __init__(self, native: Any) -> None:
+    def __init__(self, native: Any, *, trim: Callable[[], object] = trim_heap) -> None:
         self._loop = native.Loop()
+        self._trim = trim  # what each channel's trimmer calls
         self.monitor_event = int(native.EVENT_MONITOR)
         self.handed_event = int(native.EVENT_HANDED)
         self.broken_event = int(native.EVENT_BROKEN)
@@ -145,7 +146,7 @@ class SharedLoop:
             raise
         self._members[member.pump] = member
         self._handles[member] = handle
-        self._trimmers[member.pump] = BurstTrimmer(trim_after=LOOP_TRIM_AFTER)
+        self._trimmers[member.pump] = BurstTrimmer(self._trim, trim_after=LOOP_TRIM_AFTER)
         self._bytes_read[member.pump] = member.bytes_read
 
     def _remove(self, member: LoopMember) -> None:

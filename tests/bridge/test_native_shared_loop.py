@@ -10,6 +10,7 @@ an rclpy node of this process; the bridge a real ``parameter_bridge`` process.
 from __future__ import annotations
 
 import os
+import time
 
 import pytest
 from std_msgs.msg import String
@@ -50,6 +51,8 @@ NUL_TEXT = 'data: "fell\\000back"'
 #: Its messages each channel must deliver: the first of a new sender is judged and converted
 #: by the reader on the loop's thread, the later ones fall back.
 FELL = 3
+#: Seconds a thread count must hold to count as settled.
+THREADS_SETTLE = 1.0
 
 
 def require_native() -> None:
@@ -67,6 +70,19 @@ def bridge_of(topics: list[str], started: list[PeerProcess]) -> PeerProcess:
     )
     started.append(bridge)
     return bridge
+
+
+def settled_threads(process: PeerProcess) -> int:
+    """The process's thread count once it stayed the same for :data:`THREADS_SETTLE` seconds
+    (Fast DDS starts some of its threads a moment after discovery)."""
+    deadline = time.monotonic() + WAIT
+    count = threads_of(process)
+    while True:
+        time.sleep(THREADS_SETTLE)
+        now = threads_of(process)
+        if now == count or time.monotonic() > deadline:
+            return now
+        count = now
 
 
 def flowing(ros_side: RosSide, topics: list[str]) -> None:
@@ -141,7 +157,7 @@ def test_fallbacks_on_many_channels_share_one_thread(
     inboxes = [ros_side.subscribe(String, topic, 1000)[0] for topic in topics]
     for inbox in inboxes:
         inbox.wait_for_count(3, WAIT * 2)
-    before = threads_of(bridge)
+    before = settled_threads(bridge)
     started.append(start_peer("pub-many", STRING, "20", NUL_TEXT, *topics))
     for topic, inbox in zip(topics, inboxes, strict=True):
         inbox.wait_for(
@@ -149,7 +165,7 @@ def test_fallbacks_on_many_channels_share_one_thread(
             WAIT * 2,
             f"{topic}: {FELL} messages that fell back",
         )
-    after = threads_of(bridge)
+    after = settled_threads(bridge)
     assert after <= before + 1, (before, after)
     received = {message.data for inbox in inboxes for message, _ in inbox.items()}
     assert received == {"fleet", "fell"}  # a ROS string ends at its first NUL
