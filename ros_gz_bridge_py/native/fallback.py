@@ -8,7 +8,9 @@ either, or a rogue whose payloads fall back on many topics would add a thread to
 each of them. So every channel has a :class:`FallbackLane` (its own drop-oldest queue, of the
 channel's bounds in messages and bytes, its drops counted) on the process's one
 :class:`FallbackWorker`, whose thread serves the lanes that hold something one payload each in
-turn: a flood on one channel's fallback delays another's by at most one payload per turn.
+turn: a channel's payload waits at most for the one being handled and one of each other lane
+whose turn came first, so a flood on one channel's fallback does not hold up another's behind
+its whole queue.
 
 The thread starts with the first lane (a channel's first fallback) and ends with the last (the
 channel closed). It trims the heap once it has been quiet for a second after handling

@@ -9,9 +9,9 @@ back is done here in Python: the payloads no program took go through the channel
 (``refused``), which converts them or says why not, with the Python path's own error reasons,
 on the process's one fallback thread (``fallback.py``) behind a drop-oldest queue of the
 channel's own (its count and bytes), so that a payload that is slow to refuse (a Pose_V of 4 M
-empty poses: a second of parsing) holds up no native channel's loop and delays another
-channel's fallback by one payload at most; the frames of a sender not yet known go to the
-reader, on the loop's thread.
+empty poses: a second of parsing) holds up no native channel's loop, and a flood of them
+holds up another channel's fallback by one payload a turn, not by its whole queue; the frames
+of a sender not yet known go to the reader, on the loop's thread.
 
 libzmq and rcl are not linked: their functions are taken from the libraries pyzmq and rclpy
 already loaded (docs/native.md §5).
