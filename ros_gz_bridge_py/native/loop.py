@@ -13,10 +13,13 @@ runs, for the members that need it and no others:
   :data:`COUNT_EVERY` seconds while messages flow, so the status table stays current; an idle
   bridge turns once every :data:`QUIET_COUNT_EVERY` seconds, whatever its number of channels.
 
-At each count every member's bytes so far (read, and done with in Python) go to its own
-``BurstTrimmer`` (``transport/heap.py``): once a channel that read a burst of large messages
-has been quiet for a second, freed memory goes back to the system; a steady stream of large
-messages is never quiet that long.
+At each count the bytes a moving member read since the last go to its own ``BurstTrimmer``
+(``transport/heap.py``), and the trimmers that hold a burst not trimmed yet are told the time:
+once a channel that read a burst of large messages has been quiet for a second, freed memory
+goes back to the system; a steady stream of large messages is never quiet that long. A trimmer
+per channel, not one for the loop: a fleet's many light channels add up to more than a quiet
+rate, and would hold one channel's burst for ever. A member at rest, with no burst pending,
+costs nothing at a count.
 
 Members are added and removed on the loop's own thread (a command posted from any thread,
 which :meth:`SharedLoop.detach` waits for), so the C loop never runs a pump whose socket is
@@ -35,7 +38,7 @@ from typing import Any, Protocol
 
 from ros_gz_bridge_py.libc import name_os_thread
 from ros_gz_bridge_py.native import extension
-from ros_gz_bridge_py.transport.heap import BurstTrimmer
+from ros_gz_bridge_py.transport.heap import BurstTrimmer, trim_heap
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 #: Seconds between two counts of the moving members while messages flow.
@@ -57,8 +60,8 @@ class LoopMember(Protocol):
         ...
 
     @property
-    def bytes_so_far(self) -> int:
-        """Payload bytes read, and then handled by Python where it took them (for the trim)."""
+    def bytes_read(self) -> int:
+        """Payload bytes read from its socket so far (for the trim)."""
         ...
 
     def loop_turn(self, events: int) -> float | None:
@@ -71,8 +74,9 @@ class LoopMember(Protocol):
 class SharedLoop:
     """The process's loop thread for native Gazebo -> ROS channels (see the module docstring)."""
 
-    def __init__(self, native: Any) -> None:
+    def __init__(self, native: Any, *, trim: Callable[[], object] = trim_heap) -> None:
         self._loop = native.Loop()
+        self._trim = trim  # what each channel's trimmer calls
         self.monitor_event = int(native.EVENT_MONITOR)
         self.handed_event = int(native.EVENT_HANDED)
         self.broken_event = int(native.EVENT_BROKEN)
@@ -84,6 +88,8 @@ class SharedLoop:
         self._deadlines: dict[LoopMember, float] = {}
         self._handles: dict[LoopMember, Any] = {}
         self._trimmers: dict[Any, BurstTrimmer] = {}  # by pump
+        self._bytes_read: dict[Any, int] = {}  # by pump, at the last count
+        self._pending: set[Any] = set()  # pumps whose trimmer holds a burst
         self._touched: list[Any] = []
 
     # --- from any thread ----------------------------------------------------------------------
@@ -140,13 +146,16 @@ class SharedLoop:
             raise
         self._members[member.pump] = member
         self._handles[member] = handle
-        self._trimmers[member.pump] = BurstTrimmer(trim_after=LOOP_TRIM_AFTER)
+        self._trimmers[member.pump] = BurstTrimmer(self._trim, trim_after=LOOP_TRIM_AFTER)
+        self._bytes_read[member.pump] = member.bytes_read
 
     def _remove(self, member: LoopMember) -> None:
         if self._members.pop(member.pump, None) is None:
             return
         self._loop.remove(member.pump)
         self._trimmers.pop(member.pump, None)
+        self._bytes_read.pop(member.pump, None)
+        self._pending.discard(member.pump)
         self._deadlines.pop(member, None)
         self._asked.discard(member)
         self._handles.pop(member).__exit__(None, None, None)
@@ -192,9 +201,27 @@ class SharedLoop:
         moved = self._loop.moved()
         for pump in moved:
             self._turn(self._members.get(pump), 0)
-        for pump, trimmer in list(self._trimmers.items()):
-            trimmer.read_so_far(self._members[pump].bytes_so_far, now)
+        self._count_bytes(moved, now)
         return now + (COUNT_EVERY if moved else QUIET_COUNT_EVERY)
+
+    def _count_bytes(self, moved: list[Any], now: float) -> None:
+        """The bytes each of the ``moved`` pumps read since the last count to its trimmer;
+        then the trimmers holding a burst trim if it is over."""
+        for pump in moved:
+            member = self._members.get(pump)
+            if member is None:
+                continue  # removed since
+            total = member.bytes_read
+            trimmer = self._trimmers[pump]
+            trimmer.received(total - self._bytes_read[pump], now)
+            self._bytes_read[pump] = total
+            if trimmer.pending:
+                self._pending.add(pump)
+        for pump in list(self._pending):
+            trimmer = self._trimmers[pump]
+            trimmer.idle(now)
+            if not trimmer.pending:
+                self._pending.discard(pump)
 
     def _turn(self, member: LoopMember | None, events: int) -> None:
         if member is None or member.pump not in self._members:

@@ -7,10 +7,11 @@ published). The ZeroMQ reader attaches it to the process's one loop (``loop.py``
 reading its socket on a thread of its own (``transport/zmq/reader.py``); what the C loop hands
 back is done here in Python: the payloads no program took go through the channel's Python path
 (``refused``), which converts them or says why not, with the Python path's own error reasons,
-on a thread of the channel's own behind a drop-oldest queue (the channel's count and bytes),
-so that a payload that is slow to refuse (a Pose_V of 4 M empty poses: a second of parsing)
-holds up no other native channel; the frames of a sender not yet known go to the reader, on the
-loop's thread.
+on the process's one fallback thread (``fallback.py``) behind a drop-oldest queue of the
+channel's own (its count and bytes), so that a payload that is slow to refuse (a Pose_V of 4 M
+empty poses: a second of parsing) holds up no native channel's loop, and a flood of them
+holds up another channel's fallback by one payload a turn, not by its whole queue; the frames
+of a sender not yet known go to the reader, on the loop's thread.
 
 libzmq and rcl are not linked: their functions are taken from the libraries pyzmq and rclpy
 already loaded (docs/native.md §5).
@@ -21,6 +22,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import logging
+import threading
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -29,11 +31,10 @@ import zmq  # noqa: F401 - loads pyzmq's libzmq, which libzmq_path finds
 
 from ros_gz_bridge_py.converters._limits import amplification_error
 from ros_gz_bridge_py.native import extension
+from ros_gz_bridge_py.native.fallback import FallbackLane, fallback_worker
 from ros_gz_bridge_py.native.loop import shared_loop
 from ros_gz_bridge_py.transport import MessageInfo
 from ros_gz_bridge_py.transport.api import NativeHost
-from ros_gz_bridge_py.transport.delivery import DeliveryQueue, payload_size
-from ros_gz_bridge_py.transport.heap import BurstTrimmer
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 _ZMQ_FUNCTIONS = (
@@ -48,10 +49,6 @@ _ZMQ_FUNCTIONS = (
 #: Handed back by the C pump: frames it has no route for, a payload no program took, or the
 #: figures of a payload refused as too large (no payload: Python would parse it item by item).
 _UNROUTED, _REFUSED, _TOO_LARGE = 0, 1, 2
-#: Payload bytes the fallback thread handles before a quiet second is worth a trim: far fewer
-#: than a reader's, because the Python path can build objects many times a payload's size (a
-#: Pose_V of 4 M empty poses: 8 MB, some 300 MB parsed, left on the thread's own heap).
-FALLBACK_TRIM_AFTER = 1024 * 1024
 
 
 def loaded_libraries() -> list[str]:
@@ -142,9 +139,9 @@ class ChannelPump:
         self._capacity = capacity
         self._max_bytes = max_bytes
         #: The refused payloads on their way to ``refused`` (made at the first).
-        self._fallback: DeliveryQueue[tuple[bytes, MessageInfo]] | None = None
-        self._fallback_bytes = 0  # of the payloads it handled
-        self._fallback_trimmer = BurstTrimmer(trim_after=FALLBACK_TRIM_AFTER)
+        self._fallback: FallbackLane | None = None
+        self._closed = False
+        self._closing = threading.Lock()  # a lane is not made as the channel closes
         self._counted = counted
         self._partition = partition
         self._name = name
@@ -212,36 +209,29 @@ class ChannelPump:
 
     def _fall_back(self, payload: bytes, info: MessageInfo) -> None:
         """``payload`` to the channel's Python path, on the fallback thread."""
-        if self._fallback is None:
-            self._fallback = DeliveryQueue(
-                self._capacity,
-                self._handle_refused,
-                f"gz-fallback {self._name}",
-                weigh=payload_size,
-                max_bytes=self._max_bytes,
-                on_idle=self._fallback_trimmer.idle,
-            )
-        self._fallback.put((payload, info))
-
-    def _handle_refused(self, item: tuple[bytes, MessageInfo]) -> None:
-        """On the fallback thread: the channel's Python path, then the bytes it handled."""
-        try:
-            self._refused(*item)
-        finally:
-            self._fallback_bytes += len(item[0])
-            self._fallback_trimmer.received(len(item[0]))
+        lane = self._fallback
+        if lane is None:
+            with self._closing:
+                if self._closed:
+                    return
+                worker = fallback_worker()
+                lane = self._fallback = worker.lane(self._refused, self._capacity, self._max_bytes)
+        lane.put(payload, info)
 
     @property
-    def bytes_so_far(self) -> int:
-        """Payload bytes read from the socket, plus those the fallback thread handled: a burst
-        is over when both stop growing (``loop.py`` trims then)."""
+    def bytes_read(self) -> int:
+        """Payload bytes read from the socket so far (``loop.py`` trims after a burst)."""
         read: int = self._pump.traffic()[0]
-        return read + self._fallback_bytes
+        return read
 
     def close(self) -> None:
-        """Stop the fallback thread (after the payload it is converting). Idempotent."""
-        if self._fallback is not None:
-            self._fallback.close()
+        """No more payloads to the Python path (after the one being converted, if it is this
+        channel's). Idempotent."""
+        with self._closing:
+            self._closed = True
+            lane = self._fallback
+        if lane is not None:
+            lane.close()
 
     def _info(self, sender: bytes, msg_type: bytes) -> MessageInfo:
         info = self._infos.get((sender, msg_type))

@@ -41,8 +41,6 @@ Delivery = tuple[Payload, "MessageInfo"]
 MAX_QUEUED_BYTES = 64 * 1024 * 1024
 #: Seconds between two warnings of one queue's drops.
 DROP_WARN_PERIOD = 10.0
-#: Seconds between two ``on_idle`` calls of an idle :class:`DeliveryQueue`.
-IDLE_EVERY = 0.25
 
 
 def raw_deliverer(
@@ -283,8 +281,7 @@ _CLOSED = object()
 class DeliveryQueue(Generic[T]):
     """A :class:`DropOldestQueue` whose items ``handler`` takes on a daemon thread of its own.
 
-    ``on_start`` runs on that thread before it takes the first item; ``on_idle`` every
-    :data:`IDLE_EVERY` seconds while no item comes (e.g. a trim after a burst).
+    ``on_start`` runs on that thread before it takes the first item.
     """
 
     def __init__(
@@ -297,14 +294,12 @@ class DeliveryQueue(Generic[T]):
         max_bytes: int = MAX_QUEUED_BYTES,
         source: Callable[[T], Hashable] | None = None,
         on_start: Callable[[], None] | None = None,
-        on_idle: Callable[[], None] | None = None,
     ) -> None:
         self._queue: DropOldestQueue[T] = DropOldestQueue(
             size, weigh=weigh, max_bytes=max_bytes, source=source
         )
         self._handler = handler
         self._on_start = on_start
-        self._on_idle = on_idle
         self._closed = False
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
@@ -334,15 +329,9 @@ class DeliveryQueue(Generic[T]):
         if self._on_start is not None:
             self._on_start()
         get = self._queue.get
-        idle = self._on_idle
-        wait = IDLE_EVERY if idle is not None else None
         while True:
             try:
-                item = get(timeout=wait)
-            except queue.Empty:
-                if idle is not None:
-                    idle()
-                continue
+                item = get()
             except QueueClosedError:
                 return
             if self._closed:

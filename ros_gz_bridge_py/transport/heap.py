@@ -10,8 +10,9 @@ subscription that received at least :data:`TRIM_AFTER_BYTES` has been quiet for
 light stream on the same topic (a real 50 Hz Odometry publisher beside a rogue's 32 MB
 frames) does not hold a burst's memory, while a steady stream of large messages, never quiet
 that long, keeps its buffers. Elsewhere than glibc it does nothing. The Python path's readers
-tell it each message (``zmq/reader.py``); the native loop, which reads in C, tells it each
-channel's running total of bytes read at every count (``native/loop.py``).
+tell it each message (``zmq/reader.py``); the native loop, which reads in C, has one per
+channel and tells it the bytes the channel read since the last count when it moved
+(``native/loop.py``); the native channels' fallback thread has one (``native/fallback.py``).
 """
 
 from __future__ import annotations
@@ -55,27 +56,31 @@ class BurstTrimmer:
         self._window_bytes = 0
         self._window_start: float | None = None
         self._last = 0.0  # when the last window above QUIET_RATE ended
-        self._total = 0
         self.trims = 0
 
     def received(self, size: int, now: float | None = None) -> None:
+        """``size`` bytes came at ``now``. The rate window that ended before them is closed
+        first, so that bytes told after a long silence (the native loop tells a channel's
+        only when it moved) are not spread over the silence; a window that already holds more
+        than a loud one of :data:`RATE_WINDOW` is loud as of now, before it closes."""
+        now = time.monotonic() if now is None else now
+        self._close_window(now)
         self._bytes += size
         self._window_bytes += size
-        self._close_window(time.monotonic() if now is None else now)
+        if self._window_bytes > QUIET_RATE * RATE_WINDOW:
+            self._last = now
 
-    def read_so_far(self, total: int, now: float) -> None:
-        """``total`` bytes received since the start (what came since the last call is
-        received now), then :meth:`idle`."""
-        if total > self._total:
-            self.received(total - self._total, now)
-            self._total = total
-        self.idle(now)
+    @property
+    def pending(self) -> bool:
+        """Whether a burst was received that is not trimmed yet (:meth:`idle` will trim once
+        it is over)."""
+        return self._bytes >= self._trim_after
 
     def idle(self, now: float | None = None) -> None:
         """Call when nothing is waiting: trims after a burst that has ended."""
         now = time.monotonic() if now is None else now
         self._close_window(now)
-        if self._bytes >= self._trim_after and now - self._last >= IDLE_BEFORE_TRIM:
+        if self.pending and now - self._last >= IDLE_BEFORE_TRIM:
             self._bytes = 0
             self.trims += 1
             self._trim()

@@ -1,7 +1,8 @@
 """Every native Gazebo -> ROS channel of a bridge runs on one loop (docs/native.md §5).
 
-A fleet in one process: the bridge's thread count must not grow with its native channels, every
-channel's messages must flow, and a flooded channel must not starve a light one. The Gazebo side
+A fleet in one process: the bridge's thread count must not grow with its native channels, nor
+with those whose payloads fall back to Python, every channel's messages must flow, and a flooded
+channel must not starve a light one. The Gazebo side
 is the C++ Fortress peer (one process publishing many topics, as a simulator does); the ROS side
 an rclpy node of this process; the bridge a real ``parameter_bridge`` process.
 """
@@ -9,6 +10,7 @@ an rclpy node of this process; the bridge a real ``parameter_bridge`` process.
 from __future__ import annotations
 
 import os
+import time
 
 import pytest
 from std_msgs.msg import String
@@ -41,6 +43,16 @@ LIGHT_HZ = 20
 LIGHT_SETTLE = 1.0
 #: What the flood sends, as fast as the peer can.
 FLOOD_TEXT = "x" * 2000
+#: Channels whose payloads fall back to Python at once.
+FALLING = 8
+#: A string with a NUL inside: valid protobuf that the transcoder leaves to the channel's
+#: Python path (docs/native.md §4), which publishes it.
+NUL_TEXT = 'data: "fell\\000back"'
+#: Its messages each channel must deliver: the first of a new sender is judged and converted
+#: by the reader on the loop's thread, the later ones fall back.
+FELL = 3
+#: Seconds a thread count must hold to count as settled.
+THREADS_SETTLE = 1.0
 
 
 def require_native() -> None:
@@ -58,6 +70,19 @@ def bridge_of(topics: list[str], started: list[PeerProcess]) -> PeerProcess:
     )
     started.append(bridge)
     return bridge
+
+
+def settled_threads(process: PeerProcess) -> int:
+    """The process's thread count once it stayed the same for :data:`THREADS_SETTLE` seconds
+    (Fast DDS starts some of its threads a moment after discovery)."""
+    deadline = time.monotonic() + WAIT
+    count = threads_of(process)
+    while True:
+        time.sleep(THREADS_SETTLE)
+        now = threads_of(process)
+        if now == count or time.monotonic() > deadline:
+            return now
+        count = now
 
 
 def flowing(ros_side: RosSide, topics: list[str]) -> None:
@@ -115,3 +140,32 @@ def test_a_flooded_channel_does_not_starve_a_light_one(
     received = [message.data for message, _ in inbox.items()]
     assert set(received) <= {"light"}
     assert len(received) >= LIGHT_SHARE * LIGHT_COUNT, len(received)
+
+
+def test_fallbacks_on_many_channels_share_one_thread(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    """A publisher whose payloads fall back on every topic of a bridge: each channel's payloads
+    are converted and published by its Python path, and the bridge gains one thread for all of
+    them (before: a thread per channel, 8 more here)."""
+    require_peer()
+    require_native()
+    base = unique_name("fallen")
+    topics = [f"{base}_{i}" for i in range(FALLING)]
+    started.append(start_peer("pub-many", STRING, "20", 'data: "fleet"', *topics))
+    bridge = bridge_of(topics, started)
+    inboxes = [ros_side.subscribe(String, topic, 1000)[0] for topic in topics]
+    for inbox in inboxes:
+        inbox.wait_for_count(3, WAIT * 2)
+    before = settled_threads(bridge)
+    started.append(start_peer("pub-many", STRING, "20", NUL_TEXT, *topics))
+    for topic, inbox in zip(topics, inboxes, strict=True):
+        inbox.wait_for(
+            lambda items: sum(message.data == "fell" for message, _ in items) >= FELL,
+            WAIT * 2,
+            f"{topic}: {FELL} messages that fell back",
+        )
+    after = settled_threads(bridge)
+    assert after <= before + 1, (before, after)
+    received = {message.data for inbox in inboxes for message, _ in inbox.items()}
+    assert received == {"fleet", "fell"}  # a ROS string ends at its first NUL

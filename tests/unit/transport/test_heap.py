@@ -51,17 +51,48 @@ def test_small_traffic_is_never_trimmed() -> None:
     assert _trims([(0.0, TRIM_AFTER_BYTES - 1), (100.0, 0)]) == []
 
 
-def test_running_totals_trim_once_a_burst_has_stopped_growing() -> None:
-    """The native loop's form: each count gives the bytes read so far."""
+def test_a_channel_told_only_when_it_moves_trims_once_its_burst_is_over() -> None:
+    """The native loop's form: at each count (every 0.25 s while messages flow, every 1 s once
+    none did) a channel that moved is told the bytes it read since the last; only while a trim
+    is pending is it told the time at counts where it did not move."""
     trimmer = BurstTrimmer(lambda: None)
-    trimmer.read_so_far(TRIM_AFTER_BYTES // 2, 10.0)
-    trimmer.read_so_far(TRIM_AFTER_BYTES, 10.5)
-    trimmer.read_so_far(TRIM_AFTER_BYTES, 10.5 + IDLE_BEFORE_TRIM / 2)  # a short pause
+    now = 10.0
+    for _ in range(8):  # 2 s of a burst
+        trimmer.received(TRIM_AFTER_BYTES // 8, now)
+        trimmer.idle(now)
+        now += 0.25
+    assert trimmer.pending
+    trimmer.idle(now)  # the first quiet count: 0.25 s after the burst
     assert trimmer.trims == 0
-    trimmer.read_so_far(TRIM_AFTER_BYTES + 1, 10.5 + IDLE_BEFORE_TRIM)  # and a trickle
-    assert trimmer.trims == 1
-    trimmer.read_so_far(TRIM_AFTER_BYTES + 2, 30.0)
-    assert trimmer.trims == 1
+    now += 1.0
+    trimmer.received(100, now)  # a trickle
+    trimmer.idle(now)
+    assert (trimmer.trims, trimmer.pending) == (1, False)
+
+
+def test_a_burst_after_a_long_silence_is_not_trimmed_before_a_quiet_second() -> None:
+    """The bytes of a channel that moved after 100 s at rest are its burst's, not 100 s'
+    worth of a trickle (before: measured over the silence, the burst looked quiet and was
+    trimmed at once, while it might still go on)."""
+    trims: list[float] = []
+    now = [0.0]
+    trimmer = BurstTrimmer(lambda: trims.append(now[0]))
+    trimmer.received(1000, 0.0)
+    now[0] = 100.0
+    trimmer.received(TRIM_AFTER_BYTES, now[0])  # read within one count
+    for now[0] in (100.0, 100.25, 100.5, 101.0, 101.25, 101.5):
+        trimmer.idle(now[0])
+    assert trims == [100.0 + RATE_WINDOW + IDLE_BEFORE_TRIM]  # a quiet second after its window
+
+
+def test_a_trim_is_pending_from_the_threshold_until_it_is_done() -> None:
+    trimmer = BurstTrimmer(lambda: None, trim_after=1000)
+    trimmer.received(999, 0.0)
+    assert not trimmer.pending
+    trimmer.received(1, 0.0)
+    assert trimmer.pending
+    trimmer.idle(5.0)
+    assert (trimmer.trims, trimmer.pending) == (1, False)
 
 
 def test_trim_heap_runs_here() -> None:
