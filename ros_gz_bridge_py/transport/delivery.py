@@ -169,8 +169,9 @@ class DropOldestQueue(Generic[T]):
         self._weigh = weigh
         self._max_bytes = max_bytes
         self._source = source
-        #: Producers hold it to put, with a source: taking every item out and putting the rest
-        #: back must not interleave with another producer's put (it would reorder a sender's).
+        #: One producer at a time takes every item out and puts the rest back (a put of
+        #: another producer meanwhile may land before older items: the queue is ordered per
+        #: producer thread, as each backend delivers a sender's messages).
         self._producing = threading.Lock()
         #: The source of the last item dropped (None before, or without ``source``).
         self.dropped_source: Hashable | None = None
@@ -185,14 +186,11 @@ class DropOldestQueue(Generic[T]):
         items = self._items
         weigh = self._weigh
         self._bytes_put += weigh(item)
+        items.put(item)
         dropped = 0
-        if self._source is None:
-            items.put(item)
-        else:
+        if self._source is not None and self._over_budget():
             with self._producing:
-                items.put(item)
-                if self._over_budget():
-                    dropped = self._shed_heaviest()
+                dropped = self._shed_heaviest()
         while items.qsize() > self._size or self._over_budget():
             try:
                 oldest = items.get_nowait()
