@@ -16,7 +16,11 @@ through valid discovery (``tests/rogue.py``) then sends, one attack after the ot
   them (the rogue's send queue holds two and its sends wait for room: it never buffers more,
   and it sends no faster than the bridge's side of the connection takes them);
 - ``empty_poses``: a Pose_V of 4 M empty poses (8 MB), twice a second, on ``/amp_tf``;
-- ``unknown_fields``: an Odometry followed by 768 KiB of 3-byte unknown fields, 20 a second.
+- ``unknown_fields``: an Odometry followed by 768 KiB of 3-byte unknown fields, 20 a second;
+- ``oversize_frames``: an Odometry padded to 200 MB, over the largest message the bridge takes
+  (``GZ_TRANSPORT_MAX_MESSAGE_SIZE``, 128 MiB), 20 a second: libzmq drops the connection as it
+  reads the frame's size, before buffering it, and the bridge reconnects after a delay that
+  grows to 5 s.
 
 Per attack: the messages the rogue sent, the real /clock and Odometry messages that reached ROS
 during it (percent of the publishers' nominal rates), the bridge's CPU during it, its peak RSS
@@ -111,6 +115,10 @@ class Attack:
     per_second: float
 
 
+#: The padding of ``oversize_frames``: over the 128 MiB input limit.
+OVERSIZE_MB = 200
+
+
 def attacks(padding_mb: int = 32) -> list[Attack]:
     padded = padded_odometry(padding_mb << 20)
     return [
@@ -118,6 +126,13 @@ def attacks(padding_mb: int = 32) -> list[Attack]:
         Attack("empty_poses", TF, "ignition.msgs.Pose_V", empty_poses(4 << 20), 2.0),
         Attack(
             "unknown_fields", ODOM, "ignition.msgs.Odometry", small_unknown_fields(768 << 10), 20
+        ),
+        Attack(
+            "oversize_frames",
+            ODOM,
+            "ignition.msgs.Odometry",
+            padded_odometry(OVERSIZE_MB << 20),
+            20,
         ),
     ]
 

@@ -189,6 +189,7 @@ class GzToRosChannel(Channel):
             else None,
             on_reject=self._rejected,
             native=self._pump,
+            large_messages=bulk,
         )
 
     def _close_input(self) -> None:

@@ -108,6 +108,9 @@ struct PumpObject {
     struct queued *ring;
     size_t capacity, head, count;
     size_t max_bytes, queued_bytes; /* the ring's bound in payload bytes, and what it holds */
+    /* A payload larger than watch_above (SIZE_MAX: none) is told to Python (take_grown): the
+     * reader lowers the socket's receive HWM for it (transport/zmq/reader.py). */
+    size_t watch_above, grown;
     struct handed *handover;
     size_t nhanded, handed_cap;
     struct rgb_out out;
@@ -281,7 +284,11 @@ static int read_message(PumpObject *self, void *sock) {
         }
     }
     self->taken++;
-    if (n > 2) self->bytes_read += self->f.msg_size(&frames[2]);
+    if (n > 2) {
+        size_t size = self->f.msg_size(&frames[2]);
+        self->bytes_read += size;
+        if (size > self->watch_above && size > self->grown) self->grown = size;
+    }
     int route = -1;
     if (n == 4 && !extra && self->f.msg_size(&frames[0]) == self->topic_len &&
         !memcmp(self->f.msg_data(&frames[0]), self->topic, self->topic_len)) {
@@ -380,7 +387,7 @@ void pump_deliver(PumpObject *self, int budget, int64_t slice_end) {
 
 size_t pump_queued(const PumpObject *self) { return self->count; }
 
-size_t pump_handed(const PumpObject *self) { return self->nhanded; }
+size_t pump_handed(const PumpObject *self) { return self->nhanded + (self->grown != 0); }
 
 unsigned long long pump_taken(const PumpObject *self) { return self->taken; }
 
@@ -572,6 +579,7 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     }
     self->capacity = (size_t)capacity;
     self->max_bytes = (size_t)max_bytes;
+    self->watch_above = SIZE_MAX;
     self->program_objects = PyList_New(0);
     if (self->program_objects == NULL) goto done;
     PyObject *key, *value;
@@ -710,6 +718,24 @@ static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
     return handed;
 }
 
+/* take_grown() -> the largest payload above the watched size since the last call (0: none) */
+static PyObject *pump_take_grown(PumpObject *self, PyObject *unused) {
+    (void)unused;
+    if (usable(self, 1) < 0) return NULL;
+    size_t grown = self->grown;
+    self->grown = 0;
+    return PyLong_FromSize_t(grown);
+}
+
+/* watch(size): payloads larger than `size` are told (take_grown); a negative size: none. */
+static PyObject *pump_watch(PumpObject *self, PyObject *arg) {
+    if (usable(self, 1) < 0) return NULL;
+    long long size = PyLong_AsLongLong(arg);
+    if (size == -1 && PyErr_Occurred()) return NULL;
+    self->watch_above = size < 0 ? SIZE_MAX : (size_t)size;
+    Py_RETURN_NONE;
+}
+
 static PyObject *pump_counts(PumpObject *self, PyObject *unused) {
     (void)unused;
     return Py_BuildValue("(KKKKKK)", self->received, self->rate_limited, self->published,
@@ -756,6 +782,10 @@ static PyMethodDef pump_methods[] = {
     {"take_handed", (PyCFunction)pump_take_handed, METH_NOARGS,
      "take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused, "
      "[(2, sender, type, items, least, payload_size)] too large"},
+    {"take_grown", (PyCFunction)pump_take_grown, METH_NOARGS,
+     "take_grown() -> the largest payload above the watched size since the last call (0: none)"},
+    {"watch", (PyCFunction)pump_watch, METH_O,
+     "watch(size): payloads larger than size are told by take_grown (negative: none)"},
     {"counts", (PyCFunction)pump_counts, METH_NOARGS,
      "(received, rate_limited, published, dropped, skipped, lost) so far"},
     {"traffic", (PyCFunction)pump_traffic, METH_NOARGS,

@@ -179,6 +179,11 @@ class ChannelPump:
         """The host wants a turn soon (any thread)."""
         self._loop.ask(self)
 
+    def watch(self, size: int | None) -> None:
+        """Payloads larger than ``size`` are told to the host (None: none); on the loop's
+        thread, or before the pump is attached."""
+        self._pump.watch(-1 if size is None else size)
+
     # --- the loop's thread ----------------------------------------------------------------
 
     def loop_turn(self, events: int) -> float | None:
@@ -186,6 +191,7 @@ class ChannelPump:
         judged by the host, the counts; then the host's own turn."""
         loop = self._loop
         handed = self._pump.take_handed() if events & loop.handed_event else ()
+        grown = self._pump.take_grown() if events & loop.handed_event else 0
         received, rate_limited, published, _dropped = self.take_counts()
         if received:
             self._counted(received, rate_limited, published)
@@ -205,6 +211,7 @@ class ChannelPump:
             unrouted,
             monitor=bool(events & loop.monitor_event),
             broken=bool(events & loop.broken_event),
+            grown=grown,
         )
 
     def _fall_back(self, payload: bytes, info: MessageInfo) -> None:

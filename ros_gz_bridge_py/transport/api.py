@@ -158,11 +158,12 @@ class NativeHost(Protocol):
     on the loop's thread."""
 
     def native_turn(
-        self, unrouted: list[list[Any]], *, monitor: bool, broken: bool
+        self, unrouted: list[list[Any]], *, monitor: bool, broken: bool, grown: int = 0
     ) -> float | None:
         """Judges the frames the loop had no route for, runs posted commands and the
         connections (``monitor``: the connection monitor has events; ``broken``: the socket
-        cannot be read any more); returns when it wants its next turn at the latest
+        cannot be read any more; ``grown``: the largest payload read above the size
+        :meth:`NativeLoop.watch` set, or 0); returns when it wants its next turn at the latest
         (``time.monotonic()``), or None."""
         ...
 
@@ -185,6 +186,10 @@ class NativeLoop(Protocol):
 
     def wake(self) -> None:
         """Calls ``host.native_turn`` soon (from any thread)."""
+
+    def watch(self, size: int | None) -> None:
+        """Payloads larger than ``size`` bytes are told to ``host.native_turn`` (``grown``);
+        None: none."""
 
     @property
     def received(self) -> int:

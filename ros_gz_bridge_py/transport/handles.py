@@ -149,6 +149,9 @@ class Subscription:
         self.delivery: Delivery | None = None
         #: The loop that reads the subscription's socket natively, where the backend uses it.
         self.native: NativeLoop | None = None
+        #: Whether its messages are large by nature (images, point clouds): a backend that
+        #: bounds its receive queue in messages sizes it for the largest from the start.
+        self.large_messages = False
         self._node = node
         self._deliver = deliver
         # (publisher id, canonical type) -> the spelling taken from that publisher.

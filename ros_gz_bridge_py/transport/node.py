@@ -180,6 +180,7 @@ class GzNode(ServiceEnds, GraphView):
         on_delivery_start: Callable[[], None] | None = None,
         on_reject: RejectCallback | None = None,
         native: NativeLoop | None = None,
+        large_messages: bool = False,
     ) -> Subscription:
         """Receive raw payloads of ``msg_type`` (either spelling; GENERIC_TYPE = any).
 
@@ -193,6 +194,9 @@ class GzNode(ServiceEnds, GraphView):
         another type, over ``settings.max_message_size``), on the receiving thread.
         ``native``: a loop that takes over reading a queued subscription's messages where the
         backend can hand it its socket (ZeroMQ); other backends deliver through ``callback``.
+        ``large_messages``: payloads of megabytes are the topic's normal traffic (images):
+        a queue that libzmq bounds in messages is sized for the largest message from the
+        start (``zmq/reader.py``), not when the first large one comes.
 
         Raises:
             ValueError: a queue of no messages, or ``on_delivery_start`` without a queue.
@@ -205,7 +209,7 @@ class GzNode(ServiceEnds, GraphView):
         deliver = raw_deliverer(self.count, callback, copy=copy)
         return self._add_subscription(
             topic, msg_type, deliver, ignore_local, queue_size, on_delivery_start, on_reject,
-            native, queue_bytes,
+            native, queue_bytes, large_messages=large_messages,
         )  # fmt: skip
 
     def subscribe_typed(
@@ -238,6 +242,8 @@ class GzNode(ServiceEnds, GraphView):
         on_reject: RejectCallback | None,
         native: NativeLoop | None = None,
         queue_bytes: int = MAX_QUEUED_BYTES,
+        *,
+        large_messages: bool = False,
     ) -> Subscription:
         self._check_open()
         sub = self.subscription_class(
@@ -245,6 +251,7 @@ class GzNode(ServiceEnds, GraphView):
         )
         sub.on_reject = on_reject
         sub.native = native
+        sub.large_messages = large_messages
         if queue_size is not None:
             sub.delivery = self._open_delivery(sub, queue_size, on_start, queue_bytes)
         with self._subscriptions_lock:

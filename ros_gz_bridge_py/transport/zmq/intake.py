@@ -63,7 +63,7 @@ class DataIntake:
             self._context, fqn=sub.fqn, partition=node.partition, accepts=sub.accepts_from,
             takes=sub.accepts, deliver=sub.run, reject=sub.reject, size=size,
             settings=node.settings, count=node.count, on_start=on_start, native=sub.native,
-            max_bytes=max_bytes,
+            max_bytes=max_bytes, large_messages=sub.large_messages,
         )  # fmt: skip
         self.readers.append(reader)
         return reader

@@ -55,8 +55,9 @@ from ros_gz_bridge_py.transport.delivery import (
 )
 from ros_gz_bridge_py.transport.heap import BurstTrimmer
 from ros_gz_bridge_py.transport.names import decompose
-from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, TransportSettings
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
+from ros_gz_bridge_py.transport.zmq.hwm import MIN_HWM, hwm_for_bytes
 from ros_gz_bridge_py.transport.zmq.sockets import subscriber_socket
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame, decode_data
 
@@ -99,6 +100,7 @@ class SubscriptionReader:
         on_start: Callable[[], None] | None = None,
         max_bytes: int = MAX_QUEUED_BYTES,
         native: NativeLoop | None = None,
+        large_messages: bool = False,
     ) -> None:
         self.fqn = fqn
         self._received = 0
@@ -112,6 +114,16 @@ class SubscriptionReader:
         self._deliver = deliver
         self._reject = reject
         self._limit = settings.max_message_size
+        self._max_bytes = max_bytes
+        self._configured_hwm = settings.rcvhwm
+        #: The socket's receive HWM now (for the largest message taken, where messages are
+        #: large by nature), and the largest payload it holds within max_bytes.
+        self._hwm = (
+            hwm_for_bytes(settings.max_message_size, max_bytes, settings.rcvhwm)
+            if large_messages
+            else settings.rcvhwm
+        )
+        self._watch: int | None = self._watch_size()
         self._pending: DropOldestQueue[Delivery] = DropOldestQueue(
             size, weigh=payload_size, max_bytes=max_bytes, source=payload_sender
         )
@@ -122,13 +134,12 @@ class SubscriptionReader:
         self._infos: dict[tuple[Frame, Frame, Frame], Verdict] = {}
         self._posted: collections.deque[Callable[[], object]] = collections.deque()
         self._closed = False
-        self._sock = subscriber_socket(context, settings)
-        self._sock.setsockopt(zmq.SUBSCRIBE, fqn.encode())
-        self._connections = SubConnections(
-            self._sock, drain=self._drain, on_refused=self._refused, count=count, what=fqn
-        )
+        self._context = context
+        self._settings = settings
+        self._sock, self._connections = self._open_socket()
         self._thread: threading.Thread | None = None
         if native is not None:
+            native.watch(self._watch)
             native.attach(self._sock.underlying, self._connections.monitor.underlying, self)
             return
         self._wake_r, self._wake_w = socket.socketpair()
@@ -194,6 +205,15 @@ class SubscriptionReader:
         with contextlib.suppress(OSError):
             self._wake_w.send(b"\0")
 
+    def _open_socket(self) -> tuple[Any, SubConnections]:
+        """A SUB socket of the topic with the receive HWM as it is now, and its connections."""
+        sock = subscriber_socket(self._context, self._settings, self._hwm)
+        sock.setsockopt(zmq.SUBSCRIBE, self._topic_frame)
+        connections = SubConnections(
+            sock, drain=self._drain, on_refused=self._refused, count=self._count, what=self.fqn
+        )
+        return sock, connections
+
     def _release(self) -> None:
         self._connections.close()
         self._sock.close(linger=0)
@@ -204,11 +224,10 @@ class SubscriptionReader:
         try:
             if self._on_start is not None:
                 self._on_start()
-            poller = zmq.Poller()
-            poller.register(self._sock, zmq.POLLIN)
-            poller.register(self._wake_r.fileno(), zmq.POLLIN)
-            poller.register(self._connections.monitor, zmq.POLLIN)
+            polled, poller = None, zmq.Poller()
             while not self._closed:
+                if polled is not self._sock:  # at first, and after a new socket (_payload_grew)
+                    polled, poller = self._sock, self._poller()
                 try:
                     self._turn(dict(poller.poll(self._poll_timeout())))
                 except zmq.ContextTerminated:  # the node went away without closing us
@@ -221,10 +240,17 @@ class SubscriptionReader:
             self._wake_r.close()
             self._wake_w.close()
 
+    def _poller(self) -> Any:
+        poller = zmq.Poller()
+        poller.register(self._sock, zmq.POLLIN)
+        poller.register(self._wake_r.fileno(), zmq.POLLIN)
+        poller.register(self._connections.monitor, zmq.POLLIN)
+        return poller
+
     # --- the native loop's thread -----------------------------------------------------------
 
     def native_turn(
-        self, unrouted: list[list[Frame]], *, monitor: bool, broken: bool
+        self, unrouted: list[list[Frame]], *, monitor: bool, broken: bool, grown: int = 0
     ) -> float | None:
         """The reader's share of a native channel's work (``NativeHost``): posted commands,
         the frames the loop had no route for, the connections, the messages queued here."""
@@ -247,6 +273,8 @@ class SubscriptionReader:
             self._native_dropped += dropped
             self._count("messages_dropped", dropped)
             self._warning.dropped(self.dropped, native.dropped_sender)
+        if grown:
+            self._payload_grew(grown)
         now = time.monotonic()
         connections = self._connections
         if monitor or connections.is_due(now):
@@ -321,16 +349,69 @@ class SubscriptionReader:
     def _drain(self) -> None:
         sock = self._sock
         for _ in range(READ_BATCH):
+            if self._sock is not sock:  # replaced by _payload_grew: read from the new one later
+                return
             if not sock.getsockopt(zmq.EVENTS) & _POLLIN:  # cheaper than raising zmq.Again
                 return
             frames = receive_message(sock)
             verdict = self._verdict(frames)
             if isinstance(verdict, MessageInfo):
                 self._received += 1
-                self._trimmer.received(len(frames[2]))
+                size = len(frames[2])
+                self._trimmer.received(size)
                 self._keep((frames[2], verdict))
+                if self._watch is not None and size > self._watch:
+                    self._payload_grew(size)  # reads what waits: after this one, in order
             elif verdict is not None:
                 self._reject(*verdict)
+
+    def _watch_size(self) -> int | None:
+        """The largest payload the socket's receive HWM holds within ``max_bytes``; None
+        where the HWM is as low as it goes."""
+        if 0 < self._hwm <= MIN_HWM:
+            return None
+        return self._max_bytes // (self._hwm if self._hwm > 0 else DEFAULT_HWM)
+
+    def _payload_grew(self, size: int) -> None:
+        """A payload of ``size`` bytes would make libzmq's queue in front of ours (RCVHWM
+        messages of any size per connection) hold more than ``max_bytes``: the HWM is lowered
+        to fit (``hwm.py``) on a new socket, connected where the old one was, which replaces
+        it: libzmq applies an HWM set on a socket to its open connections too, which then
+        stall for good, or crash it while a connection closes (docs/protocol.md, "Memory
+        during a flood"). What the old socket holds is read first (one batch more); what is
+        still on its way in its connections is lost, once per lowering. On the socket's
+        thread."""
+        hwm = hwm_for_bytes(size, self._max_bytes, self._configured_hwm)
+        if 0 < self._hwm <= hwm:
+            self._watch = self._watch_size()
+        else:
+            self._hwm = hwm
+            self._watch = self._watch_size()
+            self._replace_socket()
+            _LOG.info(
+                "%s: a payload of %d bytes: its receive queue now holds %d messages per "
+                "publisher (parameter max_queued_bytes, %d bytes); connected anew to %d "
+                "publisher(s)",
+                self.fqn, size, hwm, self._max_bytes, len(self._connections.connected),
+            )  # fmt: skip
+        if self._native is not None:
+            self._native.watch(self._watch)
+
+    def _replace_socket(self) -> None:
+        """A socket with the HWM as it is now replaces the reader's, connected to the same
+        publishers (see :meth:`_payload_grew`); a native loop reads the new one."""
+        sock, connections = self._open_socket()
+        for address in self._connections.connected:
+            connections.connect(address)
+        if self._native is not None:
+            self._native.detach()  # on the loop's thread: at once (its queue is dropped)
+        self._drain()
+        old_sock, old_connections = self._sock, self._connections
+        self._sock, self._connections = sock, connections
+        old_connections.close()
+        old_sock.close(linger=0)
+        if self._native is not None:
+            self._native.attach(sock.underlying, connections.monitor.underlying, self)
 
     def _verdict(self, frames: list[Frame]) -> Verdict:
         """What to do with a message (see :data:`Verdict`); cached per topic, sender, type."""

@@ -122,9 +122,10 @@ def limit_input(sock: Any, settings: TransportSettings) -> None:
     sock.setsockopt(zmq.RECONNECT_IVL_MAX, int(MAX_BACKOFF * 1000))
 
 
-def subscriber_socket(context: Any, settings: TransportSettings) -> Any:
-    """A SUB socket: RCVHWM, the size limit, and a PLAIN client with credentials (§2.8.6)."""
-    sock = _socket(context, zmq.SUB, rcvhwm=settings.rcvhwm)
+def subscriber_socket(context: Any, settings: TransportSettings, rcvhwm: int | None = None) -> Any:
+    """A SUB socket: RCVHWM (``settings``' unless given), the size limit, and a PLAIN client
+    with credentials (§2.8.6)."""
+    sock = _socket(context, zmq.SUB, rcvhwm=settings.rcvhwm if rcvhwm is None else rcvhwm)
     limit_input(sock, settings)
     if settings.credentials is not None:
         user, password = settings.credentials

@@ -157,3 +157,37 @@ def test_a_pump_that_was_never_initialised_is_refused(native: Any) -> None:
         blank.learn(b"s", b"t", True)
     with pytest.raises(TypeError, match="initialised Pump"):
         native.Loop().add(blank, 1, 0)
+
+
+def test_a_payload_above_the_watched_size_is_told(native: Any, publisher: Any) -> None:
+    """The reader lowers its socket's receive HWM when payloads grow (transport/zmq/reader.py):
+    the pump tells it the largest payload above the size it watches, once, and wakes Python
+    for it; nothing is told before a size is watched, or for payloads within it."""
+    rig = Rig(native, publisher, capacity=1000, max_bytes=1 << 26)
+    try:
+        rig.connected()
+        payload = message_class("gz.msgs.StringMsg")(data="x" * 5000).SerializeToString()
+        rig.send(LEGIT, payload)
+        rig.settle()
+        assert rig.pump.take_grown() == 0  # nothing watched
+        rig.pump.watch(1000)
+        rig.send(LEGIT, PAYLOAD)
+        rig.settle()
+        assert rig.pump.take_grown() == 0  # within the watched size
+        larger = message_class("gz.msgs.StringMsg")(data="y" * 8000).SerializeToString()
+        for data in (payload, larger, payload):
+            rig.send(LEGIT, data)
+        _woken, reported = rig.loop.run(2000, [])
+        deadline = time.monotonic() + 5
+        while not reported and time.monotonic() < deadline:
+            _woken, reported = rig.loop.run(100, [])
+        assert reported, "the loop did not hand the pump to Python"
+        rig.settle()
+        assert rig.pump.take_grown() == len(larger)
+        assert rig.pump.take_grown() == 0  # told once
+        rig.pump.watch(-1)
+        rig.send(LEGIT, larger)
+        rig.settle()
+        assert rig.pump.take_grown() == 0
+    finally:
+        rig.close()
