@@ -40,10 +40,12 @@ def environment() -> dict[str, str]:
     return {**os.environ, "LD_PRELOAD": preload, "PYTHONPATH": str(ROOT)}
 
 
-def fail_size(size: int) -> None:
+def fail_size(size: int, spared: int = 0) -> None:
     """In a process the shim is preloaded into: from now on every malloc or realloc of
-    ``size`` bytes fails (0: none)."""
-    ctypes.c_size_t.in_dll(ctypes.CDLL(None), "failing_alloc_size").value = size
+    ``size`` bytes fails (0: none), but for the first ``spared`` of them."""
+    process = ctypes.CDLL(None)
+    ctypes.c_ulong.in_dll(process, "failing_alloc_spared").value = spared
+    ctypes.c_size_t.in_dll(process, "failing_alloc_size").value = size
 
 
 def failures() -> int:
