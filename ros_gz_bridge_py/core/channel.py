@@ -195,6 +195,12 @@ class Channel(abc.ABC):
         """Whether a native loop carries the channel's messages (docs/native.md)."""
         return False
 
+    @property
+    @abc.abstractmethod
+    def dropped(self) -> int:
+        """Messages received and dropped so far without a conversion error (the DROPPED
+        column of the status table)."""
+
     def limited(self) -> bool:
         """Count a received message; True (and counted as rate-limited) when ``max_rate``
         drops it. Called first for every message, before decoding or converting."""

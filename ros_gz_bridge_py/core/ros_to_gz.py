@@ -73,6 +73,7 @@ class RosToGzChannel(Channel):
         self._subscription: Any = None
         self._subscription_node: Any = None
         self._announced = False
+        self._dropped = 0  # by the native loop: no memory to copy a message for Python
         self.loop_guard = False
 
     @property
@@ -142,6 +143,7 @@ class RosToGzChannel(Channel):
             max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
             refused=self._convert_and_publish,
             counted=self._counted,
+            lost=self._lost,
             failed=self._native_failed,
             own_publishers=own.rcl_publishers,
             watch_own_publishers=own.watch_rcl_publishers,
@@ -163,6 +165,15 @@ class RosToGzChannel(Channel):
         if published and not self._announced:
             self._announce()
 
+    def _lost(self, count: int) -> None:
+        """Messages the native loop could not copy for the Python path (no memory, on its
+        thread): among the channel's drops, and said."""
+        self._dropped += count
+        self._logger.warning(
+            f"{self.describe()}: {count} message(s) dropped: no memory to copy them for the "
+            "Python path"
+        )
+
     def _native_failed(self, reason: str) -> None:
         """The native loop took the channel off: said, and kept as the channel's last error."""
         self.stats.last_error = reason
@@ -175,6 +186,10 @@ class RosToGzChannel(Channel):
         if self._subscription is not None:
             self._subscription_node.destroy_subscription(self._subscription)
             self._subscription = None
+
+    @property
+    def dropped(self) -> int:
+        return self._dropped
 
     @property
     def qos(self) -> QoSProfile:

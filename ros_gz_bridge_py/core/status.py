@@ -212,7 +212,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
         received=stats.received,
         published=stats.published,
         errors=stats.errors,
-        dropped=channel.dropped if isinstance(channel, GzToRosChannel) else 0,
+        dropped=channel.dropped,
         rate=0.0,
         new_problems=0,
         last_error=stats.last_error,

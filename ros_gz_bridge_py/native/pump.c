@@ -677,17 +677,20 @@ static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     Py_RETURN_NONE;
 }
 
-/* take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused,
- * [(2, sender, type, items, least, payload_size)] too large: what the loop left to Python
- * since the last call. */
 static Py_ssize_t size_ssize(size_t n) {
     return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n;
 }
 
+/* take_handed() -> [(0, frames)] unrouted, [(1, sender, type, payload, status)] refused,
+ * [(2, sender, type, items, least, payload_size)] too large: what the loop left to Python
+ * since the last call. A message whose Python copy cannot be made (no memory) is counted as
+ * lost, as in hand_frames, and the others are still handed; when the list itself cannot
+ * grow, what it would have held is lost and MemoryError raised. */
 static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
     (void)unused;
     if (usable(self, 1) < 0) return NULL;
     PyObject *handed = PyList_New(0);
+    if (handed == NULL) self->lost += self->nhanded;
     for (size_t i = 0; handed != NULL && i < self->nhanded; i++) {
         struct handed *h = &self->handover[i];
         PyObject *item;
@@ -711,8 +714,16 @@ static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
                                  (char *)r->type, (Py_ssize_t)r->type_len, (char *)h->data[0],
                                  (Py_ssize_t)h->size[0], h->status);
         }
-        if (item == NULL || PyList_Append(handed, item) < 0) Py_CLEAR(handed);
-        Py_XDECREF(item);
+        if (item == NULL) {
+            PyErr_Clear();
+            self->lost++;
+            continue;
+        }
+        if (PyList_Append(handed, item) < 0) {
+            self->lost += self->nhanded - i + (size_t)PyList_GET_SIZE(handed);
+            Py_CLEAR(handed);
+        }
+        Py_DECREF(item);
     }
     clear_handover(self);
     return handed;

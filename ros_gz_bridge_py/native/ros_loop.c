@@ -356,15 +356,31 @@ static PyObject *ros_loop_run(RosLoopObject *self, PyObject *arg) {
     PyObject *moved = PyList_New(0);
     for (int i = 0; moved != NULL && i < self->nmoved; i++) {
         RosPumpObject *pump = self->slots[self->moved[i]];
-        PyObject *refused = PyList_New((Py_ssize_t)pump->nrefused);
+        /* A message whose bytes object cannot be made (no memory) is counted as lost and the
+         * others still go; where a list cannot grow, the messages it would carry are counted
+         * as lost and MemoryError is raised. */
+        PyObject *refused = PyList_New(0);
+        if (refused == NULL) pump->lost += pump->nrefused;
         for (size_t k = 0; refused != NULL && k < pump->nrefused; k++) {
             PyObject *cdr = PyBytes_FromStringAndSize((char *)pump->refused[k],
                                                       (Py_ssize_t)pump->refused_len[k]);
-            if (cdr == NULL) Py_CLEAR(refused);
-            else PyList_SET_ITEM(refused, (Py_ssize_t)k, cdr);
+            if (cdr == NULL) {
+                PyErr_Clear();
+                pump->lost++;
+                continue;
+            }
+            if (PyList_Append(refused, cdr) < 0) {
+                pump->lost += pump->nrefused - k + (size_t)PyList_GET_SIZE(refused);
+                Py_CLEAR(refused);
+            }
+            Py_DECREF(cdr);
         }
+        size_t carried = refused == NULL ? 0 : (size_t)PyList_GET_SIZE(refused);
         PyObject *item = refused == NULL ? NULL : Py_BuildValue("(ONi)", pump, refused, pump->failure);
-        if (item == NULL || PyList_Append(moved, item) < 0) Py_CLEAR(moved);
+        if (item == NULL || PyList_Append(moved, item) < 0) {
+            pump->lost += carried;
+            Py_CLEAR(moved);
+        }
         Py_XDECREF(item);
         ros_pump_clear_refused(pump);
         pump->moved = 0;

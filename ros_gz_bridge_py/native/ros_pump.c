@@ -57,6 +57,8 @@ static int is_ignored(const RosPumpObject *self, const rmw_gid *gid) {
     return 0;
 }
 
+/* Hands a message to Python as a copy. When memory runs out it is counted as lost instead
+ * (never handed over empty: an empty payload would be sent as an all-default message). */
 static void refuse(RosPumpObject *self, const uint8_t *cdr, size_t len) {
     if (self->nrefused == self->refused_cap) {
         size_t cap = self->refused_cap ? self->refused_cap * 2 : 16;
@@ -64,11 +66,17 @@ static void refuse(RosPumpObject *self, const uint8_t *cdr, size_t len) {
         if (grown != NULL) self->refused = grown;
         size_t *grown_len = realloc(self->refused_len, cap * sizeof *grown_len);
         if (grown_len != NULL) self->refused_len = grown_len;
-        if (grown == NULL || grown_len == NULL) return;
+        if (grown == NULL || grown_len == NULL) {
+            self->lost++;
+            return;
+        }
         self->refused_cap = cap;
     }
     uint8_t *copy = malloc(len ? len : 1);
-    if (copy == NULL) return;
+    if (copy == NULL) {
+        self->lost++;
+        return;
+    }
     if (len) memcpy(copy, cdr, len);
     self->refused[self->nrefused] = copy;
     self->refused_len[self->nrefused++] = len;
@@ -368,8 +376,8 @@ static PyObject *ros_pump_ignore(RosPumpObject *self, PyObject *publishers) {
 static PyObject *ros_pump_counts(RosPumpObject *self, PyObject *unused) {
     (void)unused;
     if (!initialised(self)) return NULL;
-    return Py_BuildValue("(KKKKKK)", self->received, self->own_skipped, self->rate_limited,
-                         self->published, self->take_errors, self->send_failures);
+    return Py_BuildValue("(KKKKKKK)", self->received, self->own_skipped, self->rate_limited,
+                         self->published, self->take_errors, self->send_failures, self->lost);
 }
 
 static PyMethodDef ros_pump_methods[] = {
@@ -378,7 +386,7 @@ static PyMethodDef ros_pump_methods[] = {
     {"ignore", (PyCFunction)ros_pump_ignore, METH_O,
      "ignore(publishers) -> count: skip samples of these rcl publishers (by GID)"},
     {"counts", (PyCFunction)ros_pump_counts, METH_NOARGS,
-     "(received, own_skipped, rate_limited, published, take_errors, send_failures) so far"},
+     "(received, own_skipped, rate_limited, published, take_errors, send_failures, lost) so far"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -80,6 +80,7 @@ typedef struct {
     int64_t period_ns, next_ns;
     unsigned long long received, own_skipped, rate_limited, published, take_errors,
         send_failures;
+    unsigned long long lost; /* messages for Python that could not be copied (no memory) */
     uint8_t **refused;
     size_t *refused_len;
     size_t nrefused, refused_cap;

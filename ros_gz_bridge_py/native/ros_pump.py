@@ -78,12 +78,13 @@ class RosChannelPump:
 
     ``refused(cdr)``: the channel's Python path for one admitted message;
     ``counted(received, own_skipped, rate_limited, published, send_failures)``: what the loop
-    did since it last said; ``failed(reason)``: the channel's socket failed and the loop took
-    the channel off (nothing more is taken); ``own_publishers()``: the rcl publishers of the
-    bridge on the topic, and ``watch_own_publishers(changed)`` calls ``changed()`` when they
-    change (it returns the function that stops it). The publisher's ``watch_wire_types`` does
-    the same for the spellings. Every callback runs on the loop's thread. Closing the
-    publisher (or its node) first takes the channel off the loop.
+    did since it last said; ``lost(count)``: messages for the Python path that could not be
+    copied (no memory) since it last said; ``failed(reason)``: the channel's socket failed
+    and the loop took the channel off (nothing more is taken); ``own_publishers()``: the rcl
+    publishers of the bridge on the topic, and ``watch_own_publishers(changed)`` calls
+    ``changed()`` when they change (it returns the function that stops it). The publisher's
+    ``watch_wire_types`` does the same for the spellings. Every callback runs on the loop's
+    thread. Closing the publisher (or its node) first takes the channel off the loop.
     """
 
     def __init__(
@@ -95,6 +96,7 @@ class RosChannelPump:
         max_rate: float,
         refused: Callable[[bytes], None],
         counted: Callable[[int, int, int, int, int], None],
+        lost: Callable[[int], None],
         failed: Callable[[str], None],
         own_publishers: Callable[[], frozenset[int]],
         watch_own_publishers: Callable[[Callable[[], None]], Callable[[], None]],
@@ -117,9 +119,10 @@ class RosChannelPump:
         )
         self._refused = refused
         self._counted = counted
+        self._lost = lost
         self._failed = failed
         self._own_publishers = own_publishers
-        self._seen = (0, 0, 0, 0, 0)
+        self._seen = (0, 0, 0, 0, 0, 0)
         self._active: frozenset[str] | None = None
         self._ignored: frozenset[int] | None = None
         self._closed = False
@@ -180,14 +183,16 @@ class RosChannelPump:
         the failure of its socket (an errno of libzmq, 0 if none)."""
         for cdr in refused:
             self._refused(cdr)
-        received, own_skipped, rate_limited, published, _take_errors, send_failures = (
+        received, own_skipped, rate_limited, published, _take_errors, send_failures, lost = (
             self.pump.counts()
         )
-        now = (received, own_skipped, rate_limited, published, send_failures)
+        now = (received, own_skipped, rate_limited, published, send_failures, lost)
         before, self._seen = self._seen, now
-        deltas = tuple(a - b for a, b in zip(now, before, strict=True))
+        *deltas, lost_now = (a - b for a, b in zip(now, before, strict=True))
         if any(deltas):
             self._counted(*deltas)
+        if lost_now:
+            self._lost(lost_now)
         self.sync()  # a channel that moved has subscribers: a cheap safety net for them
         if failure:
             self._failed(

@@ -22,9 +22,11 @@ import yaml
 from google.protobuf import text_format
 
 from ros_gz_bridge_py.msgs import message_class
-from tests.gzpeer import ROOT, PeerProcess, peer_binary
+from tests.gzpeer import PeerProcess, peer_binary
 
-PARAMETER_BRIDGE = ROOT / ".venv" / "bin" / "parameter_bridge"
+#: The console script of the venv running the tests (``pip install -e .`` put it next to the
+#: interpreter; a worktree or a copy of the checkout has no ``.venv`` of its own).
+PARAMETER_BRIDGE = Path(sys.prefix) / "bin" / "parameter_bridge"
 CHECKER = Path(__file__).resolve().parent / "e2e_ros_checker.py"
 #: Upper bound for one run to see every expected message (2 shared cores, many processes).
 RUN_TIMEOUT = 60.0

@@ -25,7 +25,7 @@ from tests.bridge.behaviour_harness import WAIT, RosSide, ros_side
 from tests.bridge.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
 from tests.bridge.image_frames import rgb_frame
 from tests.bridge.test_zenoh_e2e import GAZEBO_SIDE, HERE
-from tests.gzpeer import ROOT, PeerProcess, unique_name, wait_for_line
+from tests.gzpeer import PeerProcess, unique_name, wait_for_line
 from tests.loopback import free_port, zenoh_env
 
 __all__ = ["ros_side"]
@@ -33,7 +33,7 @@ __all__ = ["ros_side"]
 pytestmark = [pytest.mark.ros]
 
 SERVICE_SIDE = HERE / "e2e_zenoh_extras.py"
-IMAGE_BRIDGE = ROOT / ".venv" / "bin" / "image_bridge"
+IMAGE_BRIDGE = PARAMETER_BRIDGE.with_name("image_bridge")
 #: Lifetime of the Gazebo-side processes (they are stopped at test end well before).
 GAZEBO_SECONDS = "60"
 WIDTH, HEIGHT = 8, 6

@@ -40,6 +40,7 @@ from tests.core.harness import (
     RosWorld,
     gz_to_ros,
     publish_until,
+    ros_to_gz,
     settled,
     unique,
     wait_until,
@@ -226,6 +227,21 @@ def test_queue_drops_are_counted(make_rig: Any) -> None:
     assert (status.received, status.dropped, status.errors) == (1 + MIN_DELIVERY_QUEUE, extra, 0)
     assert (status.new_problems, status.level) == (extra, WARN)
     assert status.message() == f"{extra} errors/drops in the last period"
+
+
+def test_ros_messages_the_native_loop_could_not_copy_are_drops(rig: Rig) -> None:
+    """ROS -> Gazebo, the native loop counts the messages it had no memory to copy for the
+    Python path (tests/unit/native/test_failed_copy.py) and tells the channel, whose DROPPED
+    shows them (it showed 0 for every ROS -> Gazebo channel)."""
+    channel = ros_to_gz(rig.add(string_spec(unique("status_lost"), Direction.ROS_TO_GZ)))
+    clock = FakeClock()
+    tracker = StatusTracker(rig.bridge, now=clock)
+    tracker.snapshot()
+    channel._lost(3)  # what RosChannelPump.turn calls with the loop's count
+    clock.advance(1.0)
+    status = tracker.snapshot()[0]
+    assert (status.direction, status.dropped, status.errors) == ("ROS->GZ", 3, 0)
+    assert (status.new_problems, status.level) == (3, WARN)
 
 
 def test_diagnostic_array_carries_one_status_per_channel(rig: Rig) -> None:

@@ -213,7 +213,7 @@ def test_a_terminated_context_takes_the_channel_off_and_the_loop_goes_on(
     doomed.publish("into a terminated context")
     moved = run_until(loop, lambda m: any(p is doomed.pump and f for p, _r, f in m), "failure")
     assert [f for p, _r, f in moved if p is doomed.pump][-1] == zmq.ETERM
-    received, _own, _rate, published, _take, send_failures = doomed.pump.counts()
+    received, _own, _rate, published, _take, send_failures, _lost = doomed.pump.counts()
     assert (received, published, send_failures) == (1, 0, 1)
     doomed.publish("after the failure")  # not taken: the loop does not wake for it
     other.publish("still carried")
@@ -252,7 +252,7 @@ def test_a_frame_refused_mid_message_is_not_published_and_leaves_no_part(
         channel.publish(f"message {index}")
     moved = run_until(loop, lambda m: any(f for _p, _r, f in m), "the failure")
     assert [f for _p, _r, f in moved if f] == [errno.EAGAIN]
-    received, _own, _rate, published, _take, send_failures = channel.pump.counts()
+    received, _own, _rate, published, _take, send_failures, _lost = channel.pump.counts()
     assert (published, send_failures) == (1, 1)
     assert received == 2  # the channel took nothing after its socket was left uncertain
     assert all(flags & zmq.DONTWAIT for flags in calls)

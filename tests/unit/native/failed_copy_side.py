@@ -1,0 +1,108 @@
+"""Run by test_failed_copy.py with the failing-allocation shim preloaded: a pump on a loop
+(test_pump_loop's rig: real ZeroMQ sockets, a real rclpy publisher) is sent payloads while the
+allocations of ``argv[2]`` bytes fail; ``argv[3]`` is the payload size. ``argv[1]`` says what is
+sent: ``copy``, a payload on each of the two ways a payload goes to Python, each followed by one
+a byte longer; ``grow``, one String the program takes, whose output needs a larger buffer.
+Prints, as JSON, what Python was handed, the pump's counts, the MemoryErrors raised and the
+shim's failures."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from typing import Any
+
+from ros_gz_bridge_py.native import extension
+from tests.unit.native.failing_alloc import fail_size, failures
+from tests.unit.native.test_pump_loop import LEGIT, TOPIC, TYPE, Rig
+
+#: A sender the pump has no route for: its frames are handed to Python to judge.
+UNKNOWN = b"unknown-sender"
+COUNTS = ("received", "rate_limited", "published", "dropped", "skipped", "lost")
+
+
+def string_msg(size: int, fill: bytes) -> bytes:
+    """A StringMsg of exactly ``size`` bytes (data, field 2, with a 3-byte length) of
+    ``fill`` repeated; with b"\\xff" (not UTF-8) the program finds it undecodable and hands it
+    to Python, which says why."""
+    length = size - 4
+    assert 1 << 14 <= length < 1 << 21, "the length must take 3 bytes"
+    varint = bytes([length & 0x7F | 0x80, length >> 7 & 0x7F | 0x80, length >> 14])
+    return b"\x12" + varint + fill * length
+
+
+def outcome(rig: Rig, sent: int) -> dict[str, Any]:
+    """Runs the loop until each of the ``sent`` messages was published, handed to Python or
+    counted as lost (10 s at most), keeping what was handed and the MemoryErrors of
+    ``take_handed``."""
+    before = rig.pump.counts()
+    handed: list[dict[str, Any]] = []
+    memory_errors = 0
+    deadline = time.monotonic() + 10
+    counts = dict.fromkeys(COUNTS, 0)
+    while len(handed) + counts["lost"] + counts["published"] < sent and (
+        time.monotonic() < deadline
+    ):
+        _woken, reported = rig.loop.run(100, [])
+        for _pump, _events in reported:
+            try:
+                items = rig.pump.take_handed()
+            except MemoryError:
+                memory_errors += 1
+                continue
+            for item in items:
+                if item[0] == 0:
+                    topic, sender, payload, msg_type = item[1]
+                    assert (topic, msg_type) == (TOPIC, TYPE)
+                    status = None
+                else:
+                    _kind, sender, _type, payload, status = item
+                size = None if payload is None else len(payload)  # None: "y#" of NULL
+                handed.append(
+                    {"kind": item[0], "sender": sender.decode(), "size": size, "status": status}
+                )
+        now = rig.pump.counts()
+        counts = {name: b - a for name, a, b in zip(COUNTS, before, now, strict=True)}
+    return {"handed": handed, "counts": counts, "memory_errors": memory_errors}
+
+
+def main() -> None:
+    import rclpy  # noqa: PLC0415 - only in this process
+    from rclpy.context import Context  # noqa: PLC0415
+    from rclpy.node import Node  # noqa: PLC0415
+    from std_msgs.msg import String  # noqa: PLC0415
+
+    mode, failing, size = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+    native = extension()
+    assert native is not None
+    context = Context()
+    rclpy.init(context=context)
+    node = Node("failed_copy_side", context=context)
+    rig = Rig(native, node.create_publisher(String, "/failed_copy_side", 10), capacity=10,
+              max_bytes=1 << 26)  # fmt: skip
+    try:
+        rig.connected()  # LEGIT's route is known from here on
+        rig.settle()
+        if mode == "copy":
+            for payload_size in (size, size + 1):
+                rig.send(UNKNOWN, string_msg(payload_size, b"u"))  # unrouted: frames to Python
+                rig.send(LEGIT, string_msg(payload_size, b"\xff"))  # routed, refused: payload
+        else:
+            rig.send(LEGIT, string_msg(size, b"a"))
+        failures_before = failures()
+        fail_size(failing)
+        try:
+            report = outcome(rig, 4 if mode == "copy" else 1)
+        finally:
+            fail_size(0)
+        report["failures"] = failures() - failures_before
+        json.dump(report, sys.stdout)
+    finally:
+        rig.close()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
+if __name__ == "__main__":
+    main()
