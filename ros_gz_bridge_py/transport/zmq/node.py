@@ -52,6 +52,7 @@ from ros_gz_bridge_py.transport.zmq.discovery import (
     SubscriberRemoved,
 )
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
+from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
 from ros_gz_bridge_py.transport.zmq.intake import DataIntake
 from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader, receive_message
 from ros_gz_bridge_py.transport.zmq.routes import DataRouter
@@ -209,14 +210,20 @@ class ZmqGzNode(GzNode):
     # --- topics -----------------------------------------------------------------------------
 
     def _open_publisher(
-        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False, queue_bytes: int = 0
     ) -> Publisher:
         """Announce ``topic`` under each spelling; re-announced every second (§2.5). With
         ``own_socket``, from a PUB socket of the publisher's own, at its own address (a record
-        names the address subscribers connect to, §2.8.1)."""
-        sock = (
-            publisher_socket(self._io.context, self._io.host, self.settings) if own_socket else None
-        )
+        names the address subscribers connect to, §2.8.1); with ``queue_bytes`` too, and that
+        socket's SNDHWM set for it before the socket is bound (§2.8.8)."""
+        sock = None
+        if own_socket or queue_bytes > 0:
+            sndhwm = (
+                hwm_for_bytes(self.settings.max_message_size, queue_bytes, self.settings.sndhwm)
+                if queue_bytes > 0
+                else self.settings.sndhwm
+            )
+            sock = publisher_socket(self._io.context, self._io.host, self.settings, sndhwm)
         address = self.pub_address if sock is None else self._io.address(sock)
         nodes = (self.node_uuid, self.respelled_node_uuid)
         records = tuple(
