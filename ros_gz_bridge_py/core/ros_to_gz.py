@@ -191,6 +191,11 @@ class RosToGzChannel(Channel):
         """True while some remote Gazebo subscriber takes this channel's messages."""
         return self._gz_publisher is not None and bool(self._gz_publisher.wire_types())
 
+    @property
+    def send_queue(self) -> int:
+        """Messages queued at most for each Gazebo subscriber (0: none, or not open)."""
+        return self._gz_publisher.send_queue() if self._gz_publisher is not None else 0
+
     def _output_has_subscribers(self) -> bool:
         return self._gz_publisher is not None and self._gz_publisher.has_connections()
 

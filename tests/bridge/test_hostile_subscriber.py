@@ -64,13 +64,16 @@ class OutboundBridge:
         self.publisher = ros_side.run(lambda: ros_side.node.create_publisher(Image, self.topic, 10))
         self._entities.append(self.publisher)
 
-    def published(self) -> int:
-        """The channel's published count in the newest /diagnostics (0 before one)."""
+    def values(self) -> dict[str, str]:
+        """The channel's key-values in the newest /diagnostics ({} before one)."""
         for message, _ in reversed(self.diagnostics.items()):
             for status in message.status:
                 if (status.name, status.hardware_id) == self._status:
-                    return int({kv.key: kv.value for kv in status.values}["published"])
-        return 0
+                    return {kv.key: kv.value for kv in status.values}
+        return {}
+
+    def published(self) -> int:
+        return int(self.values().get("published", "0"))
 
     def close(self) -> None:
         for entity in self._entities:
@@ -146,3 +149,4 @@ def test_a_subscriber_that_never_reads_costs_about_two_images(
     assert sent >= COUNT // 2, "the bridge published most of the images"
     assert received >= sent // 2, "the healthy subscriber kept receiving"
     assert highest - start < 100 * MB
+    assert outbound.values()["send_queue"] == "2"  # 64 MiB over 128 MiB, on /diagnostics

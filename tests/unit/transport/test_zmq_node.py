@@ -384,7 +384,8 @@ def test_a_publisher_of_large_messages_has_a_send_queue_sized_in_bytes(
     sock = pub.sock  # type: ignore[attr-defined]
     assert sock is not None
     assert (
-        sock.getsockopt(zmq.SNDHWM)
+        pub.send_queue()
+        == sock.getsockopt(zmq.SNDHWM)
         == hwm_for_bytes(a.settings.max_message_size, budget, a.settings.sndhwm)
         == 8
     )
@@ -392,4 +393,6 @@ def test_a_publisher_of_large_messages_has_a_send_queue_sized_in_bytes(
     assert wait_until(pub.has_connections)
     assert publish_until(lambda: pub.publish(StringMsg(data="image")), lambda: bool(got))
     assert set(got) == {"image"}
-    assert a.advertise(unique("small"), "gz.msgs.StringMsg").sock is None  # type: ignore[attr-defined]
+    small = a.advertise(unique("small"), "gz.msgs.StringMsg")
+    assert small.sock is None  # type: ignore[attr-defined]
+    assert small.send_queue() == a.settings.sndhwm
