@@ -16,18 +16,21 @@ import threading
 import time
 import uuid
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import zmq
 
+from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket
 from ros_gz_bridge_py.transport.zmq.wire import (
     DiscoveryMessage,
     DiscoveryType,
     MessagePublisher,
     PublisherRecord,
+    decode_discovery,
     encode_discovery,
 )
 
@@ -137,6 +140,89 @@ class RoguePublisher:
 
     def close(self) -> None:
         self.peer.go_silent()
+        self.context.destroy(linger=0)
+
+
+class RogueSubscriber:
+    """A raw SUB socket that subscribes to ``fqn`` through valid discovery (SUBSCRIBE, then a
+    NEW_CONNECTION for each publisher of ``msg_type`` it hears advertised, and heartbeats) and
+    never reads. Its own queue holds one message (RCVHWM 1, a 4 kB kernel buffer), so what the
+    publisher sends past that stays queued in the publisher, as behind a slow or hostile peer.
+    Everything runs on its thread, which stops with :meth:`close` (or after :data:`MAX_LIFE`).
+    """
+
+    def __init__(self, fqn: str, msg_type: str) -> None:
+        self.fqn = fqn
+        self.msg_type = msg_type
+        self.process_uuid = str(uuid.uuid4())
+        self.node_uuid = str(uuid.uuid4())
+        self._settings = TransportSettings.from_env()
+        self.context = zmq.Context()
+        self.sub = self.context.socket(zmq.SUB)
+        self.sub.setsockopt(zmq.LINGER, 0)
+        self.sub.setsockopt(zmq.RCVHWM, 1)
+        self.sub.setsockopt(zmq.RCVBUF, 4096)
+        self.sub.setsockopt(zmq.SUBSCRIBE, fqn.encode())
+        self._listen = DiscoverySocket(
+            self._settings.multicast_ip, self._settings.msg_port, self._settings.ip or "127.0.0.1"
+        )
+        self._sock = discovery_socket()
+        #: The publisher addresses it connected to.
+        self.connected: list[str] = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="rogue-sub", daemon=True)
+        self._thread.start()
+
+    def _send(self, message: DiscoveryMessage) -> None:
+        data = encode_discovery(message)
+        self._sock.sendto(data, (self._settings.multicast_ip, self._settings.msg_port))
+
+    def _run(self) -> None:
+        end = time.monotonic() + MAX_LIFE
+        next_beat = 0.0
+        while not self._stop.is_set() and (now := time.monotonic()) < end:
+            if now >= next_beat:
+                self._send(DiscoveryMessage(DiscoveryType.HEARTBEAT, self.process_uuid))
+                if not self.connected:
+                    self._send(
+                        DiscoveryMessage(DiscoveryType.SUBSCRIBE, self.process_uuid, topic=self.fqn)
+                    )
+                next_beat = now + 1.0
+            received = self._listen.receive()
+            if received is None:
+                self._stop.wait(0.01)
+                continue
+            try:
+                message = decode_discovery(received[0])
+            except RemoteProtocolError:
+                continue  # not ours to judge
+            pub = message.pub
+            if (
+                message.type == DiscoveryType.ADVERTISE
+                and pub is not None
+                and pub.msg is not None
+                and pub.topic == self.fqn
+                and pub.msg_type == self.msg_type
+                and pub.address not in self.connected
+            ):
+                self.sub.connect(pub.address)
+                self.connected.append(pub.address)
+                mine = replace(
+                    pub,
+                    process_uuid=self.process_uuid,
+                    node_uuid=self.node_uuid,
+                    msg=replace(pub.msg, ctrl=pub.process_uuid),
+                )
+                self._send(
+                    DiscoveryMessage(DiscoveryType.NEW_CONNECTION, self.process_uuid, pub=mine)
+                )
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join()
+        self._send(DiscoveryMessage(DiscoveryType.BYE, self.process_uuid))
+        self._listen.close()
+        self._sock.close()
         self.context.destroy(linger=0)
 
 

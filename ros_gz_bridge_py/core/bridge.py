@@ -272,7 +272,12 @@ class Bridge:
             raise UnsupportedTypeError(msg, spec.source or None) from None
         try:
             service = ServiceBridge(
-                self._side_node(), self.gz_node, spec, pair, self.options.service_timeout
+                self._side_node(),
+                self.gz_node,
+                spec,
+                pair,
+                self.options.service_timeout,
+                max_queued_bytes=self.options.max_queued_bytes,
             )
         except ConfigError:
             raise

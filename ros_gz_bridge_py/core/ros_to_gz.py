@@ -96,8 +96,15 @@ class RosToGzChannel(Channel):
         return f"[{ros_topic} ({spec.ros_type}) -> {spec.gz_topic} ({spec.gz_type})]"
 
     def _open_output(self) -> None:
+        """The Gazebo publisher; for a pair of large messages (a bulk pair: images, point
+        clouds) with a send queue per subscriber of ``max_queued_bytes`` (docs/protocol.md
+        §2.8.8), so a Gazebo subscriber that stops reading costs the bridge that much."""
+        large = self.pair.bulk is not None
         self._gz_publisher = self.ctx.gz_node.advertise(
-            self.spec.gz_topic, self.spec.gz_type, own_socket=self._native_loop
+            self.spec.gz_topic,
+            self.spec.gz_type,
+            own_socket=self._native_loop,
+            queue_bytes=self.ctx.options.max_queued_bytes if large else 0,
         )
 
     def _close_output(self) -> None:
@@ -198,6 +205,11 @@ class RosToGzChannel(Channel):
     def gazebo_subscribed(self) -> bool:
         """True while some remote Gazebo subscriber takes this channel's messages."""
         return self._gz_publisher is not None and bool(self._gz_publisher.wire_types())
+
+    @property
+    def send_queue(self) -> int:
+        """Messages queued at most for each Gazebo subscriber (0: none, or not open)."""
+        return self._gz_publisher.send_queue() if self._gz_publisher is not None else 0
 
     def _output_has_subscribers(self) -> bool:
         return self._gz_publisher is not None and self._gz_publisher.has_connections()

@@ -5,15 +5,19 @@ executor in its own thread. Each call is a coroutine: it converts the request, s
 Gazebo asynchronously, and awaits the reply or the timeout without holding a thread, so any
 number of calls can wait at once; it returns exactly one response: the converted reply, or
 ``success=False`` when Gazebo reports failure, does not answer in time, the request cannot be
-converted, or :data:`MAX_WAITING` calls already wait (answered at once, never dropped). The
-server keeps :data:`REQUEST_DEPTH` requests, so a burst of clients is not overwritten before it
-is taken. The C++ bridge can answer twice, never answers when Gazebo is absent, and holds a
-thread per waiting call. Keeping calls off the main executor means a slow or absent Gazebo
-service never delays topic traffic (the EventsExecutor also cannot run coroutine callbacks).
+converted, or :data:`MAX_WAITING` calls, or ``max_queued_bytes`` of them, already wait
+(answered at once, never dropped). The bytes are the requests sent to Gazebo and the replies
+that came back but are not converted yet (:class:`HeldBytes`); a reply that would take them
+past the budget is not kept, and its call is answered ``success=False``. The server keeps
+:data:`REQUEST_DEPTH` requests, so a burst of clients is not overwritten before it is taken.
+The C++ bridge can answer twice, never answers when Gazebo is absent, and holds a thread per
+waiting call. Keeping calls off the main executor means a slow or absent Gazebo service never
+delays topic traffic (the EventsExecutor also cannot run coroutine callbacks).
 """
 
 from __future__ import annotations
 
+import threading
 from typing import Any
 
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -27,6 +31,8 @@ from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.ros.side_node import SideNode
 from ros_gz_bridge_py.transport import GzNode
+from ros_gz_bridge_py.transport.delivery import DROP_WARN_PERIOD, MAX_QUEUED_BYTES
+from ros_gz_bridge_py.transport.throttle import Throttle
 
 DEFAULT_TIMEOUT = 5.0
 #: Requests the ROS service server keeps before they are taken (rclpy's default is 10, and a
@@ -34,6 +40,42 @@ DEFAULT_TIMEOUT = 5.0
 REQUEST_DEPTH = 1000
 #: Calls that may wait for Gazebo at once; one more is answered ``success=false`` at once.
 MAX_WAITING = 1000
+
+
+class HeldBytes:
+    """The bytes a service bridge's waiting calls hold, within a budget (any thread): a
+    request is admitted when it fits, or when no call waits (one call is always let through,
+    as a queue always keeps one message); a reply is kept when it fits, or when its call is
+    the only one waiting."""
+
+    def __init__(self, budget: int) -> None:
+        self.budget = budget
+        self.held = 0
+        self.calls = 0
+        self._lock = threading.Lock()
+
+    def admit(self, size: int) -> bool:
+        """Hold ``size`` bytes of a new call's request; False (nothing held) when over."""
+        with self._lock:
+            if self.calls and self.held + size > self.budget:
+                return False
+            self.calls += 1
+            self.held += size
+            return True
+
+    def keep(self, size: int) -> bool:
+        """Hold ``size`` bytes of a waiting call's reply; False (nothing held) when over."""
+        with self._lock:
+            if self.calls > 1 and self.held + size > self.budget:
+                return False
+            self.held += size
+            return True
+
+    def release(self, size: int) -> None:
+        """A call is answered: its ``size`` bytes (request and kept reply) go."""
+        with self._lock:
+            self.calls -= 1
+            self.held -= size
 
 
 def resolve_gz_types(spec: ServiceBridgeSpec, pair: ServicePair) -> tuple[str, str]:
@@ -74,6 +116,8 @@ class ServiceBridge:
         spec: ServiceBridgeSpec,
         pair: ServicePair,
         timeout: float = DEFAULT_TIMEOUT,
+        *,
+        max_queued_bytes: int = MAX_QUEUED_BYTES,
     ) -> None:
         self.spec = spec
         self.pair = pair
@@ -87,6 +131,11 @@ class ServiceBridge:
         self.calls = 0
         self.failures = 0
         self.waiting = 0
+        #: The bytes the waiting calls hold, within ``max_queued_bytes``.
+        self.held = HeldBytes(max_queued_bytes)
+        #: Calls answered at once because the waiting ones held the budget.
+        self.refused_over_bytes = 0
+        self._refusals = Throttle(DROP_WARN_PERIOD)
         self._service = host.node.create_service(
             pair.ros_class,
             spec.service,
@@ -135,25 +184,56 @@ class ServiceBridge:
             payload = self.pair.request_to_gz(request).SerializeToString()
         except Exception as err:
             return self._fail(f"request not converted: {err}")
+        if not self.held.admit(len(payload)):
+            return self._refuse(len(payload))
         self.waiting += 1
+        held = [len(payload)]
         try:
-            return await self._forward(payload)
+            return await self._forward(payload, held)
         except Exception as err:
             return self._fail(f"request failed: {err}")
         finally:
             self.waiting -= 1
+            self.held.release(sum(held))
 
-    async def _forward(self, payload: bytes) -> Any:
+    def _refuse(self, size: int) -> Any:
+        """A call over the byte budget: answered at once, counted, told once per period."""
+        self.failures += 1
+        self.refused_over_bytes += 1
+        if self._refusals.ready():
+            self._logger.warning(
+                f"{self.describe()}: a request of {size} bytes refused (success=false): "
+                f"{self.held.calls} calls holding {self.held.held} bytes already wait for "
+                f"Gazebo, at most {self.held.budget} bytes (parameter max_queued_bytes); "
+                f"{self.refused_over_bytes} refused so far"
+            )
+        return self.pair.failure_to_ros()
+
+    async def _forward(self, payload: bytes, held: list[int]) -> Any:
+        """Send ``payload`` and await the reply; ``held`` gets the bytes of a kept reply."""
         future = self._host.future()
+        dropped: list[int] = []
 
         def on_reply(ok: bool | None, reply: bytes) -> None:
-            if not future.done():
-                future.set_result((ok, reply))
+            if future.done():
+                return
+            if ok and not self.held.keep(len(reply)):
+                dropped.append(len(reply))  # not kept: only its size waits for the executor
+                future.set_result((None, b""))
+                return
+            held.append(len(reply))
+            future.set_result((ok, reply))
 
         self._gz_node.request_async(
             self.spec.service, payload, self.gz_req_type, self.gz_rep_type, self.timeout, on_reply
         )
         success, reply = await future
+        if dropped:
+            return self._fail(
+                f"the reply of {dropped[0]} bytes is not kept: with the {self.held.calls} "
+                f"waiting calls' {self.held.held} bytes it is over {self.held.budget} bytes "
+                "(parameter max_queued_bytes)"
+            )
         if success is None:
             return self._fail(f"no reply from Gazebo within {self.timeout:g} s")
         if not success:

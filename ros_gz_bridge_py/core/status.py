@@ -40,6 +40,7 @@ from rclpy.clock import Clock, ClockType
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.channel import Channel, ChannelState
 from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
+from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.ros.runtime import (
     batch_dds_event_threads,
@@ -94,6 +95,8 @@ class ChannelStatus:
     conversion_errors: int = 0
     #: Whether the channel's messages take the native data plane (docs/native.md).
     native: bool = False
+    #: ROS->GZ: messages queued at most for each Gazebo subscriber (0: none kept).
+    send_queue: int = 0
 
     @property
     def path(self) -> str:
@@ -154,6 +157,7 @@ class ChannelStatus:
             "flow": self.flow,
             "why": self.why,
             "path": self.path,
+            **({"send_queue": str(self.send_queue)} if self.send_queue else {}),
         }
 
 
@@ -225,6 +229,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
         ),
         conversion_errors=stats.conversion_errors,
         native=channel.native,
+        send_queue=channel.send_queue if isinstance(channel, RosToGzChannel) else 0,
     )
 
 

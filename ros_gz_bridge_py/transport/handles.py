@@ -81,6 +81,11 @@ class Publisher:
         """True if a remote subscriber or a local subscription would receive a message."""
         return not self.closed and self._node.has_connections(self)
 
+    def send_queue(self) -> int:
+        """Messages the backend queues at most for each remote subscriber (ZeroMQ's SNDHWM);
+        0 where it keeps no such queue."""
+        return 0
+
     def before_close(self, stop: Callable[[], None]) -> Callable[[], None]:
         """Call ``stop()`` before the publisher's socket goes (its :meth:`close`, or its
         node's), e.g. to stop a native loop that sends on it; returns the function that

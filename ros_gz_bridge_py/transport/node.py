@@ -121,19 +121,27 @@ class GzNode(ServiceEnds, GraphView):
 
     # --- topics -----------------------------------------------------------------------------
 
-    def advertise(self, topic: str, msg_type: str, *, own_socket: bool = False) -> Publisher:
+    def advertise(
+        self, topic: str, msg_type: str, *, own_socket: bool = False, queue_bytes: int = 0
+    ) -> Publisher:
         """Advertise ``topic`` under the spellings of ``msg_type``.
 
         ``own_socket``: where the backend can (ZeroMQ), the publisher sends from a socket of its
         own, announced at its own address, instead of the node's shared one; then it must be
         published from one thread at a time (a native loop's, ``native/ros_pump.py``).
+        ``queue_bytes`` (above 0), for a publisher of large messages: where the backend queues
+        messages for each remote subscriber by count (ZeroMQ), the publisher sends from a
+        socket of its own whose queue holds only as many of the largest messages the transport
+        carries as fit in ``queue_bytes`` (``zmq/hwm.py``; docs/protocol.md §2.8.8).
 
         Raises:
             LocalProtocolError: the name is not a valid Gazebo topic.
             TransportError: the node is closed.
         """
         self._check_open()
-        return self._open_publisher(topic, self.fqn(topic), msg_type, own_socket=own_socket)
+        return self._open_publisher(
+            topic, self.fqn(topic), msg_type, own_socket=own_socket, queue_bytes=queue_bytes
+        )
 
     def unadvertise(self, publisher: Publisher) -> None:
         """Withdraw ``publisher`` (called by its ``close``)."""
@@ -312,7 +320,7 @@ class GzNode(ServiceEnds, GraphView):
 
     @abc.abstractmethod
     def _open_publisher(
-        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False, queue_bytes: int = 0
     ) -> Publisher:
         """Create and announce a publisher (a :class:`Publisher`, or a subclass)."""
 

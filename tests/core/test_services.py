@@ -16,6 +16,7 @@ import pytest
 from ros_gz_interfaces.srv import ControlWorld, SetEntityPose
 
 from ros_gz_bridge_py.config import ServiceBridgeSpec
+from ros_gz_bridge_py.core.services import HeldBytes
 from ros_gz_bridge_py.core.status import StatusTracker
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import Spelling, respell
@@ -194,3 +195,48 @@ def test_each_call_is_answered_exactly_once(rig: Rig, world: RosWorld) -> None:
     (status,) = StatusTracker(rig.bridge).snapshot()
     assert (status.direction, status.ros_name) == ("service", service)
     assert (status.received, status.published, status.errors) == (3, 1, 2)
+
+
+def test_calls_past_max_queued_bytes_are_answered_at_once(
+    make_rig: Callable[..., Rig], world: RosWorld
+) -> None:
+    """A bridge whose waiting calls may hold 2.5 MB takes five calls of 1 MB each for a
+    provider that never answers: two wait for Gazebo (its timeout), the other three are
+    answered ``success=false`` while those two still wait, and counted (before, all five
+    waited, holding 5 MB)."""
+    rig = make_rig(options(service_timeout=WAIT, max_queued_bytes=2_500_000))
+    service = unique("held_bytes")
+    rig.add(ServiceBridgeSpec(service, "ros_gz_interfaces/srv/SetEntityPose"))
+    bridge = rig.bridge.services[0]
+    request = SetEntityPose.Request()
+    request.entity.name = "x" * 1_000_000
+    client = world.run(lambda: world.node.create_client(SetEntityPose, service))
+    try:
+        wait_until(client.service_is_ready, f"the service {service}")
+        futures = [world.run(lambda: client.call_async(request)) for _ in range(5)]
+        wait_until(lambda: sum(f.done() for f in futures) == 3, "three calls answered at once")
+        assert bridge.waiting == 2
+        assert [f.result().success for f in futures if f.done()] == [False] * 3
+        assert (bridge.refused_over_bytes, bridge.held.calls) == (3, 2)
+        assert bridge.held.held > 2_000_000
+    finally:
+        world.destroy(client)
+    assert bridge.failures == 3
+
+
+def test_held_bytes_always_lets_one_call_through() -> None:
+    """The budget of a service bridge's waiting calls (core/services.py): requests and kept
+    replies count until their call is answered; one call alone passes whatever its size."""
+    held = HeldBytes(1000)
+    assert held.admit(5000)  # alone: let through
+    assert not held.admit(1)  # over the budget while it waits
+    assert held.keep(3000)  # its own reply, alone: kept
+    held.release(8000)
+    assert (held.calls, held.held) == (0, 0)
+    assert held.admit(400)
+    assert held.admit(500)
+    assert not held.keep(200)  # a reply past the budget with another call waiting
+    assert held.keep(100)
+    held.release(500)
+    held.release(500)
+    assert (held.calls, held.held) == (0, 0)

@@ -135,9 +135,9 @@ class MemoryGzNode(GzNode):
     # --- topics -----------------------------------------------------------------------------
 
     def _open_publisher(
-        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False, queue_bytes: int = 0
     ) -> Publisher:
-        """``own_socket`` changes nothing here (a ZeroMQ notion)."""
+        """``own_socket`` and ``queue_bytes`` change nothing here (ZeroMQ notions)."""
         publisher = MemoryPublisher(self, topic, fqn, msg_type)
         publisher.announcements = tuple(
             Announcement(fqn, name, self, self.address) for name in publisher.names

@@ -174,10 +174,11 @@ class ZenohGzNode(GzNode):
     # --- topics -----------------------------------------------------------------------------
 
     def _open_publisher(
-        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False, queue_bytes: int = 0
     ) -> Publisher:
         """A Zenoh publisher on the FQN (remote destinations only) and its MP token;
-        ``own_socket`` changes nothing here (a ZeroMQ notion)."""
+        ``own_socket`` and ``queue_bytes`` change nothing here (ZeroMQ notions; Zenoh's
+        publishers drop what the network cannot take, docs/protocol.md §4.2)."""
         publisher = ZenohPublisher(self, topic, fqn, msg_type)
         token = message_token(
             fqn, self.process_uuid, self.node_uuid, EntityKind.PUBLISHER, canonical_type(msg_type)

@@ -31,16 +31,22 @@ class ZmqPublisher(Publisher):
         records: tuple[PublisherRecord, ...],
         *,
         sock: Any = None,
+        send_queue: int = 0,
     ) -> None:
         super().__init__(node, topic, fqn, msg_type)
         self.records = records
         #: Its own PUB socket, or None (the node's).
         self.sock = sock
+        self._send_queue = send_queue
         #: The data frames with an empty payload per spelling, encoded once (§2.8.2).
         self.wire_frames: dict[str, list[Frame]] = {
             record.msg_type: encode_data(record.topic, record.address, b"", record.msg_type)
             for record in records
         }
+
+    def send_queue(self) -> int:
+        """The SNDHWM of its socket, set when the socket was made (docs/protocol.md §2.8.8)."""
+        return self._send_queue
 
 
 class ZmqSubscription(Subscription):

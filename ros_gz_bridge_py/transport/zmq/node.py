@@ -39,7 +39,7 @@ from ros_gz_bridge_py.transport.api import (
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.node import GzNode
-from ros_gz_bridge_py.transport.settings import TransportSettings
+from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, TransportSettings
 from ros_gz_bridge_py.transport.zmq import graph
 from ros_gz_bridge_py.transport.zmq.discovery import (
     INIT_DELAY,
@@ -52,6 +52,7 @@ from ros_gz_bridge_py.transport.zmq.discovery import (
     SubscriberRemoved,
 )
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
+from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
 from ros_gz_bridge_py.transport.zmq.intake import DataIntake
 from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader, receive_message
 from ros_gz_bridge_py.transport.zmq.routes import DataRouter
@@ -209,14 +210,18 @@ class ZmqGzNode(GzNode):
     # --- topics -----------------------------------------------------------------------------
 
     def _open_publisher(
-        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False
+        self, topic: str, fqn: str, msg_type: str, *, own_socket: bool = False, queue_bytes: int = 0
     ) -> Publisher:
         """Announce ``topic`` under each spelling; re-announced every second (§2.5). With
         ``own_socket``, from a PUB socket of the publisher's own, at its own address (a record
-        names the address subscribers connect to, §2.8.1)."""
-        sock = (
-            publisher_socket(self._io.context, self._io.host, self.settings) if own_socket else None
-        )
+        names the address subscribers connect to, §2.8.1); with ``queue_bytes`` too, and that
+        socket's SNDHWM set for it before the socket is bound (§2.8.8)."""
+        sock = None
+        sndhwm = self.settings.sndhwm
+        if queue_bytes > 0:
+            sndhwm = hwm_for_bytes(self.settings.max_message_size, queue_bytes, sndhwm)
+        if own_socket or queue_bytes > 0:
+            sock = publisher_socket(self._io.context, self._io.host, self.settings, sndhwm)
         address = self.pub_address if sock is None else self._io.address(sock)
         nodes = (self.node_uuid, self.respelled_node_uuid)
         records = tuple(
@@ -225,7 +230,9 @@ class ZmqGzNode(GzNode):
             )
             for name, node in zip(self.names_of(msg_type), nodes, strict=False)
         )
-        publisher = ZmqPublisher(self, topic, fqn, msg_type, records, sock=sock)
+        publisher = ZmqPublisher(
+            self, topic, fqn, msg_type, records, sock=sock, send_queue=sndhwm or DEFAULT_HWM
+        )
         if sock is not None:
             self._own_socket_publishers.add(publisher)
 

@@ -89,7 +89,7 @@ def open_sockets(
             context=context,
             msg_udp=opened[0],
             srv_udp=opened[1],
-            pub=publisher_socket(context, host, settings),
+            pub=publisher_socket(context, host, settings, settings.sndhwm),
             sub=subscriber_socket(context, settings),
             replier=_bound(context, host, zmq.ROUTER, routing_id=replier_id, mandatory=True),
             requester=_socket(context, zmq.ROUTER, mandatory=True),
@@ -134,13 +134,16 @@ def subscriber_socket(context: Any, settings: TransportSettings, rcvhwm: int | N
     return sock
 
 
-def publisher_socket(context: Any, host: str, settings: TransportSettings) -> Any:
-    """A PUB socket bound on ``host``: a PLAIN server in ZAP domain ``gz-auth`` with
-    credentials (§2.8.6); the ZAP handler (``auth.py``) must be bound before, or libzmq lets
-    everyone in. The node's own, and that of each publisher with a socket of its own."""
+def publisher_socket(context: Any, host: str, settings: TransportSettings, sndhwm: int) -> Any:
+    """A PUB socket bound on ``host`` with SNDHWM ``sndhwm`` (0: libzmq's default): a PLAIN
+    server in ZAP domain ``gz-auth`` with credentials (§2.8.6); the ZAP handler (``auth.py``)
+    must be bound before, or libzmq lets everyone in. The node's own, and that of each
+    publisher with a socket of its own. The mark is set before the bind and never after: the
+    pipe of each subscriber takes it when it connects, and libzmq 4.3.5 mishandles a mark
+    changed on a live socket (§2.8.8)."""
     sock = _socket(context, zmq.PUB)
-    if settings.sndhwm:
-        sock.setsockopt(zmq.SNDHWM, settings.sndhwm)
+    if sndhwm:
+        sock.setsockopt(zmq.SNDHWM, sndhwm)
     if settings.credentials is not None:
         sock.setsockopt(zmq.ZAP_DOMAIN, ZAP_DOMAIN.encode())
         sock.setsockopt(zmq.PLAIN_SERVER, 1)

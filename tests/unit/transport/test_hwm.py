@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from ros_gz_bridge_py.transport.zmq.hwm import MIN_HWM, hwm_for_bytes
+from ros_gz_bridge_py.transport.zmq.hwm import MAX_HWM, MIN_HWM, hwm_for_bytes
 
 MIB = 1024 * 1024
 
@@ -21,6 +21,7 @@ MIB = 1024 * 1024
         (6 * MIB, 64 * MIB, 1, 1),  # the floor never raises a configured count
         (6 * MIB, 64 * MIB, 0, 10),  # 0 (no count limit): the bytes alone
         (0, 64 * MIB, 0, 0),  # 0 and nothing sent: still no count limit
+        (1, 2**40, 0, MAX_HWM),  # no count limit, tiny messages: libzmq's largest mark
     ],
 )
 def test_hwm_for_bytes(largest: int, budget: int, configured: int, expected: int) -> None:

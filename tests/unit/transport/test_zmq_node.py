@@ -9,6 +9,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
+import zmq
 
 from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
@@ -364,3 +365,34 @@ def test_close_leaves_no_threads_and_is_idempotent() -> None:
     assert set(threading.enumerate()) <= before
     with pytest.raises(TransportError):
         node.advertise("/late", GENERIC_TYPE)
+
+
+def test_a_publisher_of_large_messages_has_a_send_queue_sized_in_bytes(
+    nodes: tuple[ZmqGzNode, ZmqGzNode],
+) -> None:
+    """``queue_bytes``: the publisher sends from a socket of its own, at its own address, whose
+    SNDHWM (set before the bind, docs/protocol.md §2.8.8) holds ``queue_bytes`` of the largest
+    messages the transport carries; messages reach a subscriber as from any publisher."""
+    from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes  # noqa: PLC0415
+
+    a, b = nodes
+    topic = unique("large")
+    got: list[str] = []
+    b.subscribe_typed(topic, StringMsg, lambda m, _: got.append(m.data))
+    budget = 8 * a.settings.max_message_size
+    pub = a.advertise(topic, "gz.msgs.StringMsg", queue_bytes=budget)
+    sock = pub.sock  # type: ignore[attr-defined]
+    assert sock is not None
+    assert (
+        pub.send_queue()
+        == sock.getsockopt(zmq.SNDHWM)
+        == hwm_for_bytes(a.settings.max_message_size, budget, a.settings.sndhwm)
+        == 8
+    )
+    assert pub.records[0].address != a.pub_address  # type: ignore[attr-defined]
+    assert wait_until(pub.has_connections)
+    assert publish_until(lambda: pub.publish(StringMsg(data="image")), lambda: bool(got))
+    assert set(got) == {"image"}
+    small = a.advertise(unique("small"), "gz.msgs.StringMsg")
+    assert small.sock is None  # type: ignore[attr-defined]
+    assert small.send_queue() == a.settings.sndhwm
