@@ -426,7 +426,8 @@ def main(argv: list[str] | None = None) -> int:
         for loop in loops:
             loop.kill()
             loop.wait()
-    command = "python -m benchmarks.attacks" + (" " + " ".join(argv) if argv else "")
+    given = sys.argv[1:] if argv is None else argv
+    command = " ".join(["python -m benchmarks.attacks", *given])
     write_section(args.report, report(runs, args.seconds, args.after, command, args.load))
     print(f"wrote {args.report}")
     return 0
