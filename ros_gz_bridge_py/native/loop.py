@@ -96,7 +96,12 @@ class SharedLoop:
 
     def attach(self, member: LoopMember, sock: int, monitor: int, handle: Any) -> None:
         """Run ``member`` on the ZeroMQ socket ``sock`` with its connection ``monitor`` (socket
-        addresses); ``handle`` (the rclpy publisher's, a context manager) is held while it runs."""
+        addresses); ``handle`` (the rclpy publisher's, a context manager) is held while it runs.
+        On the loop's thread (a reader that replaced its socket in its turn) it is done at once,
+        so that a close posted meanwhile from another thread comes after it."""
+        if threading.current_thread() is self._thread:
+            self._guarded(lambda: self._add(member, sock, monitor, handle))
+            return
         self._post(lambda: self._add(member, sock, monitor, handle))
 
     def detach(self, member: LoopMember) -> None:
