@@ -33,6 +33,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -416,15 +417,19 @@ def main(argv: list[str] | None = None) -> int:
         "--load", type=int, default=0, help="busy loops beside the bridge (its own section)"
     )
     args = parser.parse_args(argv)
+    # each in a process group of its own, killed whole (timeout and yes): they stop by
+    # themselves after 15 minutes if this process dies first
     loops = [
-        subprocess.Popen(["timeout", "900", "yes"], stdout=subprocess.DEVNULL)
+        subprocess.Popen(
+            ["timeout", "900", "yes"], stdout=subprocess.DEVNULL, start_new_session=True
+        )
         for _ in range(args.load)
     ]
     try:
         runs = _run_all(args)
     finally:
         for loop in loops:
-            loop.kill()
+            os.killpg(loop.pid, signal.SIGKILL)
             loop.wait()
     given = sys.argv[1:] if argv is None else argv
     command = " ".join(["python -m benchmarks.attacks", *given])
