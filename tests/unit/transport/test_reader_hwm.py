@@ -22,7 +22,7 @@ from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader
 FQN = "@/reader_hwm@/big"
 TYPE = b"gz.msgs.StringMsg"
 SENDER = b"tcp://127.0.0.1:1"
-LIMIT = 1_000_000
+LIMIT = 10_000_000
 
 
 def _received(sub: Any, timeout: float) -> int:
@@ -133,12 +133,16 @@ def test_the_reader_lowers_its_rcvhwm_and_still_hears_the_publisher(
     first = reader._sock
     big = b"x" * 300_000
     _send_until(pub, big, delivered)
-    assert _rcvhwm(reader) == hwm_for_bytes(len(big), LIMIT, settings.rcvhwm) == 3
+    # room for twice the payload: 10 MB / 600 kB
+    assert _rcvhwm(reader) == hwm_for_bytes(2 * len(big), LIMIT, settings.rcvhwm) == 16
     assert reader._sock is not first  # a new socket, never a lowered HWM on open connections
     _send_until(pub, b"after", delivered)  # the connection made anew carries on
-    bigger = b"y" * 600_000
-    _send_until(pub, bigger, delivered)
+    second = reader._sock
+    _send_until(pub, b"y" * 600_000, delivered)  # within the room: the same socket
+    assert reader._sock is second
+    _send_until(pub, b"z" * 2_000_000, delivered)
     assert _rcvhwm(reader) == 2  # as low as it goes: no more watching
+    assert reader._sock is not second
     _send_until(pub, b"last", delivered)
 
 
