@@ -377,14 +377,13 @@ class SubscriptionReader:
     def _payload_grew(self, size: int) -> None:
         """A payload of ``size`` bytes would make libzmq's queue in front of ours (RCVHWM
         messages of any size per connection) hold more than ``max_bytes``: the HWM is lowered
-        to fit payloads of up to :data:`GROWTH_ROOM` times that size (``hwm.py``) on a new socket, connected where the old one was, which replaces
-        it: libzmq applies an HWM set on a socket to its open connections too, which then
-        stall for good, or crash it while a connection closes (docs/protocol.md, "Memory
-        during a flood"). What the old socket holds is read first (one batch more); what is
-        still on its way in its connections is lost, once per lowering. On the socket's
-        thread."""
-        # room for payloads twice as large: a topic whose messages grow by little steps
-        # changes socket a few times (at most one per doubling), not at each step
+        to fit payloads of up to :data:`GROWTH_ROOM` times that size (``hwm.py``; a topic
+        whose messages grow by small steps changes socket once per doubling, not at each step)
+        on a new socket, connected where the old one was, which replaces it: libzmq applies
+        an HWM set on a socket to its open connections too, which then stall for good, or
+        crash it while a connection closes (docs/protocol.md, "The receive queue in bytes").
+        What the old socket holds is read first (one batch more); what is still on its way
+        in its connections is lost, once per lowering. On the socket's thread."""
         hwm = hwm_for_bytes(GROWTH_ROOM * size, self._max_bytes, self._configured_hwm)
         if 0 < self._hwm <= hwm:
             self._watch = self._watch_size()
