@@ -15,7 +15,7 @@ import uuid
 from typing import Any
 
 from ros_gz_bridge_py.native import extension
-from tests.unit.native.failing_alloc import fail_size, failures
+from tests.unit.native.failing_alloc import while_failing
 from tests.unit.native.test_ros_loop import WAIT, Channel
 
 COUNTS = ("received", "own_skipped", "rate_limited", "published", "take_errors",
@@ -73,13 +73,7 @@ def main() -> None:
         assert before[3] == 1, before
         channel.publisher.publish(string_cdr(size, b"\xff"))
         channel.publisher.publish(string_cdr(size + 4, b"\xff"))
-        failures_before = failures()
-        fail_size(failing, spared)
-        try:
-            report = outcome(loop, channel, before)
-        finally:
-            fail_size(0)
-        report["failures"] = failures() - failures_before
+        report = while_failing(failing, lambda: outcome(loop, channel, before), spared)
         json.dump(report, sys.stdout)
     finally:
         channel.close()

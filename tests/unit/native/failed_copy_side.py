@@ -14,7 +14,7 @@ import time
 from typing import Any
 
 from ros_gz_bridge_py.native import extension
-from tests.unit.native.failing_alloc import fail_size, failures
+from tests.unit.native.failing_alloc import while_failing
 from tests.unit.native.test_pump_loop import LEGIT, TOPIC, TYPE, Rig
 
 #: A sender the pump has no route for: its frames are handed to Python to judge.
@@ -90,14 +90,8 @@ def main() -> None:
                 rig.send(LEGIT, string_msg(payload_size, b"\xff"))  # routed, refused: payload
         else:
             rig.send(LEGIT, string_msg(size, b"a"))
-        failures_before = failures()
-        fail_size(failing)
-        try:
-            report = outcome(rig, 4 if mode == "copy" else 1)
-        finally:
-            fail_size(0)
-        report["failures"] = failures() - failures_before
-        json.dump(report, sys.stdout)
+        sent = 4 if mode == "copy" else 1
+        json.dump(while_failing(failing, lambda: outcome(rig, sent)), sys.stdout)
     finally:
         rig.close()
         node.destroy_node()

@@ -9,7 +9,9 @@ import hashlib
 import os
 import shutil
 import subprocess
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -51,3 +53,17 @@ def fail_size(size: int, spared: int = 0) -> None:
 def failures() -> int:
     """In a process the shim is preloaded into: the allocations it made fail so far."""
     return int(ctypes.c_ulong.in_dll(ctypes.CDLL(None), "failing_alloc_failures").value)
+
+
+def while_failing(size: int, run: Callable[[], dict[str, Any]], spared: int = 0) -> dict[str, Any]:
+    """In a process the shim is preloaded into: ``run()``'s report, made while allocations of
+    ``size`` bytes fail (but the first ``spared``), with the failures the shim made meanwhile
+    (``"failures"``)."""
+    before = failures()
+    fail_size(size, spared)
+    try:
+        report = run()
+    finally:
+        fail_size(0)
+    report["failures"] = failures() - before
+    return report

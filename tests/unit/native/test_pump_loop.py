@@ -7,7 +7,6 @@ back) is done here by the test.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -82,18 +81,6 @@ class Rig:
         self.pub.close(linger=0)
         self.sub.close(linger=0)
         self.context.term()
-
-
-@pytest.fixture
-def publisher(ros_context: Any) -> Iterator[Any]:
-    from rclpy.node import Node  # noqa: PLC0415 - rclpy only for the tests that ask
-    from std_msgs.msg import String  # noqa: PLC0415
-
-    node = Node("pump_loop_test", context=ros_context)
-    try:
-        yield node.create_publisher(String, "/pump_loop_test", 10)
-    finally:
-        node.destroy_node()
 
 
 def test_a_sender_that_changes_every_message_leaves_the_others_routes_alone(

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -83,18 +82,6 @@ def _settled(channels: list[Channel]) -> list[int]:
             return now
         assert time.monotonic() < deadline, "the channels never came to rest"
         asked = now
-
-
-@pytest.fixture
-def publisher(ros_context: Any) -> Iterator[Any]:
-    from rclpy.node import Node  # noqa: PLC0415 - rclpy only for the tests that ask
-    from std_msgs.msg import String  # noqa: PLC0415
-
-    node = Node("shared_loop_counts_test", context=ros_context)
-    try:
-        yield node.create_publisher(String, "/shared_loop_counts_test", 10)
-    finally:
-        node.destroy_node()
 
 
 def test_only_channels_that_read_are_counted_and_a_burst_is_trimmed(
