@@ -386,17 +386,16 @@ class SubscriptionReader:
         in its connections is lost, once per lowering. On the socket's thread."""
         hwm = hwm_for_bytes(GROWTH_ROOM * size, self._max_bytes, self._configured_hwm)
         if 0 < self._hwm <= hwm:
-            self._watch = self._watch_size()
-        else:
-            self._hwm = hwm
-            self._watch = self._watch_size()
-            self._replace_socket()
-            _LOG.info(
-                "%s: a payload of %d bytes: its receive queue now holds %d messages per "
-                "publisher (parameter max_queued_bytes, %d bytes); connected anew to %d "
-                "publisher(s)",
-                self.fqn, size, hwm, self._max_bytes, len(self._connections.connected),
-            )  # fmt: skip
+            return  # as low already (a size the native pump told before the last lowering)
+        self._hwm = hwm
+        self._watch = self._watch_size()
+        self._replace_socket()
+        _LOG.info(
+            "%s: a payload of %d bytes: its receive queue now holds %d messages per "
+            "publisher (parameter max_queued_bytes, %d bytes); connected anew to %d "
+            "publisher(s)",
+            self.fqn, size, hwm, self._max_bytes, len(self._connections.connected),
+        )  # fmt: skip
         if self._native is not None:
             self._native.watch(self._watch)
 
