@@ -15,9 +15,10 @@ NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/encode.c",
     "ros_gz_bridge_py/native/loop.c",
     "ros_gz_bridge_py/native/pump.c",
-    "ros_gz_bridge_py/native/ros_loop.c",
+    "ros_gz_bridge_py/native/pump_loop.c",
     "ros_gz_bridge_py/native/ros_pump.c",
     "ros_gz_bridge_py/native/transcode.c",
+    "ros_gz_bridge_py/native/transcoders.c",
 ]
 
 setup(
@@ -26,9 +27,8 @@ setup(
             "ros_gz_bridge_py.native._native",
             sources=NATIVE_SOURCES,
             depends=[
+                "ros_gz_bridge_py/native/_native.h",
                 "ros_gz_bridge_py/native/encode.h",
-                "ros_gz_bridge_py/native/pump.h",
-                "ros_gz_bridge_py/native/ros_pump.h",
                 "ros_gz_bridge_py/native/transcode.h",
                 "ros_gz_bridge_py/native/wire.h",
             ],

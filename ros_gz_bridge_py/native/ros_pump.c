@@ -1,38 +1,105 @@
-/* One native ROS -> Gazebo channel (docs/native.md §7).
+/* RosPump: one native ROS -> Gazebo channel (docs/native.md §7), run by its direction's Loop
+ * (loop.c) through the hooks below, with the GIL released.
  *
- * Driven by the process's shared loop (ros_loop.c) with the GIL released: rcl tells of new
- * messages through the subscription's on-new-message callback (an eventfd), each message is
- * taken serialized from the rclpy subscription's rcl handle, skipped when one of the bridge's
- * own publishers on the topic wrote it (by publisher GID, as the C++ bridge does), passed
- * through max_rate, encoded (encode.c) in each spelling Gazebo subscribers take and sent as the
- * four data frames on the channel's own ZeroMQ PUB socket. No Python runs per message; what an
- * encoder leaves to Python is handed back, and Python converts it as without the native path.
- * rcl, rmw, rcutils and libzmq functions come from the libraries rclpy and pyzmq loaded
- * (ros_pump.py). */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
+ * rcl tells of new messages through the subscription's on-new-message callback (an eventfd,
+ * the descriptor the loop sleeps on); a turn takes each message serialized from the rclpy
+ * subscription's rcl handle, skips it when one of the bridge's own publishers on the topic
+ * wrote it (by publisher GID, as the C++ bridge does), passes it through max_rate, encodes it
+ * (encode.c) in each spelling Gazebo subscribers take and sends it as the four data frames on
+ * the channel's own ZeroMQ PUB socket. No Python runs per message; what an encoder leaves to
+ * Python is handed back (take_handed), and Python converts it as without the native path. rcl,
+ * rmw, rcutils and libzmq functions come from the libraries rclpy and pyzmq loaded (abi.py). */
+#include "_native.h"
 
 #include <errno.h>
-#include <stdint.h>
 #include <string.h>
 #include <sys/eventfd.h>
-#include <time.h>
 #include <unistd.h>
 
-#include "encode.h"
-#include "pump.h"
-#include "ros_pump.h"
+/* rcutils_allocator_t, rcl_serialized_message_t, rmw_gid_t and rmw_message_info_t as Jazzy's
+ * headers lay them out (abi.py checks the loaded rclpy). */
+typedef struct {
+    void *(*allocate)(size_t size, void *state);
+    void (*deallocate)(void *pointer, void *state);
+    void *(*reallocate)(void *pointer, size_t size, void *state);
+    void *(*zero_allocate)(size_t count, size_t size, void *state);
+    void *state;
+} rcu_allocator;
+
+typedef struct {
+    uint8_t *buffer;
+    size_t buffer_length;
+    size_t buffer_capacity;
+    rcu_allocator allocator;
+} rcl_bytes;
+
+#define GID_SIZE 16
+typedef struct {
+    const char *implementation_identifier;
+    uint8_t data[GID_SIZE];
+} rmw_gid;
+
+typedef struct {
+    int64_t source_timestamp;
+    int64_t received_timestamp;
+    uint64_t publication_sequence_number;
+    uint64_t reception_sequence_number;
+    rmw_gid publisher_gid;
+    _Bool from_intra_process;
+} rmw_info;
+
+typedef void (*event_callback)(const void *user_data, size_t number_of_events);
+
+struct ros_foreign {
+    int (*take)(const void *subscription, rcl_bytes *message, rmw_info *info, void *allocation);
+    int (*set_callback)(const void *subscription, event_callback callback, const void *user_data);
+    void (*reset_error)(void);
+    rcu_allocator (*default_allocator)(void);
+    void *(*publisher_rmw_handle)(const void *publisher);
+    int (*gid_for_publisher)(const void *rmw_publisher, rmw_gid *gid);
+    int (*send)(void *socket, const void *buffer, size_t length, int flags);
+};
+_Static_assert(sizeof(struct ros_foreign) == 7 * sizeof(void *), "the functions, in order");
 
 enum { RCL_TAKE_FAILED = 401, ZMQ_SNDMORE_ = 2, ZMQ_DONTWAIT_ = 1 };
 #define INITIAL_CAPACITY 4096
 /* Retries of a frame send that a signal interrupted. */
 #define EINTR_RETRIES 8
+#define MAX_SPELLINGS 4
+#define MAX_IGNORED 16
 
-static int64_t monotonic_ns(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
+struct spelling {
+    uint8_t *type, *topic, *sender;
+    size_t type_len, topic_len, sender_len;
+    struct rgb_encoder *encoder;
+    int active;
+};
+
+typedef struct {
+    PyObject_HEAD
+    struct rgb_member member;
+    struct ros_foreign f;
+    void *subscription;
+    void *sock;
+    int event_fd; /* written by rcl's on-new-message callback */
+    int callback_set;
+    PyObject *encoders; /* list: keeps the Encoder objects alive; set by the first __init__ */
+    struct spelling spellings[MAX_SPELLINGS];
+    int nspellings;
+    rcl_bytes message;
+    struct rgb_out out[MAX_SPELLINGS];
+    uint8_t ignored[MAX_IGNORED][GID_SIZE];
+    int nignored;
+    int64_t period_ns, next_ns;
+    unsigned long long received, own_skipped, rate_limited, published, take_errors,
+        send_failures, bytes_read;
+    unsigned long long lost; /* messages for Python that could not be copied (no memory) */
+    uint8_t **refused;
+    size_t *refused_len;
+    size_t nrefused, refused_cap;
+    /* Set when the channel's socket or eventfd failed (an errno): it takes nothing more. */
+    int failure;
+} RosPumpObject;
 
 /* rcl's on-new-message callback, on a middleware thread: wake the loop. */
 static void on_new_message(const void *user_data, size_t number_of_events) {
@@ -44,7 +111,7 @@ static void on_new_message(const void *user_data, size_t number_of_events) {
 
 static int admit(RosPumpObject *self) {
     if (self->period_ns <= 0) return 1;
-    int64_t now = monotonic_ns();
+    int64_t now = rgb_now_ns(CLOCK_MONOTONIC);
     if (self->next_ns != INT64_MIN && now < self->next_ns) return 0;
     int on_time = self->next_ns != INT64_MIN && now - self->next_ns < self->period_ns;
     self->next_ns = on_time ? self->next_ns + self->period_ns : now + self->period_ns;
@@ -72,14 +139,18 @@ static void refuse(RosPumpObject *self, const uint8_t *cdr, size_t len) {
         }
         self->refused_cap = cap;
     }
-    uint8_t *copy = malloc(len ? len : 1);
+    uint8_t *copy = rgb_copy(cdr, len);
     if (copy == NULL) {
         self->lost++;
         return;
     }
-    if (len) memcpy(copy, cdr, len);
     self->refused[self->nrefused] = copy;
     self->refused_len[self->nrefused++] = len;
+}
+
+static void clear_refused(RosPumpObject *self) {
+    for (size_t i = 0; i < self->nrefused; i++) free(self->refused[i]);
+    self->nrefused = 0;
 }
 
 /* One frame; 0, or libzmq's errno. An interrupted send is tried again: PUB with ZMQ_DONTWAIT
@@ -148,9 +219,52 @@ static void deliver(RosPumpObject *self, const uint8_t *cdr, size_t len) {
     if (sent_all && !self->failure) self->published++;
 }
 
-int ros_pump_drain(RosPumpObject *self, int budget) {
+/* ---- the hooks (loop.c) -------------------------------------------------------------------- */
+
+static int descriptors(struct rgb_member *m, int fds[RGB_MAX_FDS], const char **why) {
+    (void)why;
+    fds[0] = RGB_OWNER(RosPumpObject, m)->event_fd;
+    return 1;
+}
+
+static int attach(struct rgb_member *m, const char **why) {
+    RosPumpObject *self = RGB_OWNER(RosPumpObject, m);
+    if (self->f.set_callback(self->subscription, on_new_message, self) != 0) {
+        self->f.reset_error();
+        *why = "rcl refused the on-new-message callback";
+        return -1;
+    }
+    self->callback_set = 1;
+    self->failure = 0;
+    return 0;
+}
+
+static void clear_callback(RosPumpObject *self) {
+    if (self->callback_set) {
+        self->f.set_callback(self->subscription, NULL, NULL);
+        self->f.reset_error();
+        self->callback_set = 0;
+    }
+}
+
+static void detach(struct rgb_member *m) {
+    RosPumpObject *self = RGB_OWNER(RosPumpObject, m);
+    clear_callback(self);
+    clear_refused(self);
+}
+
+/* Takes and handles waiting messages within the budget; an eventfd or a socket that failed
+ * takes the channel off (RGB_EVENT_BROKEN: the loop sleeps on it no more). */
+static int turn(struct rgb_member *m, unsigned fired, const struct rgb_budget *budget) {
+    RosPumpObject *self = RGB_OWNER(RosPumpObject, m);
+    uint64_t count;
+    if (fired & RGB_FIRED_ERROR)
+        self->failure = EBADF;
+    else if ((fired & 1) && read(self->event_fd, &count, sizeof count) < 0 && errno != EAGAIN)
+        self->failure = errno;
     int taken = 0;
-    while (taken < budget && !self->failure) {
+    int64_t slice_end = rgb_now_ns(CLOCK_MONOTONIC) + budget->slice_ns;
+    while (taken < budget->messages && !self->failure) {
         rmw_info info;
         memset(&info, 0, sizeof info);
         self->message.buffer_length = 0;
@@ -163,59 +277,43 @@ int ros_pump_drain(RosPumpObject *self, int budget) {
         }
         taken++;
         self->received++;
+        self->bytes_read += self->message.buffer_length;
         if (is_ignored(self, &info.publisher_gid)) {
             self->own_skipped++;
-            continue;
-        }
-        if (!admit(self)) {
+        } else if (!admit(self)) {
             self->rate_limited++;
-            continue;
+        } else {
+            deliver(self, self->message.buffer, self->message.buffer_length);
         }
-        deliver(self, self->message.buffer, self->message.buffer_length);
+        if (rgb_now_ns(CLOCK_MONOTONIC) >= slice_end) {
+            taken = budget->messages; /* more may wait: again at once */
+            break;
+        }
     }
-    return taken;
+    int events = self->nrefused ? RGB_EVENT_HANDED : 0;
+    if (self->failure) return events | RGB_EVENT_BROKEN;
+    return events | (taken == budget->messages ? RGB_AGAIN : 0);
 }
 
-int ros_pump_set_callback(RosPumpObject *self) {
-    if (self->callback_set) return 0;
-    if (self->f.set_callback(self->subscription, on_new_message, self) != 0) {
-        self->f.reset_error();
-        return -1;
-    }
-    self->callback_set = 1;
-    return 0;
+static unsigned long long progress(const struct rgb_member *m) {
+    return RGB_OWNER(RosPumpObject, m)->received;
 }
 
-void ros_pump_clear_callback(RosPumpObject *self) {
-    if (self->callback_set) {
-        self->f.set_callback(self->subscription, NULL, NULL);
-        self->f.reset_error();
-        self->callback_set = 0;
-    }
-}
+static const struct rgb_hooks hooks = {descriptors, attach, detach, turn, progress};
 
-void ros_pump_clear_refused(RosPumpObject *self) {
-    for (size_t i = 0; i < self->nrefused; i++) free(self->refused[i]);
-    self->nrefused = 0;
-}
-
-/* ---- Python ------------------------------------------------------------------------------------ */
-
-static PyTypeObject RosPumpType;
-
-int ros_pump_check(PyObject *object) {
-    return PyObject_TypeCheck(object, &RosPumpType) && ((RosPumpObject *)object)->ready;
-}
+/* ---- Python -------------------------------------------------------------------------------- */
 
 /* Every method first: an object made by __new__ alone has no functions to call. */
-static int initialised(RosPumpObject *self) {
-    if (self->ready) return 1;
-    PyErr_SetString(PyExc_RuntimeError, "the RosPump is not initialised (call __init__)");
-    return 0;
+static int usable(RosPumpObject *self, int idle) {
+    if (self->member.hooks == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "the RosPump is not initialised (call __init__)");
+        return -1;
+    }
+    return idle ? rgb_member_idle(&self->member, "RosPump") : 0;
 }
 
 static void ros_pump_dealloc(RosPumpObject *self) {
-    if (self->ready) ros_pump_clear_callback(self);
+    clear_callback(self);
     if (self->event_fd >= 0) close(self->event_fd);
     if (self->message.buffer != NULL)
         self->message.allocator.deallocate(self->message.buffer, self->message.allocator.state);
@@ -225,7 +323,7 @@ static void ros_pump_dealloc(RosPumpObject *self) {
         free(self->spellings[i].sender);
     }
     for (int i = 0; i < MAX_SPELLINGS; i++) rgb_out_free(&self->out[i]);
-    ros_pump_clear_refused(self);
+    clear_refused(self);
     free(self->refused);
     free(self->refused_len);
     Py_XDECREF(self->encoders);
@@ -234,21 +332,15 @@ static void ros_pump_dealloc(RosPumpObject *self) {
 
 static PyObject *ros_pump_new(PyTypeObject *type, PyObject *args, PyObject *kwds) {
     RosPumpObject *self = (RosPumpObject *)type->tp_alloc(type, 0);
-    if (self != NULL) {
-        self->event_fd = -1;
-        self->slot = -1;
-    }
+    if (self != NULL) self->event_fd = -1;
     (void)args;
     (void)kwds;
     return (PyObject *)self;
 }
 
 static uint8_t *copy_buffer(PyObject *bytes, size_t *len) {
-    if (!PyBytes_Check(bytes)) return NULL;
     *len = (size_t)PyBytes_GET_SIZE(bytes);
-    uint8_t *copy = malloc(*len ? *len : 1);
-    if (copy != NULL && *len) memcpy(copy, PyBytes_AS_STRING(bytes), *len);
-    return copy;
+    return rgb_copy(PyBytes_AS_STRING(bytes), *len);
 }
 
 /* RosPump(functions, subscription, sock, spellings, max_rate)
@@ -269,28 +361,22 @@ static int ros_pump_init(RosPumpObject *self, PyObject *args, PyObject *kwds) {
                                      &sock, &PyList_Type, &spellings, &max_rate))
         return -1;
     void *addresses[7];
-    if (native_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0)
-        return -1;
+    if (rgb_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0) return -1;
     Py_ssize_t n = PyList_GET_SIZE(spellings);
     if (subscription == 0 || sock == 0 || n < 1 || n > MAX_SPELLINGS || !(max_rate >= 0)) {
         PyErr_SetString(PyExc_ValueError, "bad handles, spellings or max_rate");
         return -1;
     }
-    memcpy(&self->f.take, &addresses[0], sizeof(void *));
-    memcpy(&self->f.set_callback, &addresses[1], sizeof(void *));
-    memcpy(&self->f.reset_error, &addresses[2], sizeof(void *));
-    memcpy(&self->f.default_allocator, &addresses[3], sizeof(void *));
-    memcpy(&self->f.publisher_rmw_handle, &addresses[4], sizeof(void *));
-    memcpy(&self->f.gid_for_publisher, &addresses[5], sizeof(void *));
-    memcpy(&self->f.send, &addresses[6], sizeof(void *));
+    memcpy(&self->f, addresses, sizeof self->f); /* the same order, all pointers */
     self->encoders = PyList_New(0);
     if (self->encoders == NULL) return -1;
     for (Py_ssize_t i = 0; i < n; i++) {
-        PyObject *item = PyList_GET_ITEM(spellings, i);
         struct spelling *s = &self->spellings[self->nspellings];
         PyObject *type, *topic, *sender, *encoder;
-        if (!PyArg_ParseTuple(item, "SSSO", &type, &topic, &sender, &encoder)) return -1;
-        s->encoder = native_encoder_of(encoder);
+        if (!PyArg_ParseTuple(PyList_GET_ITEM(spellings, i), "SSSO", &type, &topic, &sender,
+                              &encoder))
+            return -1;
+        s->encoder = rgb_encoder_of(encoder);
         if (s->encoder == NULL) {
             PyErr_SetString(PyExc_TypeError, "spellings: (bytes, bytes, bytes, Encoder)");
             return -1;
@@ -322,13 +408,13 @@ static int ros_pump_init(RosPumpObject *self, PyObject *args, PyObject *kwds) {
     self->sock = (void *)(uintptr_t)sock;
     self->period_ns = max_rate > 0 ? (int64_t)(1e9 / max_rate) : 0;
     self->next_ns = INT64_MIN;
-    self->ready = 1;
+    self->member.hooks = &hooks; /* last: a RosPump with hooks is whole */
     return 0;
 }
 
 /* set_active(types): the spellings Gazebo subscribers take now. */
 static PyObject *ros_pump_set_active(RosPumpObject *self, PyObject *types) {
-    if (!initialised(self)) return NULL;
+    if (usable(self, 1) < 0) return NULL;
     if (!PyFrozenSet_Check(types) && !PySet_Check(types)) {
         PyErr_SetString(PyExc_TypeError, "a set of type names (bytes)");
         return NULL;
@@ -348,7 +434,7 @@ static PyObject *ros_pump_set_active(RosPumpObject *self, PyObject *types) {
 /* ignore(publishers): skip what these rcl publishers (the bridge's own, on the same topic)
  * wrote. */
 static PyObject *ros_pump_ignore(RosPumpObject *self, PyObject *publishers) {
-    if (!initialised(self)) return NULL;
+    if (usable(self, 1) < 0) return NULL;
     PyObject *sequence = PySequence_Fast(publishers, "a sequence of rcl publisher addresses");
     if (sequence == NULL) return NULL;
     Py_ssize_t n = PySequence_Fast_GET_SIZE(sequence);
@@ -373,11 +459,70 @@ static PyObject *ros_pump_ignore(RosPumpObject *self, PyObject *publishers) {
     return PyLong_FromLong(count);
 }
 
+/* take_handed() -> [CDR message]: what the encoders left to Python since the last call. A
+ * message whose bytes object cannot be made (no memory) is counted as lost and the others still
+ * go; where the list cannot grow, the messages it would carry are counted as lost and
+ * MemoryError is raised. */
+static PyObject *ros_pump_take_handed(RosPumpObject *self, PyObject *unused) {
+    (void)unused;
+    if (usable(self, 1) < 0) return NULL;
+    PyObject *refused = PyList_New(0);
+    if (refused == NULL) self->lost += self->nrefused;
+    for (size_t k = 0; refused != NULL && k < self->nrefused; k++) {
+        PyObject *cdr = PyBytes_FromStringAndSize((char *)self->refused[k],
+                                                  (Py_ssize_t)self->refused_len[k]);
+        if (cdr == NULL) {
+            PyErr_Clear();
+            self->lost++;
+            continue;
+        }
+        if (PyList_Append(refused, cdr) < 0) {
+            self->lost += self->nrefused - k + (size_t)PyList_GET_SIZE(refused);
+            Py_CLEAR(refused);
+        }
+        Py_DECREF(cdr);
+    }
+    clear_refused(self);
+    return refused;
+}
+
+/* send(type, payload) -> bool: the four data frames of `payload` in the spelling whose type
+ * frame is `type`, from Python (the fallback thread, which converts what the encoders left to
+ * it) under the loop's mutex: the channel's socket is used by one thread at a time. False
+ * where no spelling has that type, the send failed or the socket failed before. */
+static PyObject *ros_pump_send(RosPumpObject *self, PyObject *args) {
+    Py_buffer type, payload;
+    if (usable(self, 0) < 0 || !PyArg_ParseTuple(args, "y*y*", &type, &payload)) return NULL;
+    const struct spelling *s = NULL;
+    for (int i = 0; s == NULL && i < self->nspellings; i++)
+        if (self->spellings[i].type_len == (size_t)type.len &&
+            !memcmp(self->spellings[i].type, type.buf, (size_t)type.len))
+            s = &self->spellings[i];
+    struct rgb_out out = {.data = payload.buf, .len = (size_t)payload.len};
+    int sent = 0;
+    Py_BEGIN_ALLOW_THREADS;
+    pthread_mutex_t *lock = self->member.lock; /* NULL out of a loop: no other sender */
+    if (lock != NULL) pthread_mutex_lock(lock);
+    if (s != NULL && !self->failure) sent = send_frames(self, s, &out);
+    if (lock != NULL) pthread_mutex_unlock(lock);
+    Py_END_ALLOW_THREADS;
+    PyBuffer_Release(&type);
+    PyBuffer_Release(&payload);
+    return PyBool_FromLong(sent);
+}
+
 static PyObject *ros_pump_counts(RosPumpObject *self, PyObject *unused) {
     (void)unused;
-    if (!initialised(self)) return NULL;
-    return Py_BuildValue("(KKKKKKK)", self->received, self->own_skipped, self->rate_limited,
-                         self->published, self->take_errors, self->send_failures, self->lost);
+    if (usable(self, 0) < 0) return NULL;
+    return rgb_record(rgb_records.ros_pump_counts,
+                      Py_BuildValue("(KKKKKKKK)", self->received, self->own_skipped,
+                                    self->rate_limited, self->published, self->take_errors,
+                                    self->send_failures, self->lost, self->bytes_read));
+}
+
+static PyObject *ros_pump_failure(RosPumpObject *self, void *closure) {
+    (void)closure;
+    return PyLong_FromLong(self->failure);
 }
 
 static PyMethodDef ros_pump_methods[] = {
@@ -385,28 +530,28 @@ static PyMethodDef ros_pump_methods[] = {
      "set_active(types): the spellings sent, a set of type names"},
     {"ignore", (PyCFunction)ros_pump_ignore, METH_O,
      "ignore(publishers) -> count: skip samples of these rcl publishers (by GID)"},
-    {"counts", (PyCFunction)ros_pump_counts, METH_NOARGS,
-     "(received, own_skipped, rate_limited, published, take_errors, send_failures, lost) so far"},
+    {"take_handed", (PyCFunction)ros_pump_take_handed, METH_NOARGS,
+     "take_handed() -> [bytes]: the CDR messages the encoders left to Python"},
+    {"send", (PyCFunction)ros_pump_send, METH_VARARGS,
+     "send(type, payload) -> bool: the data frames, under the loop's mutex"},
+    {"counts", (PyCFunction)ros_pump_counts, METH_NOARGS, "counts() -> RosPumpCounts so far"},
     {NULL, NULL, 0, NULL},
 };
 
-static PyTypeObject RosPumpType = {
+static PyGetSetDef ros_pump_getset[] = {
+    {"failure", (getter)ros_pump_failure, NULL,
+     "the errno that took the channel off its loop (its socket or eventfd failed), or 0", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+PyTypeObject rgb_RosPumpType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.RosPump",
     .tp_basicsize = sizeof(RosPumpObject),
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "One native ROS -> Gazebo channel, run by a RosLoop (docs/native.md §7).",
+    .tp_doc = "One native ROS -> Gazebo channel, run by a Loop (docs/native.md §7).",
     .tp_new = ros_pump_new,
     .tp_init = (initproc)ros_pump_init,
     .tp_dealloc = (destructor)ros_pump_dealloc,
     .tp_methods = ros_pump_methods,
+    .tp_getset = ros_pump_getset,
 };
-
-int ros_pump_register(PyObject *module) {
-    if (PyType_Ready(&RosPumpType) < 0) return -1;
-    Py_INCREF(&RosPumpType);
-    if (PyModule_AddObject(module, "RosPump", (PyObject *)&RosPumpType) < 0) {
-        Py_DECREF(&RosPumpType);
-        return -1;
-    }
-    return ros_loop_register(module);
-}

@@ -36,6 +36,7 @@ from ros_gz_bridge_py.transport.api import (
     ServiceHandler,
     TopicInfo,
 )
+from ros_gz_bridge_py.transport.budget import TURN_MESSAGES
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.node import GzNode
@@ -81,8 +82,6 @@ _ENGINE_COUNTS = {
     "unknown_types": "unknown_type",
     "addresses_refused": "addresses_refused",
 }
-#: Messages read from one socket per loop turn, so no socket starves the others.
-READ_BATCH = 64
 
 
 class ZmqGzNode(GzNode):
@@ -262,6 +261,9 @@ class ZmqGzNode(GzNode):
         """The four data frames on the PUB socket (§2.8.2), from the publishing thread."""
         zmq_publisher = cast(ZmqPublisher, publisher)
         topic, sender, _, type_frame = zmq_publisher.wire_frames[wire_type]
+        if zmq_publisher.sender is not None:  # a native loop's socket
+            zmq_publisher.sender(type_frame, payload)
+            return
         own = zmq_publisher.sock
         send = self._io.pub.send if own is None else own.send
         # A socket of the publisher's own is used by one thread (see advertise); the lock
@@ -475,7 +477,7 @@ class ZmqGzNode(GzNode):
         self._services.turn(now)
 
     def _read_discovery(self, udp: DiscoverySocket, engine: DiscoveryEngine) -> None:
-        for _ in range(READ_BATCH):
+        for _ in range(TURN_MESSAGES):
             received = udp.receive()
             if received is None:
                 break
@@ -488,7 +490,7 @@ class ZmqGzNode(GzNode):
             self.subscriber_book.set_spellings(spellings.snapshot())
 
     def _read_frames(self, sock: Any, handler: Callable[[list[Frame]], None]) -> None:
-        for _ in range(READ_BATCH):
+        for _ in range(TURN_MESSAGES):
             try:
                 frames = receive_message(sock)
             except zmq.Again:

@@ -44,6 +44,7 @@ import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.transport.api import MessageInfo, NativeLoop, Rejection
+from ros_gz_bridge_py.transport.budget import TURN_MESSAGES, TURN_SLICE
 from ros_gz_bridge_py.transport.delivery import (
     MAX_QUEUED_BYTES,
     Delivery,
@@ -68,12 +69,8 @@ _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 COPY_BELOW = 64 * 1024
 #: Cached message infos per (topic, sender, type) frames; cleared beyond this size.
 INFO_CACHE_SIZE = 1024
-#: Longest time one delivery run goes on before the socket is drained again (s).
-DELIVERY_SLICE = 0.001
 #: Longest poll while idle (s). A close or a posted command wakes the reader at once.
 IDLE_POLL = 0.25
-#: Messages read from the socket per drain, so a flood cannot hold the thread in reading.
-READ_BATCH = 256
 #: How many times the payload that lowers a reader's receive HWM it is lowered for.
 GROWTH_ROOM = 2
 #: ``zmq.POLLIN`` as a plain int: ``&`` with the enum runs Python code (enum.Flag.__and__).
@@ -326,9 +323,9 @@ class SubscriptionReader:
         self._deliver_pending()
 
     def _deliver_pending(self) -> None:
-        """Deliver queued messages for up to DELIVERY_SLICE (the socket is drained between)."""
+        """Deliver queued messages for up to TURN_SLICE (the socket is drained between)."""
         pending = self._pending
-        end = time.monotonic() + DELIVERY_SLICE
+        end = time.monotonic() + TURN_SLICE
         while len(pending) and not self._closed:
             try:
                 payload, info = pending.get(block=False)
@@ -350,7 +347,7 @@ class SubscriptionReader:
 
     def _drain(self) -> None:
         sock = self._sock
-        for _ in range(READ_BATCH):
+        for _ in range(TURN_MESSAGES):
             if self._sock is not sock:  # replaced by _payload_grew: read from the new one later
                 return
             if not sock.getsockopt(zmq.EVENTS) & _POLLIN:  # cheaper than raising zmq.Again

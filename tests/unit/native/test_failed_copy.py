@@ -3,12 +3,12 @@ empty (issue 29): an empty payload parses as a valid all-default message, and a 
 sends simulated time backwards. The allocation is made to fail by the failing-allocation shim
 in a subprocess (failed_copy_side.py, failed_copy_ros_side.py), not by a hook in the extension.
 
-Gazebo -> ROS, two copies are made on the way: the loop's (pump.c hand_frames: malloc of the
+Gazebo -> ROS, two copies are made on the way: the loop's (pump_loop.c hand_frames: malloc of the
 payload's size, without the GIL) and Python's (take_handed: a bytes object, PyObject_Malloc of
 33 bytes more, which is malloc at this size). The pump's ``lost`` count is what
 ``ChannelPump.dropped`` adds to the channel's drops, which the reader counts in
 ``messages_dropped`` and the status table in its DROPPED column. ROS -> Gazebo, the same two
-(ros_pump.c refuse, ros_loop.c run); the RosPump's ``lost`` goes to the channel's DROPPED.
+(ros_pump.c refuse and take_handed); the RosPump's ``lost`` goes to the channel's DROPPED.
 The other allocation on a payload's way, the transcoder's output buffer, falls back instead:
 the payload goes to the Python path whole.
 """

@@ -1,5 +1,5 @@
-"""The shared ROS -> Gazebo loop (ros_loop.c) and one channel's sends (ros_pump.c), driven
-from the test thread against a real rcl subscription and real ZeroMQ sockets (docs/native.md §7).
+"""A loop (loop.c) of ROS -> Gazebo channels and one channel's sends (ros_pump.c), driven from
+the test thread against a real rcl subscription and real ZeroMQ sockets (docs/native.md §7).
 
 A ``std_msgs/String`` publisher of the test's own context feeds the channel; a SUB socket
 connected to the channel's PUB socket reads the data frames. Faults in sending are those libzmq
@@ -21,6 +21,8 @@ from typing import Any
 import pytest
 import zmq
 
+from ros_gz_bridge_py.transport.budget import TURN_MESSAGES, TURN_SLICE
+
 pytestmark = pytest.mark.ros
 
 TYPE = b"ignition.msgs.StringMsg"
@@ -28,13 +30,16 @@ TOPIC = b"@/partition@/ros_loop_test"
 SENDER = b"tcp://127.0.0.1:1"
 #: Each publish waits for delivery (DDS, then ZeroMQ) at most this long.
 WAIT = 10.0
+#: The budget of the loops the tests make (transport/budget.py); a slice of a second where a
+#: test counts the messages of one turn, which a busy machine must not cut short.
+BUDGET, LONG_SLICE = (TURN_MESSAGES, round(TURN_SLICE * 1e9)), (TURN_MESSAGES, 10**9)
 SEND = ctypes.CFUNCTYPE(
     ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int, use_errno=True
 )
 
 
 def _functions() -> tuple[int, ...]:
-    from ros_gz_bridge_py.native.ros_pump import ros_functions  # noqa: PLC0415
+    from ros_gz_bridge_py.native.abi import ros_functions  # noqa: PLC0415
 
     functions = ros_functions()
     if functions is None:
@@ -43,7 +48,7 @@ def _functions() -> tuple[int, ...]:
 
 
 def _libzmq() -> Any:
-    from ros_gz_bridge_py.native.pump import libzmq_path  # noqa: PLC0415
+    from ros_gz_bridge_py.native.abi import libzmq_path  # noqa: PLC0415
 
     path = libzmq_path()
     assert path is not None  # pyzmq is imported
@@ -144,42 +149,45 @@ def channels(native: Any, ros_context: Any) -> Iterator[Callable[..., Channel]]:
 
 
 def run_until(loop: Any, done: Callable[[list[Any]], bool], what: str) -> list[Any]:
-    """Runs the loop (100 ms at a time) until ``done(everything moved so far)``."""
-    moved: list[Any] = []
+    """Runs the loop (100 ms at a time) until ``done(everything reported so far)``, a list of
+    (member, events)."""
+    reported: list[Any] = []
     deadline = time.monotonic() + WAIT
-    while not done(moved):
+    while not done(reported):
         if time.monotonic() > deadline:
             pytest.fail(f"timed out waiting for {what}")
-        moved += loop.run(100)[1]
-    return moved
+        reported += loop.run(100, [])[1]
+    return reported
 
 
 def test_methods_of_uninitialised_objects_raise(native: Any) -> None:
     pump = native.RosPump.__new__(native.RosPump)
-    for call in (pump.counts, lambda: pump.set_active(set()), lambda: pump.ignore([])):
+    calls = (pump.counts, pump.take_handed, lambda: pump.set_active(set()),
+             lambda: pump.ignore([]), lambda: pump.send(TYPE, b""))  # fmt: skip
+    for call in calls:
         with pytest.raises(RuntimeError, match="not initialised"):
             call()
-    loop = native.RosLoop.__new__(native.RosLoop)
-    for call in (lambda: loop.run(0), loop.wake, loop.size, lambda: loop.add(pump)):
+    loop = native.Loop.__new__(native.Loop)
+    for call in (lambda: loop.run(0, []), loop.wake, loop.size, lambda: loop.add(pump)):
         with pytest.raises(RuntimeError, match="not initialised"):
             call()
-    with pytest.raises(TypeError, match="initialised RosPump"):
-        native.RosLoop().add(pump)
+    with pytest.raises(TypeError, match="an initialised Pump or RosPump"):
+        native.Loop(*BUDGET).add(pump)
 
 
 def test_init_twice_raises(native: Any, channels: Callable[..., Channel]) -> None:
     channel = channels("twice")
     with pytest.raises(RuntimeError, match="initialised once"):
         channel.pump.__init__(_functions(), 1, 1, [], 0.0)
-    loop = native.RosLoop()
+    loop = native.Loop(*BUDGET)
     with pytest.raises(RuntimeError, match="initialised once"):
-        loop.__init__()
+        loop.__init__(*BUDGET)
 
 
 def test_messages_of_several_channels_are_sent_whole(
     native: Any, channels: Callable[..., Channel]
 ) -> None:
-    loop = native.RosLoop()
+    loop = native.Loop(*BUDGET)
     first, second = channels("first"), channels("second")
     for channel in (first, second):
         loop.add(channel.pump)
@@ -188,7 +196,11 @@ def test_messages_of_several_channels_are_sent_whole(
     for index in range(5):
         first.publish(f"one {index}")
         second.publish(f"two {index}")
-    run_until(loop, lambda _m: first.pump.counts()[3] == 5 == second.pump.counts()[3], "5 each")
+    run_until(
+        loop,
+        lambda _m: first.pump.counts().published == 5 == second.pump.counts().published,
+        "5 each",
+    )
     for channel in (first, second):
         messages = channel.messages(5)
         assert len(messages) == 5
@@ -197,28 +209,29 @@ def test_messages_of_several_channels_are_sent_whole(
     assert loop.remove(first.pump) is False  # once only
     first.publish("not taken")
     second.publish("taken")
-    run_until(loop, lambda _m: second.pump.counts()[3] == 6, "the channel left")
-    assert first.pump.counts()[0] == 5
+    run_until(loop, lambda _m: second.pump.counts().published == 6, "the channel left")
+    assert first.pump.counts().received == 5
 
 
 def test_a_terminated_context_takes_the_channel_off_and_the_loop_goes_on(
     native: Any, channels: Callable[..., Channel]
 ) -> None:
-    loop = native.RosLoop()
+    loop = native.Loop(*BUDGET)
     doomed, other = channels("doomed"), channels("other")
     for channel in (doomed, other):
         loop.add(channel.pump)
         channel.remove_from(loop)
     _libzmq().zmq_ctx_shutdown(ctypes.c_void_p(doomed.zmq.underlying))
     doomed.publish("into a terminated context")
-    moved = run_until(loop, lambda m: any(p is doomed.pump and f for p, _r, f in m), "failure")
-    assert [f for p, _r, f in moved if p is doomed.pump][-1] == zmq.ETERM
-    received, _own, _rate, published, _take, send_failures, _lost = doomed.pump.counts()
-    assert (received, published, send_failures) == (1, 0, 1)
+    broken = native.EVENT_BROKEN
+    run_until(loop, lambda r: any(p is doomed.pump and e & broken for p, e in r), "failure")
+    assert doomed.pump.failure == zmq.ETERM
+    counts = doomed.pump.counts()
+    assert (counts.received, counts.published, counts.send_failures) == (1, 0, 1)
     doomed.publish("after the failure")  # not taken: the loop does not wake for it
     other.publish("still carried")
-    run_until(loop, lambda _m: other.pump.counts()[3] == 1, "the other channel")
-    assert doomed.pump.counts()[0] == 1
+    run_until(loop, lambda _m: other.pump.counts().published == 1, "the other channel")
+    assert doomed.pump.counts().received == 1
     assert loop.remove(doomed.pump) is True
 
 
@@ -245,16 +258,18 @@ def test_a_frame_refused_mid_message_is_not_published_and_leaves_no_part(
     send, calls = _refusing(frame=7, code=errno.EAGAIN, times=1)  # the 3rd frame of the 2nd
     address = ctypes.cast(send, ctypes.c_void_p).value
     channel = channels("mid_message", send=address)
-    loop = native.RosLoop()
+    loop = native.Loop(*BUDGET)
     loop.add(channel.pump)
     channel.remove_from(loop)
     for index in range(3):
         channel.publish(f"message {index}")
-    moved = run_until(loop, lambda m: any(f for _p, _r, f in m), "the failure")
-    assert [f for _p, _r, f in moved if f] == [errno.EAGAIN]
-    received, _own, _rate, published, _take, send_failures, _lost = channel.pump.counts()
-    assert (published, send_failures) == (1, 1)
-    assert received == 2  # the channel took nothing after its socket was left uncertain
+    broken = native.EVENT_BROKEN
+    reported = run_until(loop, lambda r: any(e & broken for _p, e in r), "the failure")
+    assert [e & broken for _p, e in reported] == [broken]  # reported once: slept on no more
+    assert channel.pump.failure == errno.EAGAIN
+    counts = channel.pump.counts()
+    assert (counts.published, counts.send_failures) == (1, 1)
+    assert counts.received == 2  # the channel took nothing after its socket was left uncertain
     assert all(flags & zmq.DONTWAIT for flags in calls)
     assert [(len(m), m[2]) for m in channel.messages(1)] == [(4, b"\x12\tmessage 0")]
     loop.remove(channel.pump)
@@ -263,40 +278,43 @@ def test_a_frame_refused_mid_message_is_not_published_and_leaves_no_part(
 def test_an_interrupted_frame_is_sent_again(native: Any, channels: Callable[..., Channel]) -> None:
     send, _calls = _refusing(frame=3, code=errno.EINTR, times=2)
     channel = channels("interrupted", send=ctypes.cast(send, ctypes.c_void_p).value)
-    loop = native.RosLoop()
+    loop = native.Loop(*BUDGET)
     loop.add(channel.pump)
     channel.remove_from(loop)
     channel.publish("once")
-    run_until(loop, lambda _m: channel.pump.counts()[3] == 1, "the message")
+    run_until(loop, lambda _m: channel.pump.counts().published == 1, "the message")
     messages = channel.messages(1)
     assert [len(m) for m in messages] == [4]
     assert messages[0][2] == b"\x12\x04once"
-    assert channel.pump.counts()[5] == 0
+    assert channel.pump.counts().send_failures == 0
     loop.remove(channel.pump)
 
 
-def test_a_round_gives_each_channel_its_budget_and_a_wake_ends_the_run_after_it(
+def test_a_pass_gives_each_channel_its_budget_and_a_wake_ends_the_run(
     native: Any, channels: Callable[..., Channel]
 ) -> None:
-    loop = native.RosLoop()
+    loop = native.Loop(*LONG_SLICE)
     flooded = [channels("flood_a"), channels("flood_b")]
     for channel in flooded:
         for index in range(100):
             channel.publish(f"flood {index}")
     time.sleep(0.5)  # the samples reach both subscriptions' queues (100 deep)
     for channel in flooded:
-        loop.add(channel.pump)  # each add also wakes the loop
+        loop.add(channel.pump)
         channel.remove_from(loop)
-    status, _moved = loop.run(60_000)
-    assert status == 1  # woken: returned after one round, the backlog still queued
-    assert [channel.pump.counts()[0] for channel in flooded] == [64, 64]
-    run_until(loop, lambda _m: all(c.pump.counts()[0] == 100 for c in flooded), "the rest")
+    woken, _reported = loop.run(0, [])  # one pass: the backlog still queued
+    assert not woken
+    assert [channel.pump.counts().received for channel in flooded] == [TURN_MESSAGES] * 2
+    loop.wake()
+    assert loop.run(60_000, []) == (True, [])  # at once, before a pass
+    assert [channel.pump.counts().received for channel in flooded] == [TURN_MESSAGES] * 2
+    run_until(loop, lambda _m: all(c.pump.counts().received == 100 for c in flooded), "the rest")
 
 
 def test_channels_join_and_leave_while_the_loop_runs_and_the_others_keep_flowing(
     native: Any, channels: Callable[..., Channel]
 ) -> None:
-    loop = native.RosLoop()
+    loop = native.Loop(*BUDGET)
     steady, churned = channels("steady"), channels("churned")
     loop.add(steady.pump)
     steady.remove_from(loop)
@@ -305,7 +323,7 @@ def test_channels_join_and_leave_while_the_loop_runs_and_the_others_keep_flowing
 
     def run() -> None:
         while not stop.is_set():
-            loop.run(20)
+            loop.run(20, [])
 
     runner = threading.Thread(target=run, name="test-loop", daemon=True)
     runner.start()
@@ -317,12 +335,12 @@ def test_channels_join_and_leave_while_the_loop_runs_and_the_others_keep_flowing
             steady.publish(f"steady {index}")
             assert loop.remove(churned.pump) is True
         deadline = time.monotonic() + WAIT
-        while steady.pump.counts()[3] < 50 and time.monotonic() < deadline:
+        while steady.pump.counts().published < 50 and time.monotonic() < deadline:
             time.sleep(0.05)
     finally:
         stop.set()
         runner.join()
-    assert steady.pump.counts()[3] == 50
+    assert steady.pump.counts().published == 50
     assert loop.size() == 1
     texts = [m[2] for m in steady.messages(50)]
     assert texts == [
