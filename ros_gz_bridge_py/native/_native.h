@@ -171,7 +171,7 @@ typedef struct {
     size_t capacity, head, count;
     size_t max_bytes, queued_bytes; /* the ring's bound in payload bytes, and what it holds */
     /* A payload larger than watch_above (SIZE_MAX: none) is told to Python (Handover.grown):
-     * the reader lowers the socket's receive HWM for it (transport/zmq/reader.py). */
+     * the socket's owner lowers its receive HWM for it (transport/zmq/socket_owner.py). */
     size_t watch_above, grown;
     struct handed *handover;
     size_t nhanded, handed_cap;

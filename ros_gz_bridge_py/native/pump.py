@@ -1,16 +1,17 @@
-"""A native Gazebo -> ROS channel's pump, as its reader and its channel use it (docs/native.md §5).
+"""A native Gazebo -> ROS channel's pump, as its socket's owner and its channel use it
+(docs/native.md §5).
 
 :class:`ChannelPump` holds the C ``Pump`` (pump.c) of one channel: made when the channel's ROS
 publisher exists, with one program per spelling of the channel's Gazebo type, and kept for the
 publisher's life (its publication sequence numbers are the loop guard's, whichever path
-published). The topic's reader (``transport/zmq/reader.py``) attaches it, with the
-socket, to the Gazebo -> ROS loop (``loop.py``) instead of reading the socket on a thread of its
-own. Its turns, on the loop's thread, do what the C pump left to Python: the frames of a sender
-not yet known go to the reader (which judges them, as the Python path does); the payloads
-no program took go to the channel's Python path on the process's one fallback thread
-(``fallback.py``), behind a drop-oldest queue of the channel's own, so that a payload slow to
-refuse (a Pose_V of 4 M empty poses: a second of parsing) holds up no channel's loop; and the
-counts go to the channel.
+published). The topic's native reader (``transport/zmq/reader.py``) attaches it, with its
+socket owner's socket, to the Gazebo -> ROS loop (``loop.py``) instead of reading the socket on
+a thread of its own. Its turns, on the loop's thread, do what the C pump left to Python: the
+frames of a sender not yet known go to the reader (whose socket owner judges them, as on the
+Python path); the payloads no program took go to the channel's Python path on the process's one
+fallback thread (``fallback.py``), behind a drop-oldest queue of the channel's own, so that a
+payload slow to refuse (a Pose_V of 4 M empty poses: a second of parsing) holds up no channel's
+loop; and the counts go to the channel.
 """
 
 from __future__ import annotations

@@ -54,10 +54,10 @@ from ros_gz_bridge_py.transport.zmq.discovery import (
 )
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
 from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
-from ros_gz_bridge_py.transport.zmq.intake import DataIntake
-from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader, receive_message
+from ros_gz_bridge_py.transport.zmq.intake import DataIntake, Reader
 from ros_gz_bridge_py.transport.zmq.routes import DataRouter
 from ros_gz_bridge_py.transport.zmq.services import PendingCall, RouterSockets, ServiceRouter
+from ros_gz_bridge_py.transport.zmq.socket_owner import receive_message
 from ros_gz_bridge_py.transport.zmq.sockets import open_sockets, publisher_socket
 from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket, determine_host
 from ros_gz_bridge_py.transport.zmq.wire import (
@@ -282,7 +282,7 @@ class ZmqGzNode(GzNode):
 
     def _open_delivery(
         self, sub: Subscription, size: int, on_start: Callable[[], None] | None, max_bytes: int
-    ) -> SubscriptionReader:
+    ) -> Reader:
         """A queued subscription reads its topic's SUB socket on its own thread (reader.py)."""
         return self._intake.open_reader(sub, size, on_start, max_bytes)
 
@@ -309,7 +309,7 @@ class ZmqGzNode(GzNode):
 
     def _close_subscription(self, sub: Subscription, *, last: bool) -> None:
         if sub.delivery is not None:
-            self._intake.close_reader(cast(SubscriptionReader, sub.delivery))
+            self._intake.close_reader(cast(Reader, sub.delivery))
         with contextlib.suppress(TransportError):
             self._call(lambda: self._end_subscription(cast(ZmqSubscription, sub), last=last))
 
