@@ -20,6 +20,7 @@ NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/pump.c",
     "ros_gz_bridge_py/native/pump_loop.c",
     "ros_gz_bridge_py/native/ros_pump.c",
+    "ros_gz_bridge_py/native/ros_pump_loop.c",
     "ros_gz_bridge_py/native/transcode.c",
     "ros_gz_bridge_py/native/transcode_load.c",
     "ros_gz_bridge_py/native/transcoders.c",

@@ -110,6 +110,16 @@ int64_t rgb_now_ns(clockid_t clock) {
     return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
 }
 
+int rgb_admit(int64_t *next_ns, int64_t period_ns) {
+    if (period_ns <= 0) return 1;
+    int64_t now = rgb_now_ns(CLOCK_MONOTONIC);
+    if (*next_ns != INT64_MIN && now < *next_ns) return 0;
+    /* on the schedule, or a fresh start after a pause */
+    int on_time = *next_ns != INT64_MIN && now - *next_ns < period_ns;
+    *next_ns = on_time ? *next_ns + period_ns : now + period_ns;
+    return 1;
+}
+
 struct rgb_member *rgb_member_of(PyObject *object) {
     if (!PyObject_TypeCheck(object, &rgb_PumpType) && !PyObject_TypeCheck(object, &rgb_RosPumpType))
         return NULL;

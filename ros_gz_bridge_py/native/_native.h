@@ -1,12 +1,12 @@
 /* What the C files of the extension share (private; docs/native.md).
  *
  * One type a file, as CPython's Modules/_io: transcoders.c (Program, Encoder: the two
- * transcoders' Python faces), pump.c and pump_loop.c (Pump: one Gazebo -> ROS channel; its
- * Python methods, then its per-message work), ros_pump.c (RosPump: one ROS -> Gazebo channel),
- * loop.c (Loop: the one loop that runs either kind of pump, once per direction) and _native.c
- * (the module: its constants, the named structures the types return, the helpers below). The
- * transcoders' own headers (transcode.h, encode.h, wire.h) stay apart: the fuzz targets build
- * them without Python. */
+ * transcoders' Python faces), pump.c (Pump: one Gazebo -> ROS channel) and ros_pump.c (RosPump:
+ * one ROS -> Gazebo channel), each with its per-message work beside it (pump_loop.c,
+ * ros_pump_loop.c), loop.c (Loop: the one loop that runs either kind of pump, once per
+ * direction) and _native.c (the module: its constants, the named structures the types return,
+ * the helpers below). The transcoders' own headers (transcode.h, encode.h, wire.h) stay apart:
+ * the fuzz targets build them without Python. */
 #ifndef RGB_NATIVE_H
 #define RGB_NATIVE_H
 
@@ -60,7 +60,7 @@ enum { RGB_EVENT_HANDED = 1, RGB_EVENT_MONITOR = 2, RGB_EVENT_BROKEN = 4, RGB_AG
 
 struct rgb_member;
 /* The one difference between the directions: each kind of member's hooks (pump_loop.c,
- * ros_pump.c), all under the loop's mutex: `turn` on the loop's thread without the GIL, the
+ * ros_pump_loop.c), all under the loop's mutex: `turn` on the loop's thread without the GIL, the
  * others on the thread that adds or removes the member. */
 struct rgb_hooks {
     /* The descriptors to sleep on, fds[0..n); n, or -1 with a reason in *why. */
@@ -196,5 +196,98 @@ uint64_t pump_begin_publication(PumpObject *self);
 void pump_end_publication(PumpObject *self, uint64_t sequence, int ok);
 void pump_clear_ring(PumpObject *self);
 void pump_clear_handover(PumpObject *self);
+
+/* ---- a ROS -> Gazebo channel (ros_pump.c, ros_pump_loop.c) --------------------------------- */
+
+/* rcutils_allocator_t, rcl_serialized_message_t, rmw_gid_t and rmw_message_info_t as Jazzy's
+ * headers lay them out (abi.py checks the loaded rclpy). */
+typedef struct {
+    void *(*allocate)(size_t size, void *state);
+    void (*deallocate)(void *pointer, void *state);
+    void *(*reallocate)(void *pointer, size_t size, void *state);
+    void *(*zero_allocate)(size_t count, size_t size, void *state);
+    void *state;
+} rcu_allocator;
+
+typedef struct {
+    uint8_t *buffer;
+    size_t buffer_length;
+    size_t buffer_capacity;
+    rcu_allocator allocator;
+} rcl_bytes;
+
+#define GID_SIZE 16
+typedef struct {
+    const char *implementation_identifier;
+    uint8_t data[GID_SIZE];
+} rmw_gid;
+
+typedef struct {
+    int64_t source_timestamp;
+    int64_t received_timestamp;
+    uint64_t publication_sequence_number;
+    uint64_t reception_sequence_number;
+    rmw_gid publisher_gid;
+    _Bool from_intra_process;
+} rmw_info;
+
+typedef void (*event_callback)(const void *user_data, size_t number_of_events);
+
+struct ros_foreign {
+    int (*take)(const void *subscription, rcl_bytes *message, rmw_info *info, void *allocation);
+    int (*set_callback)(const void *subscription, event_callback callback, const void *user_data);
+    void (*reset_error)(void);
+    rcu_allocator (*default_allocator)(void);
+    void *(*publisher_rmw_handle)(const void *publisher);
+    int (*gid_for_publisher)(const void *rmw_publisher, rmw_gid *gid);
+    int (*send)(void *socket, const void *buffer, size_t length, int flags);
+};
+_Static_assert(sizeof(struct ros_foreign) == 7 * sizeof(void *), "the functions, in order");
+
+#define MAX_SPELLINGS 4
+#define MAX_IGNORED 16
+
+struct spelling {
+    uint8_t *type, *topic, *sender;
+    size_t type_len, topic_len, sender_len;
+    struct rgb_encoder *encoder;
+    int active;
+};
+
+typedef struct {
+    PyObject_HEAD
+    struct rgb_member member;
+    struct ros_foreign f;
+    void *subscription;
+    void *sock;
+    int event_fd; /* written by rcl's on-new-message callback */
+    int callback_set;
+    PyObject *encoders; /* list: keeps the Encoder objects alive; set by the first __init__ */
+    struct spelling spellings[MAX_SPELLINGS];
+    int nspellings;
+    rcl_bytes message;
+    struct rgb_out out[MAX_SPELLINGS];
+    uint8_t ignored[MAX_IGNORED][GID_SIZE];
+    int nignored;
+    int64_t period_ns, next_ns;
+    unsigned long long received, own_skipped, rate_limited, published, take_errors,
+        send_failures, bytes_read;
+    unsigned long long lost; /* messages for Python that could not be copied (no memory) */
+    uint8_t **refused;
+    size_t *refused_len;
+    size_t nrefused, refused_cap;
+    /* Set when the channel's socket or eventfd failed (an errno): it takes nothing more. */
+    int failure;
+} RosPumpObject;
+
+extern const struct rgb_hooks rgb_ros_pump_hooks;
+/* The four data frames of one message in spelling `s`; 1 when sent (ros_pump_loop.c). */
+int ros_pump_send_frames(RosPumpObject *self, const struct spelling *s, const struct rgb_out *out);
+void ros_pump_clear_callback(RosPumpObject *self);
+void ros_pump_clear_refused(RosPumpObject *self);
+
+/* max_rate's admission (core/rate_limit.py): 1 when a message may go now; *next_ns is the
+ * next time on the schedule (INT64_MIN before the first), period_ns 0: no limit. */
+int rgb_admit(int64_t *next_ns, int64_t period_ns);
 
 #endif

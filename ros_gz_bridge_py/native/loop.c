@@ -1,7 +1,7 @@
 /* Loop: the one loop design, run once per direction (docs/native.md §5).
  *
  * A Loop runs every member of its direction (Gazebo -> ROS: each channel's Pump, pump_loop.c;
- * ROS -> Gazebo: each channel's RosPump, ros_pump.c) on one thread, whatever their number, so
+ * ROS -> Gazebo: each channel's RosPump, ros_pump_loop.c) on one thread, whatever their number, so
  * that a fleet of robots costs no thread per topic and a message no thread switch of its own.
  * The directions differ only in their members' hooks (struct rgb_hooks, _native.h): which
  * descriptors to sleep on, and what one turn does.

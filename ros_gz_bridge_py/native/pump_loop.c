@@ -199,19 +199,9 @@ static int read_message(PumpObject *self) {
 
 /* ---- delivering ---------------------------------------------------------------------------- */
 
-static int admit(PumpObject *self) {
-    if (self->period_ns <= 0) return 1;
-    int64_t now = rgb_now_ns(CLOCK_MONOTONIC);
-    if (self->next_ns != INT64_MIN && now < self->next_ns) return 0;
-    /* on the schedule, or a fresh start after a pause (core/rate_limit.py) */
-    int on_time = self->next_ns != INT64_MIN && now - self->next_ns < self->period_ns;
-    self->next_ns = on_time ? self->next_ns + self->period_ns : now + self->period_ns;
-    return 1;
-}
-
 static void deliver(PumpObject *self, struct queued *q) {
     self->received++;
-    if (!admit(self)) {
+    if (!rgb_admit(&self->next_ns, self->period_ns)) {
         self->rate_limited++;
         return;
     }
