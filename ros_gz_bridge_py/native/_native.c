@@ -7,67 +7,25 @@
 
 struct rgb_records rgb_records;
 
-#define FIELD(name, doc) {name, doc}
+/* The records' fields (documented in _native.pyi), in the order the types fill them. */
+#define FIELDS(name, ...) static PyStructSequence_Field name[] = {__VA_ARGS__, {NULL, NULL}}
+#define F(name) {name, NULL}
+FIELDS(pump_counts, F("received"), F("rate_limited"), F("published"), F("dropped"), F("skipped"),
+       F("lost"), F("taken"), F("bytes_read"));
+FIELDS(ros_pump_counts, F("received"), F("own_skipped"), F("rate_limited"), F("published"),
+       F("take_errors"), F("send_failures"), F("lost"), F("bytes_read"));
+FIELDS(handover, F("unrouted"), F("refused"), F("too_large"), F("grown"));
+FIELDS(refused, F("sender"), F("msg_type"), F("payload"), F("status"));
+FIELDS(too_large, F("sender"), F("msg_type"), F("items"), F("least"), F("size"));
 
-static PyStructSequence_Field pump_counts_fields[] = {
-    FIELD("received", "payloads taken off the queue for delivery"),
-    FIELD("rate_limited", "of those, dropped by max_rate"),
-    FIELD("published", "published by the pump itself"),
-    FIELD("dropped", "dropped oldest first (the queue's count or bytes)"),
-    FIELD("skipped", "another spelling of a type taken from the same publisher"),
-    FIELD("lost", "could not be copied for Python (no memory)"),
-    FIELD("taken", "messages read from the socket, whatever became of them"),
-    FIELD("bytes_read", "their payload bytes"),
-    {NULL, NULL},
-};
-
-static PyStructSequence_Field ros_pump_counts_fields[] = {
-    FIELD("received", "messages taken from the subscription"),
-    FIELD("own_skipped", "of those, written by the bridge's own publishers"),
-    FIELD("rate_limited", "dropped by max_rate"),
-    FIELD("published", "sent in every spelling subscribers take"),
-    FIELD("take_errors", "takes rcl refused"),
-    FIELD("send_failures", "messages whose send failed"),
-    FIELD("lost", "could not be copied for Python (no memory)"),
-    FIELD("bytes_read", "the CDR bytes taken"),
-    {NULL, NULL},
-};
-
-static PyStructSequence_Field handover_fields[] = {
-    FIELD("unrouted", "frames of each message no route was known for, for Python to judge"),
-    FIELD("refused", "payloads no program took (Refused), for the channel's Python path"),
-    FIELD("too_large", "payloads refused as too large (TooLarge), for Python to count"),
-    FIELD("grown", "the largest payload read above the watched size (0: none)"),
-    {NULL, NULL},
-};
-
-static PyStructSequence_Field refused_fields[] = {
-    FIELD("sender", "the publisher's sender frame"),
-    FIELD("msg_type", "the type frame"),
-    FIELD("payload", "the payload"),
-    FIELD("status", "what the program said (transcode.h)"),
-    {NULL, NULL},
-};
-
-static PyStructSequence_Field too_large_fields[] = {
-    FIELD("sender", "the publisher's sender frame"),
-    FIELD("msg_type", "the type frame"),
-    FIELD("items", "the items of the list"),
-    FIELD("least", "the fewest CDR bytes of one item"),
-    FIELD("size", "the payload's bytes"),
-    {NULL, NULL},
-};
-
+#define RECORD(name, doc, fields) {"ros_gz_bridge_py.native._native." name, doc, fields, \
+                                    sizeof fields / sizeof *fields - 1}
 static PyStructSequence_Desc records[] = {
-    {"ros_gz_bridge_py.native._native.PumpCounts", "A Pump's counts so far.",
-     pump_counts_fields, 8},
-    {"ros_gz_bridge_py.native._native.RosPumpCounts", "A RosPump's counts so far.",
-     ros_pump_counts_fields, 8},
-    {"ros_gz_bridge_py.native._native.Handover", "What a Pump left to Python.",
-     handover_fields, 4},
-    {"ros_gz_bridge_py.native._native.Refused", "A payload no program took.", refused_fields, 4},
-    {"ros_gz_bridge_py.native._native.TooLarge", "A payload refused as too large.",
-     too_large_fields, 5},
+    RECORD("PumpCounts", "A Pump's counts so far.", pump_counts),
+    RECORD("RosPumpCounts", "A RosPump's counts so far.", ros_pump_counts),
+    RECORD("Handover", "What a Pump left to Python.", handover),
+    RECORD("Refused", "A payload no program took.", refused),
+    RECORD("TooLarge", "A payload refused as too large.", too_large),
 };
 
 PyObject *rgb_record(PyTypeObject *type, PyObject *values) {

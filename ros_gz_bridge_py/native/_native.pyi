@@ -1,4 +1,5 @@
-"""Types of the compiled extension (_native.c and the files of _native.h)."""
+"""Types of the compiled extension (_native.c and the files of _native.h). The records (struct
+sequences) are read by name only; their fields are read-only."""
 
 from collections.abc import Sequence
 from typing import final
@@ -32,65 +33,47 @@ class Encoder:
 
 @final
 class PumpCounts:
-    """A Pump's counts so far."""
+    """A Pump's counts so far: payloads taken off its queue (``received``), of them dropped by
+    max_rate and published by the pump; dropped oldest first; ``skipped`` (another spelling of
+    a type taken from the same publisher); ``lost`` (no memory to copy them for Python); the
+    messages read from the socket (``taken``) and their payload bytes."""
 
-    @property
-    def received(self) -> int: ...
-    @property
-    def rate_limited(self) -> int: ...
-    @property
-    def published(self) -> int: ...
-    @property
-    def dropped(self) -> int: ...
-    @property
-    def skipped(self) -> int: ...
-    @property
-    def lost(self) -> int: ...
-    @property
-    def taken(self) -> int: ...
-    @property
-    def bytes_read(self) -> int: ...
+    received: int
+    rate_limited: int
+    published: int
+    dropped: int
+    skipped: int
+    lost: int
+    taken: int
+    bytes_read: int
 
 @final
 class Refused:
     """A payload no program took."""
 
-    @property
-    def sender(self) -> bytes: ...
-    @property
-    def msg_type(self) -> bytes: ...
-    @property
-    def payload(self) -> bytes: ...
-    @property
-    def status(self) -> int: ...
+    sender: bytes
+    msg_type: bytes
+    payload: bytes
+    status: int
 
 @final
 class TooLarge:
     """A payload refused as too large: its list's items, the fewest CDR bytes of one, its size."""
 
-    @property
-    def sender(self) -> bytes: ...
-    @property
-    def msg_type(self) -> bytes: ...
-    @property
-    def items(self) -> int: ...
-    @property
-    def least(self) -> int: ...
-    @property
-    def size(self) -> int: ...
+    sender: bytes
+    msg_type: bytes
+    items: int
+    least: int
+    size: int
 
 @final
 class Handover:
     """What a Pump left to Python since the last ``take_handed``."""
 
-    @property
-    def unrouted(self) -> list[list[bytes]]: ...
-    @property
-    def refused(self) -> list[Refused]: ...
-    @property
-    def too_large(self) -> list[TooLarge]: ...
-    @property
-    def grown(self) -> int: ...
+    unrouted: list[list[bytes]]
+    refused: list[Refused]
+    too_large: list[TooLarge]
+    grown: int
 
 @final
 class Pump:
@@ -121,24 +104,19 @@ class Pump:
 
 @final
 class RosPumpCounts:
-    """A RosPump's counts so far."""
+    """A RosPump's counts so far: messages taken (``received``), of them the bridge's own, those
+    max_rate dropped and those sent in every spelling subscribers take (``published``); takes
+    rcl refused; messages whose send failed; ``lost`` (no memory to copy them for Python); the
+    CDR bytes taken."""
 
-    @property
-    def received(self) -> int: ...
-    @property
-    def own_skipped(self) -> int: ...
-    @property
-    def rate_limited(self) -> int: ...
-    @property
-    def published(self) -> int: ...
-    @property
-    def take_errors(self) -> int: ...
-    @property
-    def send_failures(self) -> int: ...
-    @property
-    def lost(self) -> int: ...
-    @property
-    def bytes_read(self) -> int: ...
+    received: int
+    own_skipped: int
+    rate_limited: int
+    published: int
+    take_errors: int
+    send_failures: int
+    lost: int
+    bytes_read: int
 
 @final
 class RosPump:

@@ -18,7 +18,8 @@ from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.native import extension, unavailable_reason
 from ros_gz_bridge_py.native.abi import why_no_zmq_functions, zmq_functions, zmq_layout_fits
 from ros_gz_bridge_py.native.encoder import compile_to_gz
-from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
+from ros_gz_bridge_py.native.program import compile_to_ros
+from ros_gz_bridge_py.native.words import NotExpressibleError
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.native._native import Encoder, Program

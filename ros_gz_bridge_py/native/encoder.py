@@ -36,7 +36,9 @@ from ros_gz_bridge_py.converters.std_msgs import (
     HEADER,
 )
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native.program import (
+from ros_gz_bridge_py.native.words import (
+    CONV_EXACT,
+    CONV_WRAP,
     ROS_KINDS,
     VALUES,
     NotExpressibleError,
@@ -52,7 +54,6 @@ from ros_gz_bridge_py.ros import cdr_types as cdr
 # Read ops, write ops (encode.c).
 R_END, R_NUM, R_STR, R_ARR, R_SEQ_NUM, R_SEQ_STR, R_SEQ_MSG = 0, 1, 2, 3, 4, 5, 6
 W_END, W_NUM, W_STR, W_STR_REP, W_CONST_STR, W_MSG, W_SEQ_MSG, W_PACKED, W_SEQ_STR = range(9)
-CONV_EXACT, CONV_WRAP = 0, 1
 _PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP, _PB_BOOL = 9, 11, 12, 10, 8
 _PB_FLOATS = frozenset({1, 2})
 
