@@ -1,5 +1,5 @@
-"""Run by test_failed_copy.py with the failing-allocation shim preloaded: a ROS -> Gazebo
-channel on its loop (test_ros_loop's channel: a real rcl subscription, real ZeroMQ sockets)
+"""Run by test_ros_pump_failed_copy.py with the failing-allocation shim preloaded: a ROS -> Gazebo
+channel on its loop (ros_pump_rig's channel: a real rcl subscription, real ZeroMQ sockets)
 takes two std_msgs/String messages the native encoder leaves to Python (data that is not
 UTF-8): one of ``argv[3]`` CDR bytes, then one 4 bytes longer; allocations of ``argv[1]``
 bytes fail while the loop handles them, but for the first ``argv[2]``. Prints, as JSON, the
@@ -16,7 +16,7 @@ from typing import Any
 
 from ros_gz_bridge_py.native import extension
 from tests.unit.native.failing_alloc import while_failing
-from tests.unit.native.test_ros_loop import BUDGET, WAIT, Channel
+from tests.unit.native.ros_pump_rig import BUDGET, WAIT, Channel
 
 COUNTS = ("received", "own_skipped", "rate_limited", "published", "take_errors",
           "send_failures", "lost")  # fmt: skip

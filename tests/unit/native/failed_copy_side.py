@@ -1,5 +1,5 @@
-"""Run by test_failed_copy.py with the failing-allocation shim preloaded: a pump on a loop
-(test_pump_loop's rig: real ZeroMQ sockets, a real rclpy publisher) is sent payloads while the
+"""Run by test_pump_failed_copy.py with the failing-allocation shim preloaded: a pump on a loop
+(pump_rig's rig: real ZeroMQ sockets, a real rclpy publisher) is sent payloads while the
 allocations of ``argv[2]`` bytes fail; ``argv[3]`` is the payload size. ``argv[1]`` says what is
 sent: ``copy``, a payload on each of the two ways a payload goes to Python, each followed by one
 a byte longer; ``grow``, one String the program takes, whose output needs a larger buffer.
@@ -15,7 +15,7 @@ from typing import Any
 
 from ros_gz_bridge_py.native import extension
 from tests.unit.native.failing_alloc import while_failing
-from tests.unit.native.test_pump_loop import LEGIT, TOPIC, TYPE, Rig
+from tests.unit.native.pump_rig import LEGIT, TOPIC, TYPE, Rig
 
 #: A sender the pump has no route for: its frames are handed to Python to judge.
 UNKNOWN = b"unknown-sender"
