@@ -1,5 +1,5 @@
 """The one driver of the native loops: a thread per direction that runs its C ``Loop`` (loop.c)
-and does Python's share between the runs (docs/native.md §5).
+and does Python's share between the runs (docs/native.md §5, docs/threads.md).
 
 The C loop reads, converts and sends the messages of every member (Gazebo -> ROS: each
 channel's :class:`~ros_gz_bridge_py.native.pump.ChannelPump`; ROS -> Gazebo: each channel's

@@ -1,5 +1,5 @@
 """The two drivers of a queued subscription's socket owner (``socket_owner.py``): a reader with
-a thread of its own, or the native Gazebo -> ROS loop.
+a thread of its own, or the native Gazebo -> ROS loop (docs/threads.md).
 
 Through the node's shared SUB socket, every message of a queued subscription crossed two
 threads: the I/O thread read its four frames (pyzmq releases the GIL around each read) and
@@ -35,6 +35,7 @@ from typing import Any
 
 import zmq
 
+from ros_gz_bridge_py.libc import name_os_thread
 from ros_gz_bridge_py.transport.api import MessageInfo, NativeLoop
 from ros_gz_bridge_py.transport.budget import TURN_MESSAGES, TURN_SLICE
 from ros_gz_bridge_py.transport.delivery import (
@@ -196,6 +197,7 @@ class SubscriptionReader(_Driver):
 
     def _run(self) -> None:
         owner = self._owner
+        name_os_thread(self._thread.name)
         try:
             if self._on_start is not None:
                 self._on_start()

@@ -1,4 +1,4 @@
-"""A topic's SUB socket and what belongs to it, used from one thread.
+"""A topic's SUB socket and what belongs to it, used from one thread (docs/threads.md).
 
 A :class:`SocketOwner` holds a queued subscription's own SUB socket, subscribed to its one topic
 and connected to that topic's publishers (each topic has its own TCP connections, so a flooded
