@@ -10,7 +10,8 @@
 
 SHELL := /bin/bash
 PYTHON ?= python3
-VENV := .venv
+# One venv per interpreter: `make test PYTHON=python3.12` sets up and tests in .venv-python3.12.
+VENV ?= $(if $(filter python3,$(PYTHON)),.venv,.venv-$(notdir $(PYTHON)))
 PY := $(VENV)/bin/python
 DEMO_STAMP := $(VENV)/.ros_gz_bridge_py-setup-demo
 STAMP := $(VENV)/.ros_gz_bridge_py-setup
@@ -36,7 +37,6 @@ setup: $(STAMP)
 $(DEMO_STAMP): pyproject.toml tools/apt_ensure.sh tools/apt_get.sh tools/setup_build.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
 	bash tools/setup_build.sh
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[ros]'
 	bash tools/setup_interfaces.sh $(VENV) tf2_msgs
 	@touch $(DEMO_STAMP)

@@ -16,7 +16,7 @@
 # it was built from, and <pkg>.manifest the installed files: after a rebuild, those the new
 # build did not install again are removed, so no stale generated file survives (and the
 # package stays importable while it is rebuilt). Build trees go to
-# ROS_GZ_IFACE_BUILD_DIR (default: <repo>/.build/interfaces).
+# ROS_GZ_IFACE_BUILD_DIR (default: <repo>/.build/interfaces/<the venv's folder name>).
 set -euo pipefail
 
 # Build-time wheels. The wheels' metadata does not pull in the CMake packages that
@@ -53,7 +53,7 @@ PY=$VENV/bin/python
 [ -x "$PY" ] || die "$PY not found: VENV must be a Python venv with ros-jazzy-rclpy installed"
 REPO=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 SRC_ROOT=$REPO/interfaces
-BUILD_ROOT=${ROS_GZ_IFACE_BUILD_DIR:-$REPO/.build/interfaces}
+BUILD_ROOT=${ROS_GZ_IFACE_BUILD_DIR:-$REPO/.build/interfaces/$(basename "$VENV")}
 STAMP_DIR=$VENV/share/ros_gz_bridge_py_interfaces
 if [ $# -gt 0 ]; then PACKAGES=("$@"); else PACKAGES=("${DEFAULT_PACKAGES[@]}"); fi
 
