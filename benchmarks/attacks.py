@@ -10,7 +10,7 @@ What runs, all on loopback, on discovery ports of its own: the bridge (``/amp_cl
 Fortress peer publishing Clock at 500 Hz and Odometry at 50 Hz (its ``child_frame_id`` is
 ``real``, so its messages are told from the rogue's on ROS); one rclpy process counting what
 reaches ROS (``tests/faults/attack_ros.py``). A rogue ZeroMQ publisher that advertises itself
-through valid discovery (``tests/rogue.py``) then sends, one attack after the other:
+through valid discovery (``testing/rogue.py``) then sends, one attack after the other:
 
 - ``padded_odometry``: an Odometry padded with a 32 MB unknown field, as fast as ZeroMQ sends
   them (the rogue's send queue holds two and its sends wait for room: it never buffers more,
@@ -50,9 +50,9 @@ from benchmarks.soak import ATTACKS_SECTION, soak_env
 from ros_gz_bridge_py.app.settings import NATIVE_ENV
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.names import fully_qualified_name
-from tests.bridge.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
-from tests.gzpeer import peer_binary
-from tests.rogue import RoguePublisher
+from testing.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
+from testing.gzpeer import peer_binary
+from testing.rogue import RoguePublisher
 
 ROOT = Path(__file__).resolve().parent.parent
 ROS_SIDE = ROOT / "tests" / "faults" / "attack_ros.py"

@@ -27,7 +27,7 @@ from benchmarks.harness import (
     zenoh_override,
 )
 from benchmarks.tables import Row
-from tests.gzpeer import PeerProcess
+from testing.gzpeer import PeerProcess
 
 
 @dataclass(frozen=True)

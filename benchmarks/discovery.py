@@ -30,7 +30,7 @@ from rclpy.node import Node
 
 from benchmarks.harness import BIN, CpuWindow, bench_env, rss_mb, topic_name
 from benchmarks.report import write_section
-from tests.gzpeer import start_process, stop_processes, wait_for_line
+from testing.gzpeer import start_process, stop_processes, wait_for_line
 
 NEW_TOPICS = 10
 POLL = 0.005

@@ -30,7 +30,7 @@ from ros_gz_interfaces.srv import ControlWorld
 from benchmarks.harness import BIN, bench_env, topic_name
 from benchmarks.report import write_section
 from benchmarks.startup import CREATING, LOG_ENV
-from tests.gzpeer import start_peer, start_process, stop_processes, wait_for_line
+from testing.gzpeer import start_peer, start_process, stop_processes, wait_for_line
 
 POLL = 0.001
 #: A first call slower than this was resent (the next heartbeat), not just slow.

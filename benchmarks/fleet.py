@@ -5,7 +5,7 @@ Usage: ``.venv/bin/python -m benchmarks.fleet [--robots 10 25 50] [--seconds 20]
 Per fleet size N: the C++ peer on Ignition Transport 11 plays the simulator (mode
 ``pub-fleet``: one process, one node, publishing ``/clock`` at 1 kHz and each robot's odom
 50 Hz, imu 200 Hz and joint_states 100 Hz whether or not anyone subscribes, and subscribed to
-each robot's ``cmd_vel``; ``tests/fleet_sim.py``). One ``parameter_bridge`` with
+each robot's ``cmd_vel``; ``testing/fleet_sim.py``). One ``parameter_bridge`` with
 ``config/fleet_bridge.yaml`` and ``robot=robot_1,...`` (1 + 4N entries). One rclpy process
 (``benchmarks.fleet_ros sub``) takes every ROS topic serialized and counts per topic, and
 publishes every robot's ``cmd_vel`` at 10 Hz. Measured: start-up (from just before the bridge
@@ -35,9 +35,9 @@ from dataclasses import dataclass, field
 from benchmarks.harness import BIN, ROOT, CpuWindow, FlowFailure, bench_env, rss_mb, stop_all
 from benchmarks.report import write_section
 from benchmarks.results import store
-from tests import fleet_sim
-from tests.bridge.e2e_harness import status_rows
-from tests.gzpeer import PeerProcess, start_peer, start_process, threads_of, wait_for_line
+from testing import fleet_sim
+from testing.e2e_harness import status_rows
+from testing.gzpeer import PeerProcess, start_peer, start_process, threads_of, wait_for_line
 
 #: Where the quoted figures come from.
 QUOTED = "quoted from issue 28 (2026-11-28), measured by its author on 2 cores, not here"
@@ -416,7 +416,7 @@ def report(
         f"{args.seconds:g}`. 1-minute load average before the run: {load:.2f}; the machine "
         "(2 cores) is shared with other work, so every figure is noisy.",
         "",
-        "The simulator is the C++ peer on Ignition Transport 11 (`tests/peer`, mode `pub-fleet`: "
+        "The simulator is the C++ peer on Ignition Transport 11 (`testing/peer`, mode `pub-fleet`: "
         "one process, one node) publishing `/clock` at 1 kHz and per robot odom 50 Hz, imu "
         "200 Hz, joint_states 100 Hz (two joints), whether or not anyone subscribes, each "
         "message serialized once; it subscribes to every robot's `cmd_vel`. One "

@@ -28,7 +28,7 @@ from benchmarks.workers import MATCH_WAIT
 from benchmarks.workers import SETTLE as PUBLISH_SETTLE
 from ros_gz_bridge_py.app.settings import read_switches
 from ros_gz_bridge_py.ros.speed import apply_fastdds_profile, remove_zombie_segments
-from tests.gzpeer import PeerProcess, peer_binary, start_process, stop_processes, wait_for_line
+from testing.gzpeer import PeerProcess, peer_binary, start_process, stop_processes, wait_for_line
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
@@ -172,7 +172,7 @@ class CpuWindow:
 
 #: The sentence every report uses to say what its Gazebo ends are.
 GZ_ENDS = (
-    "Gazebo ends: on ZeroMQ, the C++ peer on the real Ignition Transport 11 (`tests/peer`, "
+    "Gazebo ends: on ZeroMQ, the C++ peer on the real Ignition Transport 11 (`testing/peer`, "
     "modes kind-pub and kind-sub), which serializes every message anew as a simulator does; "
     "on Zenoh, our Python workers (`benchmarks.workers`; Fortress has no Zenoh backend)."
 )
@@ -220,7 +220,7 @@ class Flood:
 
 
 def flood_options(flood: Flood | None, ign_peer: bool) -> list[str]:
-    """The publisher options of ``flood``: the C++ peer's (``tests/peer/flood.hh``), or the
+    """The publisher options of ``flood``: the C++ peer's (``testing/peer/flood.hh``), or the
     Python workers'."""
     if flood is None:
         return []

@@ -57,7 +57,7 @@ from benchmarks.workers import MATCH_WAIT
 from benchmarks.workers import SETTLE as PUBLISH_SETTLE
 from ros_gz_bridge_py.app.settings import NATIVE_ENV
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
-from tests.gzpeer import PeerProcess, peer_binary, start_process, wait_for_line
+from testing.gzpeer import PeerProcess, peer_binary, start_process, wait_for_line
 
 #: The bridge environment of each path, over :func:`~benchmarks.harness.bench_env`'s.
 PATHS = {"native": {}, "Python": {NATIVE_ENV: "off"}}

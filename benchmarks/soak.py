@@ -42,8 +42,8 @@ from ros_gz_bridge_py.transport.zmq.wire import (
     PublisherRecord,
     encode_discovery,
 )
-from tests.bridge.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
-from tests.gzpeer import PeerProcess, peer_binary
+from testing.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
+from testing.gzpeer import PeerProcess, peer_binary
 
 ROOT = Path(__file__).resolve().parent.parent
 ROS_SIDE = ROOT / "tests" / "faults" / "soak_ros.py"

@@ -4,7 +4,7 @@ Usage: ``.venv/bin/python -m benchmarks.startup [--counts 1 3 8 66] [--rounds 5]
 
 Per count N: ``parameter_bridge`` with N inline entries ``/t<i>@std_msgs/msg/String@
 gz.msgs.StringMsg`` (both directions, as in the issue), started ``--rounds`` times without
-traffic, then as often while the C++ peer on Ignition Transport 11 (``tests/peer``, mode
+traffic, then as often while the C++ peer on Ignition Transport 11 (``testing/peer``, mode
 pub-many: one process, one node, as upstream ros_gz_bridge's ``test_gz_publisher``) already
 publishes on every one of those Gazebo topics at ``--hz``. The
 times come from the bridge's own log (``{time}`` of rcutils, wall clock) minus the wall clock
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 from benchmarks.harness import BIN, ROOT, bench_env, topic_name
 from benchmarks.report import write_section
-from tests.gzpeer import start_peer, stop_processes, wait_for_line
+from testing.gzpeer import start_peer, stop_processes, wait_for_line
 
 #: What the issue measured for the C++ bridge (three inline entries, last ``Creating`` line).
 QUOTED_CPP_S = 0.15

@@ -32,7 +32,7 @@ from benchmarks.reference import CLOCK_UNDER_FLOOD, GOAL_CLOCK_SHARE, QUOTED
 from benchmarks.report import write_section
 from benchmarks.results import store
 from benchmarks.tables import verdict
-from tests.gzpeer import PeerProcess
+from testing.gzpeer import PeerProcess
 
 CLOCK_HZ = 1000.0
 #: Seconds the flood runs before the first clock message.

@@ -2,7 +2,7 @@
 
 Each test runs its own bridge process (``status_period:=0.5``) bridging one String topic
 Gazebo -> ROS, reads its counters from ``/diagnostics`` with rclpy and its memory and CPU from
-``/proc/<pid>``. The hostile peers (``tests/rogue.py``) are raw pyzmq sockets and raw discovery
+``/proc/<pid>``. The hostile peers (``testing/rogue.py``) are raw pyzmq sockets and raw discovery
 datagrams on loopback, bounded in count and time; the real publisher is the C++ ign-transport
 11 peer. Figures are printed (``-s`` shows them); asserts are the behaviour bounds of the
 issue, with the margins explained where they are made.
@@ -22,8 +22,8 @@ from std_msgs.msg import String
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.names import fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
-from tests.bridge.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge
-from tests.gzpeer import (
+from testing.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge
+from testing.gzpeer import (
     Inbox,
     PeerProcess,
     gz_processes,
@@ -33,7 +33,7 @@ from tests.gzpeer import (
     wait_for_line,
     wait_until,
 )
-from tests.rogue import FakePeer, RoguePublisher, TrapListeners, closed_ports, cpu_percent, usage
+from testing.rogue import FakePeer, RoguePublisher, TrapListeners, closed_ports, cpu_percent, usage
 
 __all__ = ["gz_processes", "ign_peer", "ros_side"]
 

@@ -16,8 +16,8 @@ import pytest
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.native import extension
-from tests.bridge.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge, started
-from tests.gzpeer import (
+from testing.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge, started
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,

@@ -18,7 +18,7 @@ import uuid
 import pytest
 from rcl_interfaces.srv import ListParameters
 
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -26,7 +26,7 @@ from tests.bridge.behaviour_harness import (
     start_bridge,
     started,
 )
-from tests.gzpeer import PeerProcess, unique_name, wait_until
+from testing.gzpeer import PeerProcess, unique_name, wait_until
 from tests.ros.test_bridge_node import PARAMETER_SERVICES as NODE_SERVICES
 
 __all__ = ["ros_side", "started"]

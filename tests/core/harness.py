@@ -4,7 +4,7 @@
   also spins the node of every bridge (its heartbeat and explain timers, its ROS->Gazebo
   callbacks). Whatever creates or destroys entities on a spun node goes through
   :meth:`RosWorld.run`, which holds the lock the spin loop holds (as ``RosSide`` of
-  ``tests/bridge/behaviour_harness.py`` does), so nothing changes under a running ``spin_once``.
+  ``testing/behaviour_harness.py`` does), so nothing changes under a running ``spin_once``.
 * :class:`Rig` is one :class:`~ros_gz_bridge_py.core.bridge.Bridge` on a ``MemoryGzNode`` of
   a private ``MemoryNetwork``; :meth:`Rig.gazebo` adds nodes on that network that play Gazebo
   processes (``native=Spelling.IGNITION`` for a Fortress one).

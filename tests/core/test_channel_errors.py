@@ -24,7 +24,7 @@ from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError, Undecoda
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import Rejection, TransportSettings
 from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
-from tests.polling import wait_until
+from testing.polling import wait_until
 
 STRING = "gz.msgs.StringMsg"
 IMAGE = "gz.msgs.Image"

@@ -14,7 +14,7 @@ from __future__ import annotations
 import pytest
 
 from benchmarks.attacks import AttackRun, attacks
-from tests.gzpeer import require_peer
+from testing.gzpeer import require_peer
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
 

@@ -18,7 +18,7 @@ if _ROOT not in sys.path:
     sys.path.insert(0, _ROOT)
 
 from ros_gz_bridge_py.transport import create_gz_node  # noqa: E402
-from tests.gzpeer import gz_processes, ign_peer  # noqa: E402
+from testing.gzpeer import gz_processes, ign_peer  # noqa: E402
 
 __all__ = ["gz_node", "gz_processes", "ign_peer", "stop_started_processes"]
 

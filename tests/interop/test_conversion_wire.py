@@ -78,7 +78,7 @@ from vision_msgs.msg import Detection2D
 from ros_gz_bridge_py.converters import default_registry
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import create_gz_node
-from tests.gzpeer import (
+from testing.gzpeer import (
     IGN_TOPIC,
     Inbox,
     PeerProcess,

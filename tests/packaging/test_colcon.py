@@ -12,7 +12,7 @@ import subprocess
 
 import pytest
 
-from tests.gzpeer import ROOT
+from testing.gzpeer import ROOT
 
 pytestmark = [pytest.mark.slow]
 

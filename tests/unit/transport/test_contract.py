@@ -26,8 +26,8 @@ from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
 from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
 from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
-from tests.loopback import free_port
-from tests.polling import wait_until
+from testing.loopback import free_port
+from testing.polling import wait_until
 
 GZ, IGN = "gz.msgs.StringMsg", "ignition.msgs.StringMsg"
 StringMsg = message_class(GZ)

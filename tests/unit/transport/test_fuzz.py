@@ -23,7 +23,7 @@ from ros_gz_bridge_py.transport.zmq.wire import (
     PublisherRecord,
     encode_discovery,
 )
-from tests.polling import wait_until
+from testing.polling import wait_until
 
 COUNT = 2000
 

@@ -30,8 +30,8 @@ from ros_gz_bridge_py.transport.zenoh.config import (
     session_config,
 )
 from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
-from tests.loopback import free_port
-from tests.polling import wait_until
+from testing.loopback import free_port
+from testing.polling import wait_until
 
 PEER_SCRIPT = Path(__file__).with_name("zenoh_peer.py")
 ROOT = PEER_SCRIPT.parents[3]

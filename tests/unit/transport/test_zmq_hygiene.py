@@ -1,7 +1,7 @@
 """The ZeroMQ node against hostile and vanished peers (issue 14, points 2-4), in-process.
 
 Rogue publishers and fake peers are raw pyzmq sockets and raw discovery datagrams on
-loopback (``tests/rogue.py``); each test is bounded in what it sends and in time.
+loopback (``testing/rogue.py``); each test is bounded in what it sends and in time.
 """
 
 from __future__ import annotations
@@ -23,8 +23,8 @@ from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import MessageInfo, Rejection, TransportSettings
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
 from ros_gz_bridge_py.transport.zmq.wire import ServiceRequest, encode_request
-from tests.polling import wait_until
-from tests.rogue import FakePeer, RoguePublisher, TrapListeners
+from testing.polling import wait_until
+from testing.rogue import FakePeer, RoguePublisher, TrapListeners
 
 STRING = "gz.msgs.StringMsg"
 StringMsg = message_class(STRING)

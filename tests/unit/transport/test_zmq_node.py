@@ -15,7 +15,7 @@ from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
 from ros_gz_bridge_py.transport import MessageInfo, create_gz_node
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
-from tests.polling import wait_until
+from testing.polling import wait_until
 
 StringMsg = message_class("gz.msgs.StringMsg")
 

@@ -1,7 +1,7 @@
 """Processes of the end-to-end bridge tests: the bridge, the rclpy checker, Gazebo echoes.
 
-Every process is a :class:`tests.gzpeer.PeerProcess` owned by a :class:`ProcessGroup`, which
-stops them together. They are not registered with ``tests.gzpeer.stop_processes``: a run is
+Every process is a :class:`testing.gzpeer.PeerProcess` owned by a :class:`ProcessGroup`, which
+stops them together. They are not registered with ``testing.gzpeer.stop_processes``: a run is
 shared by the tests of a module, and another test's per-test clean-up must not end it.
 Output is parsed from the lines collected so far, so checks can poll without consuming.
 """
@@ -22,7 +22,7 @@ import yaml
 from google.protobuf import text_format
 
 from ros_gz_bridge_py.msgs import message_class
-from tests.gzpeer import PeerProcess, peer_binary
+from testing.gzpeer import PeerProcess, peer_binary
 
 #: The console script of the venv running the tests (``pip install -e .`` put it next to the
 #: interpreter; a worktree or a copy of the checkout has no ``.venv`` of its own).

@@ -1,6 +1,6 @@
 """Harness for tests that talk to real Ignition Transport 11 processes.
 
-Three kinds of real peers are offered: our scriptable C++ peer (``tests/peer``, built here on
+Three kinds of real peers are offered: our scriptable C++ peer (``testing/peer``, built here on
 first use, once per source hash, into ``.build/ign_peer/<hash>/``), and the Debian CLI
 binaries ``ign-transport-topic`` / ``ign-transport-service`` (called directly; the ``ign``
 Ruby wrapper is broken on bookworm). Every process started through this module is
@@ -9,7 +9,7 @@ test end: SIGTERM, then SIGKILL after a grace period).
 
 The peer prints one machine-readable record per line (``READY``, ``MSG <type> <text>``,
 ``COUNT n BYTES b``, ``RESPONSE``/``FAILED``/``TIMEOUT``, ``STATS ...``); see
-``tests/peer/main.cc``. Environment: processes inherit ours, so the loopback settings that
+``testing/peer/main.cc``. Environment: processes inherit ours, so the loopback settings that
 ``tests/conftest.py`` puts in ``os.environ`` reach them.
 """
 
@@ -34,7 +34,7 @@ from typing import Any
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-PEER_SOURCE = ROOT / "tests" / "peer"
+PEER_SOURCE = ROOT / "testing" / "peer"
 BUILD_ROOT = ROOT / ".build" / "ign_peer"
 IGN_TOOLS = Path("/usr/libexec/ignition/transport11")
 IGN_TOPIC = IGN_TOOLS / "ign-transport-topic"

@@ -1,7 +1,7 @@
 """Shared pieces of the end-to-end behaviour tests: a bridge process, a ROS side, a Gazebo side.
 
 * :func:`start_bridge` runs the real ``parameter_bridge`` console script (through
-  :func:`tests.gzpeer.start_process`, so it inherits the loopback environment of
+  :func:`testing.gzpeer.start_process`, so it inherits the loopback environment of
   ``tests/conftest.py`` and is killed with the other started processes).
 * :class:`RosSide` is an rclpy node in a context of its own, spun by a background thread; every
   call that touches the node goes through :meth:`RosSide.run`, which holds the lock the spin
@@ -16,11 +16,9 @@ at the end of their module (never through ``stop_processes``, which would stop e
 
 from __future__ import annotations
 
-import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
-from pathlib import Path
 from typing import Any, TypeVar
 
 import pytest
@@ -31,10 +29,9 @@ from rclpy.qos import QoSProfile
 from rclpy.utilities import try_shutdown
 
 from ros_gz_bridge_py.transport import GzNode, create_gz_node
-from tests.gzpeer import Inbox, PeerProcess, start_process, wait_for_line, wait_until
+from testing.e2e_harness import PARAMETER_BRIDGE
+from testing.gzpeer import Inbox, PeerProcess, start_process, wait_for_line, wait_until
 
-#: The console script of this venv (``pip install -e .`` put it next to the interpreter).
-PARAMETER_BRIDGE = Path(sys.prefix) / "bin" / "parameter_bridge"
 STRING = "ignition.msgs.StringMsg"
 #: Upper bound of every wait for something that should happen (discovery, delivery).
 WAIT = 10.0

@@ -1,5 +1,5 @@
 // Line-oriented, machine-readable output: one record per line, flushed at once, safe to call
-// from transport callback threads. Tests parse these lines (see tests/gzpeer.py).
+// from transport callback threads. Tests parse these lines (see testing/gzpeer.py).
 #pragma once
 
 #include <google/protobuf/message.h>
