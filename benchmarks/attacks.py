@@ -36,7 +36,6 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 import uuid
 from dataclasses import dataclass, field
@@ -45,13 +44,13 @@ from typing import Any
 
 import zmq
 
-from benchmarks.harness import cpu_seconds, rss_mb
 from benchmarks.soak import ATTACKS_SECTION, soak_env
 from ros_gz_bridge_py.app.settings import NATIVE_ENV
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.names import fully_qualified_name
 from testing.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
 from testing.gzpeer import peer_binary
+from testing.procstat import MB, PeakRss, cpu_seconds, rss_mb
 from testing.rogue import RoguePublisher
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -64,8 +63,6 @@ ODOM_TEXT = (
 )
 #: Seconds to wait for the bridge, the peers and the ROS side to be connected.
 START_LIMIT = 60.0
-#: Seconds between two RSS samples of the bridge (for its peak).
-SAMPLE_EVERY = 0.01
 SECTION = ATTACKS_SECTION
 PATHS = ("native", "python")
 
@@ -155,26 +152,6 @@ class Outcome:
     #: The largest serialized message of each topic on ROS so far.
     largest: dict[str, int] = field(default_factory=dict)
     bridge_alive: bool = True
-
-
-class PeakRss:
-    """Samples a process's RSS on a thread, keeping the peak."""
-
-    def __init__(self, pid: int) -> None:
-        self._pid = pid
-        self.peak = rss_mb(pid)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        while not self._stop.wait(SAMPLE_EVERY):
-            self.peak = max(self.peak, rss_mb(self._pid))
-
-    def stop(self) -> float:
-        self._stop.set()
-        self._thread.join()
-        return self.peak
 
 
 class AttackRun:
@@ -311,7 +288,7 @@ class AttackRun:
             rogue.close()
         time.sleep(self.after)
         after = rss_mb(pid) if self.bridge.poll() is None else 0.0
-        highest = peak.stop()
+        highest = peak.stop() / MB
         first, last = self._counts_at(start), self._counts_at(end)
         span = end - start
 

@@ -32,12 +32,14 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from benchmarks.harness import BIN, ROOT, CpuWindow, FlowFailure, bench_env, rss_mb, stop_all
+from benchmarks.harness import BIN, ROOT, CpuWindow, FlowFailure, stop_all
 from benchmarks.report import write_section
 from benchmarks.results import store
 from testing import fleet_sim
 from testing.e2e_harness import status_rows
-from testing.gzpeer import PeerProcess, start_peer, start_process, threads_of, wait_for_line
+from testing.gzpeer import PeerProcess, start_peer, start_process, wait_for_line
+from testing.procstat import rss_mb, threads_of
+from testing.run_env import run_env
 
 #: Where the quoted figures come from.
 QUOTED = "quoted from issue 28 (2026-11-28), measured by its author on 2 cores, not here"
@@ -292,7 +294,7 @@ class Idle:
 def idle_round(robots: int, seconds: float) -> Idle:
     """The fleet's bridge alone, no simulator, no subscriber: CPU over ``seconds``."""
     print(f"== idle bridge of {robots} robots", file=sys.stderr)
-    env = {**bench_env(), "PYTHONPATH": str(ROOT)}
+    env = {**run_env(), "PYTHONPATH": str(ROOT)}
     names = fleet_sim.robots(robots)
     try:
         bridge = start_process(
@@ -315,7 +317,7 @@ def run(robots: int, seconds: float, ceiling: bool) -> Round:
     print(f"== fleet of {robots}, {'ceiling' if ceiling else 'bridge'}", file=sys.stderr)
     try:
         measure = ceiling_round if ceiling else bridge_round
-        result = measure(robots, seconds, bench_env())
+        result = measure(robots, seconds, run_env())
     except FlowFailure as error:  # reported in the table instead
         first = (str(error).strip().splitlines() or [type(error).__name__])[0]
         result = Round(robots, ceiling, error=first[:160])

@@ -41,7 +41,6 @@ from benchmarks.harness import (
     Flow,
     FlowFailure,
     FlowResult,
-    bench_env,
     bridge_argument,
     bridge_config,
     failed,
@@ -58,8 +57,9 @@ from benchmarks.workers import SETTLE as PUBLISH_SETTLE
 from ros_gz_bridge_py.app.settings import NATIVE_ENV
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from testing.gzpeer import PeerProcess, peer_binary, start_process, wait_for_line
+from testing.run_env import run_env
 
-#: The bridge environment of each path, over :func:`~benchmarks.harness.bench_env`'s.
+#: The bridge environment of each path, over :func:`~benchmarks.harness.run_env`'s.
 PATHS = {"native": {}, "Python": {NATIVE_ENV: "off"}}
 #: The ROS ends of the overload phase: whether each takes the messages serialized. "rclpy"
 #: deserializes every message as an application does and so tops out at its own rate on these
@@ -95,7 +95,7 @@ OVERLOAD_PNG = "benchmarks/plots/native_overload.png"
 
 def path_backend(path: str) -> Backend:
     """ZeroMQ, the bridge on ``path`` (the Gazebo and ROS ends as every benchmark's)."""
-    env = bench_env()
+    env = run_env()
     bridge_env = {key: value for key, value in env.items() if key != NATIVE_ENV}
     return Backend(f"ZeroMQ, {path} path", bridge_env | PATHS[path], env)
 
@@ -500,7 +500,7 @@ def _workload(path: str, seconds: float) -> Workload:
     with bridge_process(arguments, which.bridge_env, channels=TURTLEBOT_CHANNELS) as bridge:
         if bridge is None:
             return Workload(path, seconds, error="bridge did not start")
-        sub = start_process(command, bench_env())
+        sub = start_process(command, run_env())
         wait_for_line(sub, "^READY$", 30)
         wait_for_line(sub, "^MATCHED$", 20)
         time.sleep(3.0)  # as SETTLE_ROS: the bridge's writers reach the subscriber

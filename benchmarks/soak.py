@@ -31,7 +31,6 @@ from typing import Any
 
 import zmq
 
-from benchmarks.harness import bench_env, cpu_seconds, rss_mb
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.names import fully_qualified_name
@@ -44,6 +43,8 @@ from ros_gz_bridge_py.transport.zmq.wire import (
 )
 from testing.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
 from testing.gzpeer import PeerProcess, peer_binary
+from testing.procstat import cpu_seconds, rss_mb
+from testing.run_env import run_env
 
 ROOT = Path(__file__).resolve().parent.parent
 ROS_SIDE = ROOT / "tests" / "faults" / "soak_ros.py"
@@ -75,8 +76,8 @@ class Figures:
 
 
 def soak_env() -> dict[str, str]:
-    """bench_env with discovery ports of the soak's own."""
-    env = bench_env()
+    """run_env with discovery ports of the soak's own."""
+    env = run_env()
     port = random.randrange(21000, 29000, 2)
     for prefix in ("GZ_", "IGN_"):
         env[prefix + "DISCOVERY_MSG_PORT"] = str(port)

@@ -277,12 +277,6 @@ def ign_peer() -> Path:
     return peer_binary()
 
 
-def threads_of(process: subprocess.Popen[str]) -> int:
-    """The number of threads of a running process (Linux)."""
-    status = Path(f"/proc/{process.pid}/status").read_text(encoding="ascii")
-    return int(next(line for line in status.splitlines() if line.startswith("Threads:")).split()[1])
-
-
 class Inbox:
     """Collects what a subscription callback receives, for assertions in the test thread.
 

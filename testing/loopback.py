@@ -1,10 +1,11 @@
-"""Addresses and settings that keep a test's traffic on this host."""
+"""Addresses and environments that keep a run's traffic on this host."""
 
 from __future__ import annotations
 
 import json
 import os
 import socket
+from collections.abc import Sequence
 
 
 def free_port() -> int:
@@ -15,18 +16,25 @@ def free_port() -> int:
         return port
 
 
-def zenoh_env(mode: str, listen: list[str], connect: list[str]) -> dict[str, str]:
-    """Our environment plus the gz-transport 15 Zenoh settings for one process: ``mode``
-    (peer, client), explicit endpoints, no multicast or gossip scouting."""
-    overrides = {
+def zenoh_override(
+    mode: str = "peer", listen: Sequence[str] = (), connect: Sequence[str] = ()
+) -> str:
+    """``GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE`` for one process: ``mode`` (peer, client), explicit
+    endpoints only, no multicast or gossip scouting."""
+    entries = {
         "mode": json.dumps(mode),
         "scouting/multicast/enabled": "false",
         "scouting/gossip/enabled": "false",
-        "listen/endpoints": json.dumps(listen),
-        "connect/endpoints": json.dumps(connect),
+        "listen/endpoints": json.dumps(list(listen)),
+        "connect/endpoints": json.dumps(list(connect)),
     }
+    return ";".join(f"{key}={value}" for key, value in entries.items())
+
+
+def zenoh_env(mode: str, listen: list[str], connect: list[str]) -> dict[str, str]:
+    """Our environment plus the gz-transport 15 Zenoh settings of :func:`zenoh_override`."""
     return dict(
         os.environ,
         GZ_TRANSPORT_IMPLEMENTATION="zenoh",
-        GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE=";".join(f"{k}={v}" for k, v in overrides.items()),
+        GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE=zenoh_override(mode, listen, connect),
     )

@@ -1,5 +1,5 @@
 """Hostile and fake Gazebo Transport peers for the hygiene tests, written with raw pyzmq and
-raw UDP datagrams, and the /proc readings the tests assert on.
+raw UDP datagrams.
 
 Everything stays on this host: datagrams go to the discovery group with TTL 0 through the
 loopback interface (``GZ_IP`` of tests/conftest.py), sockets bind 127.0.0.1. Every peer is
@@ -9,14 +9,13 @@ after :data:`MAX_LIFE` seconds at the latest).
 
 from __future__ import annotations
 
-import os
 import selectors
 import socket
 import threading
 import time
 import uuid
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import zmq
@@ -36,8 +35,6 @@ from ros_gz_bridge_py.transport.zmq.wire import (
 
 #: The longest a fake peer heartbeats, whatever the test does (s).
 MAX_LIFE = 60.0
-#: Clock ticks per second of /proc/<pid>/stat.
-CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 
 
 def discovery_socket() -> socket.socket:
@@ -281,33 +278,3 @@ def closed_ports(count: int) -> list[str]:
     for sock in socks:
         sock.close()
     return addresses
-
-
-@dataclass(frozen=True)
-class Usage:
-    """A process's resident memory and CPU time at one moment (from /proc/<pid>)."""
-
-    at: float
-    rss_bytes: int
-    cpu_seconds: float
-
-
-def usage(pid: int) -> Usage:
-    """Resident set size (VmRSS) and user+system CPU time of process ``pid``."""
-    rss = 0
-    with open(f"/proc/{pid}/status", encoding="ascii") as status:
-        for line in status:
-            if line.startswith("VmRSS:"):
-                rss = int(line.split()[1]) * 1024
-    with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
-        fields = stat.read().rsplit(")", 1)[1].split()
-    utime, stime = int(fields[11]), int(fields[12])
-    return Usage(time.monotonic(), rss, (utime + stime) / CLOCK_TICKS)
-
-
-def cpu_percent(pid: int, seconds: float) -> float:
-    """Percent of one core that ``pid`` used over the next ``seconds``."""
-    before = usage(pid)
-    time.sleep(seconds)
-    after = usage(pid)
-    return 100 * (after.cpu_seconds - before.cpu_seconds) / (after.at - before.at)

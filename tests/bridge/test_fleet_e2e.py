@@ -34,7 +34,8 @@ from testing.e2e_harness import (
     status_rows,
     wait_all,
 )
-from testing.gzpeer import ROOT, PeerProcess, require_peer, threads_of, wait_for_line
+from testing.gzpeer import ROOT, PeerProcess, require_peer, wait_for_line
+from testing.procstat import threads_of
 from tests.bridge.e2e_values import mismatches
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros]

@@ -25,8 +25,8 @@ from ros_gz_bridge_py.transport.names import fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from testing.behaviour_harness import WAIT, RosSide, gz_node, ros_side, start_bridge
 from testing.gzpeer import Inbox, PeerProcess, unique_name, wait_until
-from testing.rogue import RogueSubscriber, usage
-from tests.bridge.test_hostile_gazebo import PeakRss
+from testing.procstat import PeakRss, usage
+from testing.rogue import RogueSubscriber
 
 __all__ = ["gz_node", "ros_side"]
 
