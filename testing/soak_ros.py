@@ -1,4 +1,4 @@
-"""The ROS side of the soak (``benchmarks/soak.py``): ``python soak_ros.py SPEC``.
+"""The ROS side of the soak (``testing/soak.py``): ``python soak_ros.py SPEC``.
 
 SPEC is JSON: ``{"clock": t, "odom": t, "cmd": t, "service": s, "seconds": n}``. Subscribes to
 the clock and odometry topics, publishes ``Twist`` on ``cmd`` at 50 Hz (``linear.x`` = 1, 2, ...),

@@ -1,4 +1,4 @@
-"""The ROS side of the attack suite (``benchmarks/attacks.py``): ``python attack_ros.py SPEC``.
+"""The ROS side of the attack suite (``testing/attacks.py``): ``python attack_ros.py SPEC``.
 
 SPEC is JSON: ``{"clock": t, "odom": t, "tf": t, "seconds": n}``. Subscribes to the three
 topics as serialized messages (no deserialization: the counting must not be the bottleneck)
@@ -25,7 +25,7 @@ from tf2_msgs.msg import TFMessage
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 PRINT_EVERY = 0.25
-#: What the real Odometry publisher puts in child_frame_id (``benchmarks/attacks.py``).
+#: What the real Odometry publisher puts in child_frame_id (``testing/attacks.py``).
 REAL_MARK = b"real"
 
 
