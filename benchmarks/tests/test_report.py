@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import fleet, report, results
+from benchmarks import fleet_goals, report, results
 from benchmarks.costs import split_text, thread_split_ms
-from benchmarks.fleet import Round
+from benchmarks.fleet_goals import Round
 from benchmarks.harness import FlowResult, thread_group_seconds
 from benchmarks.sustained import highest
 
@@ -111,11 +111,13 @@ def test_the_split_is_per_delivered_message_and_survives_the_results_file(
 def test_the_fleet_goals_are_judged_on_the_bridge_rows_against_the_quoted_cpp_bridge() -> None:
     def row(robots: int, us: float, threads: int, startup: float, **shares: float) -> Round:
         # One second, 10,000 messages: the CPU percentage is the µs per message.
-        delivered = {kind: shares.get(kind, 1.0) for kind in fleet.KINDS}
+        delivered = {kind: shares.get(kind, 1.0) for kind in fleet_goals.KINDS}
         return Round(robots, False, 1.0, us, delivered, 10_000, threads, 100.0, startup)
 
     ceiling = dataclasses.replace(row(25, 1.0, 99, 0.0), ceiling=True)
-    lines = fleet.goal_lines([row(10, 30.0, 15, 1.0), row(25, 40.0, 25, 3.0, imu=0.98), ceiling])
+    lines = fleet_goals.goal_lines(
+        [row(10, 30.0, 15, 1.0), row(25, 40.0, 25, 3.0, imu=0.98), ceiling]
+    )
     verdicts = {line.split(":")[0].split(" (")[0]: line.rsplit("— ", 1)[1] for line in lines}
     assert verdicts == {
         "- CPU per delivered message at 10 robots <= 0.8x C++": "**met**",  # 30 <= 61.0
