@@ -27,11 +27,9 @@ from testing.behaviour_harness import (
     started,
 )
 from testing.gzpeer import PeerProcess, unique_name, wait_until
-from tests.ros.test_bridge_node import PARAMETER_SERVICES as NODE_SERVICES
+from tests.rclpy_services import PARAMETER_SERVICES
 
 __all__ = ["ros_side", "started"]
-
-PARAMETER_SERVICES = frozenset(NODE_SERVICES)
 
 
 def services_by_node(ros: RosSide) -> dict[str, set[str]]:

@@ -115,7 +115,7 @@ NEW_CONNECTION = bytes.fromhex(
     "2e537472696e674d736720ffffffffffffffffff01"
 )
 UINT64_MAX = 2**64 - 1
-REPO_ROOT = Path(__file__).resolve().parents[2]
+REPO_ROOT = Path(__file__).resolve().parents[3]
 
 
 def _body(datagram: bytes) -> bytes:

@@ -15,7 +15,7 @@ from ros_gz_bridge_py.app import bridge_types
 from ros_gz_bridge_py.converters import registry
 from ros_gz_bridge_py.msgs import message_class
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "converter_plugin"
+EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "converter_plugin"
 
 
 @pytest.fixture

@@ -15,8 +15,8 @@ from ros_gz_bridge_py.config import (
     read_yaml_file,
 )
 
-FIXTURES = Path(__file__).parent / "fixtures" / "config"
-EXAMPLES = Path(__file__).parents[2] / "config"
+FIXTURES = Path(__file__).parent / "fixtures"
+EXAMPLES = Path(__file__).parents[3] / "config"
 
 
 _TYPES = "  ros_type_name: std_msgs/msg/String\n  gz_type_name: gz.msgs.StringMsg\n"

@@ -5,7 +5,7 @@ announces and asks for its own spelling only; a generic subscriber (``ign topic 
 recorder) registers with every publisher of the topic and decodes only the names its line
 knows. Against such nodes our publisher (announced under both spellings) must send each
 message once, in the spelling each line takes (§9.2). What every backend shares is in
-``test_contract.py``.
+``tests/unit/transport/test_node_contract.py``.
 """
 
 from __future__ import annotations

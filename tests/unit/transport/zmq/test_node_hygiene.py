@@ -257,7 +257,7 @@ def test_disconnecting_after_a_poll_aborts_libzmq_unless_the_socket_is_drained_f
     the libzmq pyzmq bundles): zmq_poll prefetches a message's first frame, a disconnect then
     drops the rest, and the next read aborts the process in fq.cpp. SubConnections.disconnect
     reads whole messages first."""
-    root = str(Path(__file__).resolve().parents[3])
+    root = str(Path(__file__).resolve().parents[4])
     script = textwrap.dedent(_FQ_ABORT).format(root=root)
     command = [sys.executable, "-c", script, how]
     done = subprocess.run(command, capture_output=True, text=True, timeout=30, check=False)

@@ -16,18 +16,9 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
 from ros_gz_bridge_py.ros.bridge_node import BridgeNode
+from tests.rclpy_services import PARAMETER_SERVICES
 
 pytestmark = pytest.mark.ros
-
-PARAMETER_SERVICES = (
-    "describe_parameters",
-    "get_parameter_types",
-    "get_parameters",
-    "get_type_description",
-    "list_parameters",
-    "set_parameters",
-    "set_parameters_atomically",
-)
 
 
 def unique(stem: str) -> str:

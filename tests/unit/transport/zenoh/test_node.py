@@ -34,7 +34,7 @@ from testing.loopback import free_port
 from testing.polling import wait_until
 
 PEER_SCRIPT = Path(__file__).with_name("zenoh_peer.py")
-ROOT = PEER_SCRIPT.parents[3]
+ROOT = PEER_SCRIPT.parents[4]
 STRING = "gz.msgs.StringMsg"
 EMPTY = "gz.msgs.Empty"
 StringMsg = message_class(STRING)
