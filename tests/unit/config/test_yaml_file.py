@@ -1,4 +1,5 @@
-"""Bridge YAML files: the C++ config tests (docs/behaviour.md §4.4), real files, located errors."""
+"""Bridge YAML files: the C++ config tests (docs/behaviour.md §4.4) and located errors; the real
+files of ``config/`` are read in test_yaml_file_real_configs.py."""
 
 from __future__ import annotations
 
@@ -16,7 +17,6 @@ from ros_gz_bridge_py.config import (
 )
 
 FIXTURES = Path(__file__).parent / "fixtures"
-EXAMPLES = Path(__file__).parents[3] / "config"
 
 
 _TYPES = "  ros_type_name: std_msgs/msg/String\n  gz_type_name: gz.msgs.StringMsg\n"
@@ -418,100 +418,3 @@ def test_non_utf8_file(tmp_path: Path) -> None:
     assert _only_error(read_yaml_file(path)) == (
         f"Could not parse config: file is not UTF-8 text [{path}]"
     )
-
-
-_REAL_ENTRIES = [
-    ("clock", "clock", "rosgraph_msgs/msg/Clock", "gz.msgs.Clock", Direction.GZ_TO_ROS),
-    (
-        "joint_states",
-        "joint_states",
-        "sensor_msgs/msg/JointState",
-        "gz.msgs.Model",
-        Direction.GZ_TO_ROS,
-    ),
-    ("odom", "odom", "nav_msgs/msg/Odometry", "gz.msgs.Odometry", Direction.GZ_TO_ROS),
-    ("tf", "tf", "tf2_msgs/msg/TFMessage", "gz.msgs.Pose_V", Direction.GZ_TO_ROS),
-    ("cmd_vel", "cmd_vel", "geometry_msgs/msg/Twist", "gz.msgs.Twist", Direction.ROS_TO_GZ),
-    ("imu", "imu", "sensor_msgs/msg/Imu", "gz.msgs.IMU", Direction.GZ_TO_ROS),
-    ("scan", "scan", "sensor_msgs/msg/LaserScan", "gz.msgs.LaserScan", Direction.GZ_TO_ROS),
-    (
-        "camera/camera_info",
-        "camera/camera_info",
-        "sensor_msgs/msg/CameraInfo",
-        "gz.msgs.CameraInfo",
-        Direction.GZ_TO_ROS,
-    ),
-]
-
-
-def _real_summary(path: Path) -> list[tuple[str, str, str, str, Direction]]:
-    result = read_yaml_file(path)
-    assert (result.errors, result.warnings) == ((), ())
-    topics = _topics(result)
-    for spec in topics:
-        assert (spec.lazy, spec.publisher_queue, spec.subscriber_queue) == (None, None, None)
-        assert (spec.qos_profile, spec.frame_id) == (None, None)
-    return [(s.ros_topic, s.gz_topic, s.ros_type, s.gz_type, s.direction) for s in topics]
-
-
-def test_turtlebot3_waffle_config_loads_unchanged() -> None:
-    path = EXAMPLES / "turtlebot3_waffle_bridge.yaml"
-    assert _real_summary(path) == _REAL_ENTRIES
-    lines = [spec.source for spec in read_yaml_file(path).specs]
-    assert lines[0] == f"{path} entry 1 (line 4)"
-    assert lines[-1] == f"{path} entry 8 (line 46)"
-
-
-def test_fleet_example_is_one_robot_file_per_robot_plus_the_clock() -> None:
-    """config/fleet_bridge.yaml (ours, one process) and config/fleet_robot.yaml (the C++
-    bridge's form, once per robot namespace) bridge the same topics."""
-    robots = ("robot_1", "robot_2")
-    fleet = read_yaml_file(EXAMPLES / "fleet_bridge.yaml", {"robot": robots})
-    assert (fleet.errors, fleet.warnings) == ((), ())
-    one_robot = _real_summary(EXAMPLES / "fleet_robot.yaml")
-    per_robot = [
-        (f"/{robot}/{ros}", f"/{robot}/{gz}", *rest)
-        for robot in robots
-        for ros, gz, *rest in one_robot
-    ]
-    clock = ("/clock", "/clock", "rosgraph_msgs/msg/Clock", "gz.msgs.Clock", Direction.GZ_TO_ROS)
-    fleet_topics = [
-        (s.ros_topic, s.gz_topic, s.ros_type, s.gz_type, s.direction) for s in _topics(fleet)
-    ]
-    assert sorted(fleet_topics) == sorted([clock, *per_robot])
-
-
-def test_diff_car_config_loads_unchanged() -> None:
-    path = EXAMPLES / "diff_car_bridge.yaml"
-    assert _real_summary(path) == [
-        *_REAL_ENTRIES,
-        (
-            "/camera/image",
-            "/camera/image",
-            "sensor_msgs/msg/Image",
-            "gz.msgs.Image",
-            Direction.GZ_TO_ROS,
-        ),
-        (
-            "/camera/depth_image",
-            "/camera/depth_image",
-            "sensor_msgs/msg/Image",
-            "gz.msgs.Image",
-            Direction.GZ_TO_ROS,
-        ),
-        (
-            "/camera/points",
-            "/camera/points",
-            "sensor_msgs/msg/PointCloud2",
-            "gz.msgs.PointCloudPacked",
-            Direction.GZ_TO_ROS,
-        ),
-    ]
-
-
-def test_examples_are_the_shared_files_unchanged() -> None:
-    shared = Path("/work/shared/data/configs")
-    if not shared.is_dir():
-        pytest.skip("the shared data directory exists only on the development machine")
-    for name in ("turtlebot3_waffle_bridge.yaml", "diff_car_bridge.yaml"):
-        assert (EXAMPLES / name).read_bytes() == (shared / name).read_bytes()
