@@ -37,7 +37,8 @@ from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.msgs.names import Spelling
-from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
+from ros_gz_bridge_py.transport.memory.network import MemoryNetwork
+from ros_gz_bridge_py.transport.memory.node import MemoryGzNode
 
 #: History depth of the test node's endpoints: deeper than any burst a test sends, so the
 #: test's reader keeps every message until its executor takes it.

@@ -22,7 +22,8 @@ from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.transport import BACKENDS, GzNode, MessageInfo, Rejection, TransportSettings
 from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER
-from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
+from ros_gz_bridge_py.transport.memory.network import MemoryNetwork
+from ros_gz_bridge_py.transport.memory.node import MemoryGzNode
 from ros_gz_bridge_py.transport.zenoh.config import endpoints_config
 from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode

@@ -18,7 +18,8 @@ import pytest
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.transport import MessageInfo
-from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
+from ros_gz_bridge_py.transport.memory.network import MemoryNetwork
+from ros_gz_bridge_py.transport.memory.node import MemoryGzNode
 
 GZ, IGN = "gz.msgs.StringMsg", "ignition.msgs.StringMsg"
 StringMsg = message_class(GZ)
