@@ -30,10 +30,7 @@ from typing import Any, TypeVar, cast
 import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError
-from ros_gz_bridge_py.transport.api import (
-    Scope,
-    ServiceHandler,
-)
+from ros_gz_bridge_py.transport.api import Scope, ServiceHandler
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, TransportSettings
