@@ -34,8 +34,8 @@ from ros_gz_bridge_py.transport.api import Scope, ServiceHandler
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, TransportSettings
-from ros_gz_bridge_py.transport.zmq.discovery import (
-    DiscoveryEngine,
+from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine
+from ros_gz_bridge_py.transport.zmq.discovery_events import (
     Event,
     PublisherAdded,
     PublisherRemoved,

@@ -18,7 +18,8 @@ from ros_gz_bridge_py.errors import TransportError
 from ros_gz_bridge_py.transport.api import GraphEndpoint, TopicInfo
 from ros_gz_bridge_py.transport.node import GzNode
 from ros_gz_bridge_py.transport.zmq import graph
-from ros_gz_bridge_py.transport.zmq.discovery import INIT_DELAY, DiscoveryEngine, Outgoing
+from ros_gz_bridge_py.transport.zmq.discovery import INIT_DELAY, DiscoveryEngine
+from ros_gz_bridge_py.transport.zmq.discovery_events import Outgoing
 from ros_gz_bridge_py.transport.zmq.sockets import NodeSockets
 from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket
 

@@ -9,6 +9,8 @@ from ros_gz_bridge_py.transport.zmq.discovery import (
     HEARTBEAT_INTERVAL,
     SILENCE_INTERVAL,
     DiscoveryEngine,
+)
+from ros_gz_bridge_py.transport.zmq.discovery_events import (
     Outgoing,
     PublisherAdded,
     PublisherRemoved,
