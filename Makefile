@@ -2,14 +2,16 @@
 # Set-up is idempotent: the venv, pip installs, the interface packages and the Debian packages
 # are only (re)done when their inputs change or they are missing (the stamps below).
 #   setup-demo: the venv with rclpy and the runtime dependencies, the Debian build tools (CMake,
-#               a C/C++ compiler), the interface packages; what `make demo` needs.
-#   setup:      that, plus the `dev` extra (pytest, ruff, mypy), the Debian ign-transport tools
-#               the interop tests talk to and clang-14 for the fuzzers; what `make test`,
-#               `make fuzz` and `make soak` need.
+#               a C/C++ compiler), the interface package the demo needs (tf2_msgs); what
+#               `make demo` needs.
+#   setup:      that, plus the other interface packages, the `dev` extra (pytest, ruff, mypy),
+#               the Debian ign-transport tools the interop tests talk to and clang-14 for the
+#               fuzzers; what `make test`, `make fuzz` and `make soak` need.
 
 SHELL := /bin/bash
 PYTHON ?= python3
-VENV := .venv
+# One venv per interpreter: `make test PYTHON=python3.12` sets up and tests in .venv-python3.12.
+VENV ?= $(if $(filter python3,$(PYTHON)),.venv,.venv-$(notdir $(PYTHON)))
 PY := $(VENV)/bin/python
 DEMO_STAMP := $(VENV)/.ros_gz_bridge_py-setup-demo
 STAMP := $(VENV)/.ros_gz_bridge_py-setup
@@ -32,16 +34,16 @@ setup-demo: $(DEMO_STAMP)
 setup: $(STAMP)
 	@$(BYTECODE)
 
-$(DEMO_STAMP): pyproject.toml tools/apt_ensure.sh tools/setup_build.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
+$(DEMO_STAMP): pyproject.toml tools/apt_ensure.sh tools/apt_get.sh tools/setup_build.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
 	bash tools/setup_build.sh
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[ros]'
-	bash tools/setup_interfaces.sh $(VENV)
+	bash tools/setup_interfaces.sh $(VENV) tf2_msgs
 	@touch $(DEMO_STAMP)
 
-$(STAMP): $(DEMO_STAMP) tools/setup_peer.sh tools/setup_fuzz.sh
+$(STAMP): $(DEMO_STAMP) tools/setup_peer.sh tools/setup_fuzz.sh tools/apt_get.sh
 	$(PY) -m pip install --quiet -e '.[ros,dev]'
+	bash tools/setup_interfaces.sh $(VENV)
 	bash tools/setup_peer.sh
 	bash tools/setup_fuzz.sh
 	@touch $(STAMP)

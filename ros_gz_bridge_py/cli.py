@@ -1,4 +1,5 @@
-"""Console entry points: ``parameter_bridge``, ``image_bridge`` and ``bridge_types``."""
+"""Console entry points: ``parameter_bridge``, ``bridge_node``, ``image_bridge`` and
+``bridge_types``."""
 
 from __future__ import annotations
 
@@ -25,6 +26,16 @@ def parameter_bridge_main() -> None:
         from ros_gz_bridge_py.app import parameter_bridge  # noqa: PLC0415 - imports rclpy
 
         sys.exit(parameter_bridge.main(stop=stop))
+
+
+def bridge_node_main() -> None:
+    one_blas_thread()
+    pause_collector()
+    _exit_without_rclpy("bridge_node")
+    with StopSignal() as stop:
+        from ros_gz_bridge_py.app import bridge_node  # noqa: PLC0415 - imports rclpy
+
+        sys.exit(bridge_node.main(stop=stop))
 
 
 def bridge_types_main() -> None:

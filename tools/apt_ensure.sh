@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # apt_ensure.sh NAME PACKAGE...: installs the Debian packages of PACKAGE... that are missing.
-# Idempotent. As root it installs what is missing; otherwise it prints the command and exits 0
-# (the tests that need them then skip locally and fail under CI=true). NAME prefixes the lines.
+# Idempotent. As root it installs what is missing, waiting while another apt or dpkg holds the
+# package manager (apt_get.sh); otherwise it prints the command and exits 0 (the tests that need
+# them then skip locally and fail under CI=true). NAME prefixes the lines.
 set -euo pipefail
 
 name=$1
@@ -27,5 +28,6 @@ fi
 
 echo "$name: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
-apt-get update
-apt-get install -y --no-install-recommends "${missing[@]}"
+apt_get=$(dirname "$0")/apt_get.sh
+bash "$apt_get" update
+bash "$apt_get" install -y --no-install-recommends "${missing[@]}"

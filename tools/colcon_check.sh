@@ -6,8 +6,8 @@
 # reused while the pins stay the same; the workspace is made anew on every run from a copy of
 # the sources (so the build cannot write into the repository). Checks: the console scripts are
 # where `ros2 run` looks (install/<pkg>/lib/<pkg>/), the ament index marker, package.xml, the
-# launch examples and their configurations are installed, and the installed package (not the
-# repository's) imports and runs.
+# launch files, the launch examples and their configurations are installed, and the installed
+# package (not the repository's) imports and runs.
 #
 # Exit status: 0 ok, 1 a check failed, 3 colcon could not be installed (e.g. no registry).
 set -euo pipefail
@@ -74,16 +74,17 @@ build() {
 
 check_install() {
   local prefix=$WS/install/$PKG
-  for script in parameter_bridge image_bridge bridge_types; do
+  for script in parameter_bridge bridge_node image_bridge bridge_types; do
     [[ -x $prefix/lib/$PKG/$script ]] || fail "missing executable lib/$PKG/$script"
   done
   [[ -f $prefix/share/ament_index/resource_index/packages/$PKG ]] ||
     fail "missing ament index marker share/ament_index/resource_index/packages/$PKG"
   [[ -f $prefix/share/$PKG/package.xml ]] || fail "missing share/$PKG/package.xml"
-  # The launch examples find their configurations relative to the package root.
+  # ros_gz_bridge's launch files (launch/); the launch examples find their configurations
+  # relative to the package root.
   local src=$WS/src/$PKG data
-  for data in "$src"/launch_examples/*.launch.py "$src"/launch_examples/config/*.yaml \
-    "$src"/config/*.yaml; do
+  for data in "$src"/launch/ros_gz_bridge.launch* "$src"/launch_examples/*.launch.py \
+    "$src"/launch_examples/config/*.yaml "$src"/config/*.yaml; do
     data=${data#"$src"/}
     [[ -f $prefix/share/$PKG/$data ]] || fail "missing share/$PKG/$data"
   done

@@ -3,19 +3,20 @@
 #
 # usage: tools/setup_interfaces.sh [--check] VENV [PACKAGE...]
 #
-# For each package (all of interfaces/ by default, in dependency order):
+# For each package (all of interfaces/ by default):
 #   * "provided by the environment": importable from VENV's python and not built by this
 #     script (a full ROS install, or wheels), so it is left alone;
 #   * "up to date": built by this script from sources identical to the current ones;
 #   * "built": otherwise it is built with cmake (ninja, else make) against the ros-jazzy-*
 #     wheels in VENV and installed into the VENV prefix.
-# With --check nothing is built: packages that would be are reported as "needs a build",
+# The packages that need a build are built side by side, ROS_GZ_IFACE_JOBS at a time (default:
+# the number of cores). With --check nothing is built: packages that would be are reported as "needs a build",
 # and the exit status is 1 if there is any.
 # A stamp VENV/share/ros_gz_bridge_py_interfaces/<pkg>.sha256 holds the hash of the sources
 # it was built from, and <pkg>.manifest the installed files: after a rebuild, those the new
 # build did not install again are removed, so no stale generated file survives (and the
 # package stays importable while it is rebuilt). Build trees go to
-# ROS_GZ_IFACE_BUILD_DIR (default: <repo>/.build/interfaces).
+# ROS_GZ_IFACE_BUILD_DIR (default: <repo>/.build/interfaces/<the venv's folder name>).
 set -euo pipefail
 
 # Build-time wheels. The wheels' metadata does not pull in the CMake packages that
@@ -36,9 +37,10 @@ BUILD_WHEELS=(
   "ros-jazzy-ament-package==0.16.4"
   "catkin-pkg==1.1.1"
 )
-# Dependency order; each depends only on the common interfaces (tf2_msgs also on
-# action_msgs, which ros-jazzy-rclpy brings; marine_acoustic_msgs on std_msgs and
-# geometry_msgs), none on another package of this list.
+# Each depends only on the common interfaces (tf2_msgs also on action_msgs, which
+# ros-jazzy-rclpy brings; marine_acoustic_msgs on std_msgs and geometry_msgs), none on another
+# package of this list: they build in any order, side by side. `make demo` builds tf2_msgs only
+# (its TurtleBot3 configuration needs no other); `make setup` builds them all.
 DEFAULT_PACKAGES=(tf2_msgs ros_gz_interfaces vision_msgs gps_msgs actuator_msgs marine_acoustic_msgs)
 
 die() { echo "setup_interfaces: $*" >&2; exit 1; }
@@ -51,7 +53,7 @@ PY=$VENV/bin/python
 [ -x "$PY" ] || die "$PY not found: VENV must be a Python venv with ros-jazzy-rclpy installed"
 REPO=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 SRC_ROOT=$REPO/interfaces
-BUILD_ROOT=${ROS_GZ_IFACE_BUILD_DIR:-$REPO/.build/interfaces}
+BUILD_ROOT=${ROS_GZ_IFACE_BUILD_DIR:-$REPO/.build/interfaces/$(basename "$VENV")}
 STAMP_DIR=$VENV/share/ros_gz_bridge_py_interfaces
 if [ $# -gt 0 ]; then PACKAGES=("$@"); else PACKAGES=("${DEFAULT_PACKAGES[@]}"); fi
 
@@ -78,9 +80,7 @@ cls.__class__.__import_type_support__()
 PYEOF
 }
 
-TOOLS_READY=0
 prepare_build_tools() {  # once per run, only when something has to be built
-  [ "$TOOLS_READY" = 1 ] && return
   local piplog=$BUILD_ROOT/pip.log
   if ! "$PY" -m pip install --disable-pip-version-check "${BUILD_WHEELS[@]}" >"$piplog" 2>&1; then
     tail -n 20 "$piplog" >&2
@@ -100,7 +100,6 @@ prepare_build_tools() {  # once per run, only when something has to be built
       -e "s#/opt/python/$tag/lib/python$pyv/site-packages/numpy/_core/include#$npinc#g"
   fi
   if command -v ninja >/dev/null; then GENERATOR=Ninja; else GENERATOR="Unix Makefiles"; fi
-  TOOLS_READY=1
 }
 
 prune_previous_install() {  # files of the previous build that this one did not install again
@@ -117,7 +116,6 @@ prune_previous_install() {  # files of the previous build that this one did not 
 
 build_package() {
   local pkg=$1 src=$SRC_ROOT/$1 b=$BUILD_ROOT/$1
-  prepare_build_tools
   rm -f -- "$STAMP_DIR/$pkg.sha256"
   rm -rf -- "$b"
   mkdir -p "$b"
@@ -144,7 +142,9 @@ build_package() {
   cp -- "$b/install_manifest.txt" "$STAMP_DIR/$pkg.manifest"
 }
 
-STALE=0
+# What needs a build, and the source hash it is built from.
+declare -A WANT
+TODO=()
 for pkg in "${PACKAGES[@]}"; do
   [ -f "$SRC_ROOT/$pkg/package.xml" ] || die "no interface package '$pkg' in $SRC_ROOT"
   want=$(source_hash "$SRC_ROOT/$pkg")
@@ -160,13 +160,38 @@ for pkg in "${PACKAGES[@]}"; do
   fi
   if [ "$CHECK" = 1 ]; then
     echo "$pkg: needs a build"
-    STALE=1
-    continue
   fi
-  start=$SECONDS
+  WANT[$pkg]=$want
+  TODO+=("$pkg")
+done
+[ "$CHECK" = 1 ] && exit $(( ${#TODO[@]} > 0 ))
+[ ${#TODO[@]} -gt 0 ] || exit 0
+
+build_and_stamp() {
+  local pkg=$1 start=$SECONDS
   build_package "$pkg"
   importable "$pkg" || die "$pkg: built and installed, but '$PY' cannot import it"
-  echo "$want" >"$stamp"
+  echo "${WANT[$pkg]}" >"$STAMP_DIR/$pkg.sha256"
   echo "$pkg: built ($((SECONDS - start)) s)"
+}
+
+# The packages depend on none of each other: JOBS build side by side (a build's configure step
+# and its code generators run on one core, its compiles on all).
+JOBS=${ROS_GZ_IFACE_JOBS:-$(nproc)}
+prepare_build_tools
+echo "building ${TODO[*]} ($JOBS at a time)"
+running=0
+failed=0
+for pkg in "${TODO[@]}"; do
+  if [ "$running" -ge "$JOBS" ]; then
+    wait -n || failed=1
+    running=$((running - 1))
+  fi
+  build_and_stamp "$pkg" &
+  running=$((running + 1))
 done
-exit "$STALE"
+while [ "$running" -gt 0 ]; do
+  wait -n || failed=1
+  running=$((running - 1))
+done
+[ "$failed" = 0 ] || die "some packages did not build (above)"

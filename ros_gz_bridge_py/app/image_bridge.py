@@ -105,8 +105,8 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -
     logger = node.get_logger()
     for warning in switches.warnings:
         logger.warning(warning)
-    params = declare_image_bridge_parameters(node)
     try:
+        params = declare_image_bridge_parameters(node)
         gz_type = check_gz_type(params.gz_type)
         gz_version = check_gz_version(params.shared.gz_version)
     except ConfigError as err:

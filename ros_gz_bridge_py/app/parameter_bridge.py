@@ -108,7 +108,11 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         diagnostics: DiagnosticsPublisher | None = None
         discovered: DiscoveredBridges | None = None
         try:
-            params = declare_parameter_bridge_parameters(node)
+            try:
+                params = declare_parameter_bridge_parameters(node)
+            except ConfigError as err:  # a parameter of the wrong type
+                node.get_logger().error(str(err))
+                return USAGE_EXIT
             try:
                 values = placeholder_values(params, cli_values)
                 cli = parse_cli_args(positional, values)

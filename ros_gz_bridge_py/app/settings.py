@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.parameter import Parameter
 
 from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV
@@ -226,12 +227,44 @@ class ImageBridgeParameters:
 
 _Parameters = TypeVar("_Parameters", bound="DataclassInstance")
 
+#: How each parameter type is written on the command line, for the fix of a wrong one.
+_WRITTEN_AS = {
+    Parameter.Type.BOOL: "true or false",
+    Parameter.Type.INTEGER: "an integer",
+    Parameter.Type.DOUBLE: "a number",
+    Parameter.Type.STRING: "a string",
+    Parameter.Type.STRING_ARRAY: "a list of strings, such as ['a', 'b']",
+}
+
+
+def _declare(
+    node: Any, name: str, default: object, descriptor: ParameterDescriptor | None = None
+) -> Any:
+    """``node.declare_parameter(...).value``; a value given of another type than the
+    parameter's is a :class:`ConfigError` naming it and the fix (rclpy raises
+    InvalidParameterTypeException, which ended the process with a traceback).
+
+    Raises:
+        ConfigError: the value given for ``name`` has the wrong type.
+    """
+    try:
+        return node.declare_parameter(name, default, descriptor or ParameterDescriptor()).value
+    except InvalidParameterTypeException as err:
+        said = str(err.args[0]).removesuffix(f": {name}")  # "Trying to set parameter ..."
+        expected = (
+            default if isinstance(default, Parameter.Type)
+            else Parameter.Type.from_parameter_value(default)
+        )  # fmt: skip
+        wanted = _WRITTEN_AS.get(expected, expected.name.lower())
+        msg = f"parameter {name} has the wrong type ({said}); give it as {wanted}, or leave it out"
+        raise ConfigError(msg) from None
+
 
 def _declare_fields(node: Any, defaults: _Parameters, skip: Collection[str]) -> _Parameters:
     """Declare a parameter per field of ``defaults`` but those in ``skip``, each defaulting to
     its value (which sets its type); ``defaults`` with the declared values."""
     values = {
-        field.name: node.declare_parameter(field.name, getattr(defaults, field.name)).value
+        field.name: _declare(node, field.name, getattr(defaults, field.name))
         for field in dataclasses.fields(defaults)
         if field.name not in skip
     }
@@ -245,7 +278,7 @@ def declare_shared_parameters(node: Any, env: Mapping[str, str] | None = None) -
     defaults = SharedParameters(gz_version=env.get(GZ_VERSION_ENV, ""))
     declared = _declare_fields(node, defaults, ("max_rate",))
     any_type = ParameterDescriptor(dynamic_typing=True)
-    max_rate = node.declare_parameter("max_rate", defaults.max_rate, any_type).value
+    max_rate = _declare(node, "max_rate", defaults.max_rate, any_type)
     return dataclasses.replace(declared, max_rate=max_rate)
 
 
@@ -260,11 +293,10 @@ def declare_parameter_bridge_parameters(
         ("shared", "status_period", *arrays),
     )
     lists: dict[str, Any] = {
-        name: tuple(node.declare_parameter(name, Parameter.Type.STRING_ARRAY).value or ())
-        for name in arrays
+        name: tuple(_declare(node, name, Parameter.Type.STRING_ARRAY) or ()) for name in arrays
     }
     any_type = ParameterDescriptor(dynamic_typing=True)
-    period = node.declare_parameter("status_period", declared.status_period, any_type).value
+    period = _declare(node, "status_period", declared.status_period, any_type)
     return dataclasses.replace(declared, status_period=period, **lists)
 
 

@@ -45,6 +45,26 @@ if TYPE_CHECKING:
 
 ENTRY_POINT_GROUP = "ros_gz_bridge_py.converters"
 _PACKAGE = __name__.rpartition(".")[0]
+#: The ROS interface packages that are not on PyPI: the source tree builds them into a venv
+#: (``interfaces/``, ``tools/setup_interfaces.sh``; a test checks the two lists agree).
+BUILT_FROM_SOURCE = frozenset(
+    {"tf2_msgs", "ros_gz_interfaces", "vision_msgs", "gps_msgs", "actuator_msgs",
+     "marine_acoustic_msgs"}
+)  # fmt: skip
+
+
+def why_unavailable(name: str, err: ImportError) -> str:
+    """Why converter module ``name`` (named after its ROS package) could not be imported, and
+    where the missing package comes from when it is one the source tree builds."""
+    missing = (err.name or "").partition(".")[0]
+    if missing != name or name not in BUILT_FROM_SOURCE:
+        return str(err)
+    dashed = name.replace("_", "-")
+    return (
+        f"the ROS interface package {name} is not installed; build it with "
+        f"`tools/setup_interfaces.sh <venv> {name}` from the source tree (`make setup` builds "
+        f"them all), or install ros-jazzy-{dashed} in a ROS install"
+    )
 
 
 @dataclass(frozen=True)
@@ -215,7 +235,7 @@ class Registry:
         try:
             module = load()
         except ImportError as err:
-            self._unavailable[name] = str(err)
+            self._unavailable[name] = why_unavailable(name, err)
             return
         self.add_module(module, name)
 

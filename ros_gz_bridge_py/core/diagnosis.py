@@ -102,6 +102,10 @@ class Situation:
     interval: float | None = None
     #: The rule of discovered bridging that chose the types ("" for a configured entry).
     discovered_by: str = ""
+    #: Discovery has listened long enough to have heard every Gazebo process. Until then,
+    #: hearing none is no fault yet: the channel waits (a Gazebo endpoint absent), it is not
+    #: told that no Gazebo process exists.
+    peers_settled: bool = True
 
 
 def flow(situation: Situation) -> Flow:
@@ -183,7 +187,7 @@ def _gazebo_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
     elsewhere = [e for e in situation.gz_endpoints if e.partition != situation.partition]
     if elsewhere:
         return [_partition_finding(situation, elsewhere)]
-    if situation.gz_peers == 0:
+    if situation.gz_peers == 0 and situation.peers_settled:
         return [_no_peer_finding(situation)]
     return [_absent_finding(situation, role)]
 

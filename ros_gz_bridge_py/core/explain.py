@@ -37,6 +37,7 @@ from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 #: Seconds between two evaluations of every channel.
 EXPLAIN_PERIOD = 2.0
 #: A channel is not judged before it is this old: discovery hears every peer within ~3 s.
+#: Nor is "no Gazebo process at all" said before the bridge listened this long.
 WARM_UP = 3.0
 #: A cause is logged once it was seen in two evaluations, this far apart at least.
 CONFIRM_AFTER = EXPLAIN_PERIOD / 2
@@ -149,6 +150,7 @@ class Explainer:
         self._own = frozenset(own_nodes)
         self._log = log
         self._now = now
+        self._started = now()
         self._seen: dict[int, _Seen] = {}
         self._bridge_announced: set[str] = set()
         self._asked = float("-inf")
@@ -229,6 +231,7 @@ class Explainer:
             since_message=None if seen.changed is None else now - seen.changed,
             interval=seen.interval,
             discovered_by=spec.discovered_by,
+            peers_settled=now - self._started >= WARM_UP,
         )
 
     def _ask_subscribers(self, now: float) -> None:

@@ -16,7 +16,9 @@ process at all, incompatible QoS), or when errors (messages the channel could no
 what was wrong: ``ChannelStats.errors_by_reason``), queue drops or failed service calls
 happened in the period (messages ``max_rate`` drops are counted apart, as ``rate_limited``,
 and are no problem); STALE for a lazy channel whose input side is closed (nobody reads its
-output); OK otherwise (a side that is not there yet is explained, not warned about).
+output) and nothing is wrong: a misconfiguration found for it still makes it WARN, since the
+subscriber that opens it would get nothing; OK otherwise (a side that is not there yet is
+explained, not warned about).
 
 :func:`serve` is how both executables run a built bridge: spinning, with the table on SIGUSR1.
 """

@@ -84,6 +84,18 @@ def test_bad_argument_prints_usage_and_names_it(
 
 @pytest.mark.ros
 @pytest.mark.peer
+def test_a_parameter_of_the_wrong_type_stops_with_one_error_and_no_traceback() -> None:
+    done = run("/t@std_msgs/msg/String[gz.msgs.StringMsg", "--ros-args",
+               "-p", "expand_gz_topic_names:=maybe")  # fmt: skip
+    assert done.returncode == USAGE_EXIT
+    assert "Traceback" not in done.stderr
+    assert (
+        "parameter expand_gz_topic_names has the wrong type (Trying to set parameter "
+        "'expand_gz_topic_names' to 'maybe' of type 'STRING', expecting type 'BOOL'); give it "
+        "as true or false, or leave it out"
+    ) in done.stderr
+
+
 def test_unsupported_pair_is_reported_and_the_other_bridges_run(
     gz_node: GzNode, started: list[PeerProcess]
 ) -> None:

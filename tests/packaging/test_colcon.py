@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 
 import pytest
 
@@ -23,8 +24,9 @@ NO_COLCON = 3
 
 def test_colcon_build_installs_a_ros_package() -> None:
     done = subprocess.run(
-        ["bash", str(SCRIPT)], capture_output=True, text=True, timeout=300, check=False
-    )
+        ["bash", str(SCRIPT)], capture_output=True, text=True, timeout=300, check=False,
+        env={**os.environ, "PROJECT_PYTHON": sys.executable},
+    )  # fmt: skip
     output = done.stdout + done.stderr
     if done.returncode == NO_COLCON and os.environ.get("CI", "").lower() != "true":
         pytest.skip(f"colcon cannot be installed here:\n{output}")

@@ -54,7 +54,8 @@ def _text_files() -> Iterator[tuple[str, str]]:
         folder = stack.pop()
         for path in sorted(folder.iterdir()):
             if path.is_dir():
-                if path.name not in _SKIPPED_DIRS and not path.name.endswith(".egg-info"):
+                skipped = path.name in _SKIPPED_DIRS or path.name.startswith(".venv")
+                if not skipped and not path.name.endswith(".egg-info"):
                     stack.append(path)
                 continue
             if path.resolve() == THIS or not path.is_file() or path.stat().st_size > _MAX_SIZE:

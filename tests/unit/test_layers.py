@@ -21,7 +21,7 @@ LAYERS: tuple[frozenset[str], ...] = (
     frozenset({"native"}),
     frozenset({"core"}),
     frozenset({"app", "demo"}),
-    frozenset({"cli", "__init__"}),
+    frozenset({"cli", "actions", "__init__"}),
 )
 LEVEL = {part: level for level, parts in enumerate(LAYERS) for part in parts}
 

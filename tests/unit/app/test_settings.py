@@ -34,6 +34,7 @@ from ros_gz_bridge_py.app.settings import (
 )
 from ros_gz_bridge_py.core.bridge import BridgeOptions
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
+from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.transport import NodeOptions
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
@@ -357,3 +358,28 @@ def test_every_message_path_switch_is_a_bridge_option() -> None:
     option_fields = {f.name for f in dataclasses.fields(BridgeOptions)}
     switch_fields = {f.name for f in dataclasses.fields(Switches)}
     assert set(MESSAGE_PATH_SWITCHES) <= option_fields & switch_fields
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize(
+    ("name", "value", "wanted"),
+    [
+        ("expand_gz_topic_names", "maybe", "true or false"),
+        ("subscription_heartbeat", "often", "an integer"),
+        ("config_file", 5, "a string"),
+        ("bridge_names", "robot", "a list of strings, such as ['a', 'b']"),
+    ],
+)
+def test_a_parameter_of_the_wrong_type_is_named_with_the_fix(
+    ros_context: Context, name: str, value: object, wanted: str
+) -> None:
+    node = make_node(ros_context, [Parameter(name, value=value)])
+    try:
+        with pytest.raises(ConfigError) as raised:
+            declare_parameter_bridge_parameters(node, {})
+    finally:
+        node.destroy_node()
+    text = str(raised.value)
+    assert text.startswith(f"parameter {name} has the wrong type (Trying to set parameter ")
+    assert f"'{value}'" in text
+    assert text.endswith(f"); give it as {wanted}, or leave it out")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import re
 import sys
 from collections import defaultdict
 from collections.abc import Iterator
@@ -138,10 +139,28 @@ def test_a_missing_interface_package_is_recorded_and_the_rest_keeps_working(
     monkeypatch.delitem(sys.modules, f"{CONVERTERS}.gps_msgs")
     found = build_registry(modules_of(CONVERTERS))
     assert list(found.unavailable) == ["gps_msgs"]
-    assert "gps_msgs.msg" in found.unavailable["gps_msgs"]
+    assert found.unavailable["gps_msgs"] == (
+        "the ROS interface package gps_msgs is not installed; build it with "
+        "`tools/setup_interfaces.sh <venv> gps_msgs` from the source tree (`make setup` builds "
+        "them all), or install ros-jazzy-gps-msgs in a ROS install"
+    )
     assert found.ros_types_for("gz.msgs.NavSat") == ["sensor_msgs/msg/NavSatFix"]
     with pytest.raises(UnsupportedTypeError, match="converters for gps_msgs could not load"):
         found.get("gps_msgs/msg/GPSFix", "gz.msgs.NavSat")
+
+
+def test_other_import_failures_are_recorded_as_they_were_raised() -> None:
+    inner = ModuleNotFoundError("No module named 'numpy'", name="numpy")
+    assert registry.why_unavailable("gps_msgs", inner) == "No module named 'numpy'"
+    pypi = ModuleNotFoundError("No module named 'nav_msgs'", name="nav_msgs")
+    assert registry.why_unavailable("nav_msgs", pypi) == "No module named 'nav_msgs'"
+
+
+def test_the_packages_built_from_source_are_those_the_set_up_builds() -> None:
+    script = (Path(__file__).parents[3] / "tools" / "setup_interfaces.sh").read_text()
+    listed = re.search(r"^DEFAULT_PACKAGES=\((.*)\)$", script, re.MULTILINE)
+    assert listed is not None
+    assert set(listed.group(1).split()) == registry.BUILT_FROM_SOURCE
 
 
 def test_every_pair_is_in_the_module_of_its_ros_package() -> None:

@@ -87,6 +87,17 @@ def test_other_partition_no_peer_and_absent_are_told_apart() -> None:
     assert "similar topics: /model/robot/odom, /odometry" in finding.text
 
 
+def test_no_peer_is_no_fault_before_discovery_listened_long_enough() -> None:
+    early = situation(Direction.GZ_TO_ROS, gz_peers=0, peers_settled=False)
+    (finding,) = findings(early, HINTS)
+    assert finding.key == "gz-absent:publisher"
+    assert not finding.fault
+    assert "(0 Gazebo processes heard)" in finding.text
+    assert flow(early) is Flow.WAITING_GAZEBO
+    (settled,) = findings(dataclasses.replace(early, peers_settled=True), HINTS)
+    assert (settled.key, settled.fault) == ("no-peer", True)
+
+
 def test_ros_to_gazebo_waits_for_a_registered_subscriber() -> None:
     typed_fortress = endpoint(SUBSCRIBER, "ignition.msgs.Twist")
     cmd = situation(
