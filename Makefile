@@ -57,10 +57,10 @@ lint: setup
 	$(VENV)/bin/ruff format --check .
 
 typecheck: setup
-	$(VENV)/bin/mypy ros_gz_bridge_py tests benchmarks tools examples
+	$(VENV)/bin/mypy ros_gz_bridge_py testing tests benchmarks tools examples
 
 unit: setup
-	$(WITH_LOOPBACK) $(PY) -m pytest -q tests
+	$(WITH_LOOPBACK) $(PY) -m pytest -q tests benchmarks/tests
 
 test: lint typecheck unit
 
