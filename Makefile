@@ -34,15 +34,19 @@ setup-demo: $(DEMO_STAMP)
 setup: $(STAMP)
 	@$(BYTECODE)
 
-$(DEMO_STAMP): pyproject.toml tools/apt_ensure.sh tools/apt_get.sh tools/setup_build.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
+# The pinned requirements first (pyproject.toml's, without the package: tools/requirements.py),
+# then the editable package, whose native extension compiles, beside tf2_msgs's build.
+$(DEMO_STAMP): pyproject.toml tools/requirements.py tools/apt_ensure.sh tools/apt_get.sh tools/setup_build.sh tools/setup_interfaces.sh $(shell find interfaces -type f 2>/dev/null)
 	bash tools/setup_build.sh
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet -e '.[ros]'
-	bash tools/setup_interfaces.sh $(VENV) tf2_msgs
+	$(PY) -m pip install --quiet -r <($(PY) tools/requirements.py ros interfaces)
+	$(PY) -m pip install --quiet --no-deps -e . & editable=$$!; \
+	  bash tools/setup_interfaces.sh $(VENV) tf2_msgs; built=$$?; \
+	  wait $$editable && exit $$built
 	@touch $(DEMO_STAMP)
 
 $(STAMP): $(DEMO_STAMP) tools/setup_peer.sh tools/setup_fuzz.sh tools/apt_get.sh
-	$(PY) -m pip install --quiet -e '.[ros,dev]'
+	$(PY) -m pip install --quiet -r <($(PY) tools/requirements.py --extras-only dev)
 	bash tools/setup_interfaces.sh $(VENV)
 	bash tools/setup_peer.sh
 	bash tools/setup_fuzz.sh
@@ -53,10 +57,10 @@ lint: setup
 	$(VENV)/bin/ruff format --check .
 
 typecheck: setup
-	$(VENV)/bin/mypy ros_gz_bridge_py tests benchmarks tools examples
+	$(VENV)/bin/mypy ros_gz_bridge_py testing tests benchmarks tools examples
 
 unit: setup
-	$(WITH_LOOPBACK) $(PY) -m pytest -q tests
+	$(WITH_LOOPBACK) $(PY) -m pytest -q tests benchmarks/tests
 
 test: lint typecheck unit
 
@@ -65,7 +69,7 @@ demo: setup-demo
 
 # The benchmarks also need the `bench` extra (matplotlib, for the plots of BENCHMARKS.md).
 $(BENCH_STAMP): $(STAMP)
-	$(PY) -m pip install --quiet -e '.[ros,dev,bench]'
+	$(PY) -m pip install --quiet -r <($(PY) tools/requirements.py --extras-only bench)
 	@touch $(BENCH_STAMP)
 
 bench: $(BENCH_STAMP)

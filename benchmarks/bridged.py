@@ -15,19 +15,18 @@ from benchmarks.harness import (
     Flow,
     FlowFailure,
     FlowResult,
-    bench_env,
     bridge_argument,
     bridge_config,
     failed,
-    free_port,
     run_flow,
     start_bridge,
     stop_all,
     topic_name,
-    zenoh_override,
 )
 from benchmarks.tables import Row
-from tests.gzpeer import PeerProcess
+from testing.gzpeer import PeerProcess
+from testing.loopback import free_port, zenoh_override
+from testing.run_env import run_env
 
 
 @dataclass(frozen=True)
@@ -41,10 +40,10 @@ class Backend:
 
 def backend(name: str) -> Backend:
     if name == "zeromq":
-        env = bench_env()
+        env = run_env()
         return Backend("ZeroMQ", env, env)
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    bridge_env, gz_env = bench_env("zenoh"), bench_env("zenoh")
+    bridge_env, gz_env = run_env("zenoh"), run_env("zenoh")
     bridge_env["GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE"] = zenoh_override(listen=[endpoint])
     gz_env["GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE"] = zenoh_override(connect=[endpoint])
     return Backend("Zenoh", bridge_env, gz_env)
@@ -79,7 +78,7 @@ def flow_through(
     """``flow`` through a running ``bridge`` of backend ``which`` on ``topic``."""
     if bridge is None:
         return FlowResult(0, 0, 0.0, 0.0, 0.0, None, "bridge did not start")
-    ros_env = bench_env()
+    ros_env = run_env()
     pub_env, sub_env = (
         (which.gz_env, ros_env) if flow.publisher == "gz-pub" else (ros_env, which.gz_env)
     )
@@ -100,7 +99,7 @@ def unbridged(
 ) -> Ceilings:
     """Publisher -> subscriber (``ends``, worker roles) of each case with no bridge between
     (``depth``: the history depth of the ROS ends, None: their default)."""
-    env = bench_env()
+    env = run_env()
     results = {}
     for kind, hz in cases:
         topic = topic_name(f"{label.replace(' ', '_')}_{kind}")

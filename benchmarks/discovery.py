@@ -28,9 +28,11 @@ from pathlib import Path
 import rclpy
 from rclpy.node import Node
 
-from benchmarks.harness import BIN, CpuWindow, bench_env, rss_mb, topic_name
+from benchmarks.harness import BIN, CpuWindow, topic_name
 from benchmarks.report import write_section
-from tests.gzpeer import start_process, stop_processes, wait_for_line
+from testing.gzpeer import start_process, stop_processes, wait_for_line
+from testing.procstat import rss_mb
+from testing.run_env import run_env
 
 NEW_TOPICS = 10
 POLL = 0.005
@@ -67,14 +69,14 @@ def measure(node: Node, count: int, idle: float, workdir: Path) -> Row:
     gazebo = start_process(
         [sys.executable, "-m", "benchmarks.discovery_topics", prefix, str(count),
          str(NEW_TOPICS), str(start_file)],
-        bench_env(),
+        run_env(),
     )  # fmt: skip
     try:
         wait_for_line(gazebo, "^READY", timeout=60)
         bridge = start_process(
             [str(BIN / "parameter_bridge"), "--ros-args", "-p", "auto_bridge:=true",
              "-p", f"auto_bridge_allow:=[^{prefix}/]"],
-            bench_env(),
+            run_env(),
         )  # fmt: skip
         started = time.monotonic()
         names = {f"{prefix}/t{i}" for i in range(count)}
@@ -135,7 +137,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--idle", type=float, default=10.0)
     args = parser.parse_args(argv)
     load = os.getloadavg()[0]
-    os.environ.update(bench_env())  # the same domain and settings as the processes it starts
+    os.environ.update(run_env())  # the same domain and settings as the processes it starts
     rclpy.init()
     node = Node("discovery_bench")
     rows = []

@@ -27,10 +27,11 @@ import rclpy
 from rclpy.node import Node
 from ros_gz_interfaces.srv import ControlWorld
 
-from benchmarks.harness import BIN, bench_env, topic_name
+from benchmarks.harness import BIN, topic_name
 from benchmarks.report import write_section
 from benchmarks.startup import CREATING, LOG_ENV
-from tests.gzpeer import start_peer, start_process, stop_processes, wait_for_line
+from testing.gzpeer import start_peer, start_process, stop_processes, wait_for_line
+from testing.run_env import run_env
 
 POLL = 0.001
 #: A first call slower than this was resent (the next heartbeat), not just slow.
@@ -50,7 +51,7 @@ def one_run(node: Node, sleep: float) -> Run:
     try:
         replier = start_peer(
             "reply", service, "ignition.msgs.WorldControl", "ignition.msgs.Boolean", "60",
-            env=bench_env(),
+            env=run_env(),
         )  # fmt: skip
         wait_for_line(replier, "^READY", timeout=30)
         client = node.create_client(ControlWorld, service)
@@ -59,7 +60,7 @@ def one_run(node: Node, sleep: float) -> Run:
             [str(BIN / "parameter_bridge"),
              f"{service}@ros_gz_interfaces/srv/ControlWorld@ignition.msgs.WorldControl"
              "@ignition.msgs.Boolean"],
-            bench_env() | LOG_ENV,
+            run_env() | LOG_ENV,
         )  # fmt: skip
         time.sleep(sleep)
         while not client.service_is_ready():
@@ -120,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sleep", type=float, default=0.0)
     args = parser.parse_args(argv)
     load = os.getloadavg()[0]
-    os.environ.update(bench_env())  # the same domain and settings as the processes it starts
+    os.environ.update(run_env())  # the same domain and settings as the processes it starts
     rclpy.init()
     node = Node("first_call_bench")
     runs = []

@@ -1,7 +1,7 @@
 """The ROS ends of ``benchmarks.fleet``: the fleet's ROS subscriber, and a bare rclpy publisher.
 
 ``python -m benchmarks.fleet_ros sub ROBOTS`` subscribes to every Gazebo -> ROS topic of the
-fleet of ``tests/fleet_sim.py`` (``/clock``, and each robot's odom, imu, joint_states), taking
+fleet of ``testing/fleet_sim.py`` (``/clock``, and each robot's odom, imu, joint_states), taking
 the messages serialized (rclpy's ``raw=True``: no deserialization, as a recorder or a relay
 would) and counting them per topic; it publishes every robot's ``cmd_vel`` at 10 Hz from the
 moment the bridge subscribes to it. Lines: ``READY``; ``ALL_FLOWING <wall time>`` once every
@@ -27,8 +27,8 @@ import time
 from typing import Any
 
 from benchmarks.workers import _ros_qos, _ros_start, say
-from tests import fleet_sim
-from tests.bridge.e2e_ros_checker import fill
+from testing import fleet_sim
+from testing.e2e_ros_checker import fill
 
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
 

@@ -9,10 +9,8 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import json
 import os
 import re
-import socket
 import sys
 import time
 import uuid
@@ -26,9 +24,9 @@ from benchmarks.payloads import KINDS
 from benchmarks.transport import STATS_LINE
 from benchmarks.workers import MATCH_WAIT
 from benchmarks.workers import SETTLE as PUBLISH_SETTLE
-from ros_gz_bridge_py.app.settings import read_switches
-from ros_gz_bridge_py.ros.speed import apply_fastdds_profile, remove_zombie_segments
-from tests.gzpeer import PeerProcess, peer_binary, start_process, stop_processes, wait_for_line
+from ros_gz_bridge_py.ros.speed import remove_zombie_segments
+from testing.gzpeer import PeerProcess, peer_binary, start_process, stop_processes, wait_for_line
+from testing.procstat import cpu_seconds
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
@@ -42,79 +40,12 @@ SETTLE = 1.0
 #: all); with 3 s, none of 8 did.
 SETTLE_ROS = 3.0
 LARGE_KINDS = frozenset({"image640", "image1080", "cloud1mb"})
-#: One Gazebo partition for the whole run, so every process of it meets the others.
-PARTITION = f"bench-{os.getpid()}-{uuid.uuid4().hex[:6]}"
 #: Errors a flow may end with; it is then reported as failed and the run goes on.
 FlowFailure = (Exception, pytest.fail.Exception)
 
 
-def bench_env(backend: str = "zeromq", base: Mapping[str, str] | None = None) -> dict[str, str]:
-    """The environment of every benchmark process: loopback only, our own partition/domain,
-    the bridge executables' Fast DDS profile (so the ceiling uses the same settings); made
-    from ``base`` (default: this process's environment)."""
-    env = dict(os.environ if base is None else base)
-    partition = PARTITION
-    env.update(
-        {
-            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-            "ROS_LOCALHOST_ONLY": "1",
-            "GZ_IP": "127.0.0.1",
-            "IGN_IP": "127.0.0.1",
-            "GZ_PARTITION": partition,
-            "IGN_PARTITION": partition,
-            "RCUTILS_LOGGING_SEVERITY_THRESHOLD": "WARN",
-        }
-    )
-    env.setdefault("ROS_DOMAIN_ID", str(os.getpid() % 100 + 101))
-    for name in ("GZ_RELAY", "IGN_RELAY", "GZ_TRANSPORT_IMPLEMENTATION"):
-        env.pop(name, None)
-    apply_fastdds_profile(env, enabled=read_switches(env).fastdds_profile)
-    if backend == "zenoh":
-        env["GZ_TRANSPORT_IMPLEMENTATION"] = "zenoh"
-    return env
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port: int = sock.getsockname()[1]
-        return port
-
-
-def zenoh_override(listen: Sequence[str] = (), connect: Sequence[str] = ()) -> str:
-    """``GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE`` for a peer on explicit loopback endpoints only."""
-    entries = {
-        "mode": '"peer"',
-        "scouting/multicast/enabled": "false",
-        "scouting/gossip/enabled": "false",
-        "listen/endpoints": json.dumps(list(listen)),
-        "connect/endpoints": json.dumps(list(connect)),
-    }
-    return ";".join(f"{key}={value}" for key, value in entries.items())
-
-
 def topic_name(stem: str) -> str:
     return f"/bench_{stem}_{os.getpid()}_{uuid.uuid4().hex[:6]}"
-
-
-# --- /proc ------------------------------------------------------------------------------------
-
-_TICK = os.sysconf("SC_CLK_TCK")
-
-
-def cpu_seconds(pid: int) -> float:
-    """User + system CPU time of process ``pid`` (all its threads)."""
-    with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
-        fields = stat.read().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / _TICK
-
-
-def rss_mb(pid: int) -> float:
-    with open(f"/proc/{pid}/status", encoding="ascii") as status:
-        for line in status:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
-    return 0.0
 
 
 #: Thread groups of a bridge process, by the start of the thread's name (``comm``): the
@@ -172,7 +103,7 @@ class CpuWindow:
 
 #: The sentence every report uses to say what its Gazebo ends are.
 GZ_ENDS = (
-    "Gazebo ends: on ZeroMQ, the C++ peer on the real Ignition Transport 11 (`tests/peer`, "
+    "Gazebo ends: on ZeroMQ, the C++ peer on the real Ignition Transport 11 (`testing/peer`, "
     "modes kind-pub and kind-sub), which serializes every message anew as a simulator does; "
     "on Zenoh, our Python workers (`benchmarks.workers`; Fortress has no Zenoh backend)."
 )
@@ -220,7 +151,7 @@ class Flood:
 
 
 def flood_options(flood: Flood | None, ign_peer: bool) -> list[str]:
-    """The publisher options of ``flood``: the C++ peer's (``tests/peer/flood.hh``), or the
+    """The publisher options of ``flood``: the C++ peer's (``testing/peer/flood.hh``), or the
     Python workers'."""
     if flood is None:
         return []

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 
-from benchmarks import fleet, plots, starvation
+from benchmarks import plots, starvation
 from benchmarks.costs import (
     GZ_TO_ROS,
     ROS_TO_GZ,
@@ -22,6 +22,14 @@ from benchmarks.costs import (
     per_message_ms,
     split_text,
     thread_split_ms,
+)
+from benchmarks.fleet_goals import (
+    CPP_QUOTED,
+    GOAL_CPU_RATIO,
+    GOAL_IDLE_PERCENT,
+    GOAL_STARTUP_ROBOTS,
+    GOAL_STARTUP_S,
+    GOAL_THREADS,
 )
 from benchmarks.harness import PYTHON_THREADS, FlowResult
 from benchmarks.reference import (
@@ -293,30 +301,30 @@ def fleet_lines(stored: Stored | None) -> list[str]:
         return ["- not measured yet (`benchmarks.fleet`)"]
     numbers = stored.numbers
     lines = []
-    for robots, quoted in fleet.ISSUE_28.items():
+    for robots, quoted in CPP_QUOTED.items():
         us = numbers.get(f"fleet{robots}.us_per_message")
         threads = numbers.get(f"fleet{robots}.threads")
         if us is None or threads is None:
             continue
-        goal = fleet.GOAL_CPU_RATIO * quoted.cpp_us_per_message()
+        goal = GOAL_CPU_RATIO * quoted.cpp_us_per_message()
         lines.append(
             f"- {robots} robots ({1 + 4 * robots} entries): {us:.1f} µs of CPU per delivered "
             f"message (goal <= {goal:.1f}, 0.8x C++'s {quoted.cpp_us_per_message():.1f} quoted): "
             f"{verdict(us <= goal, f'{us - goal:.1f} µs')}; {threads:.0f} threads (C++ "
             f"{quoted.threads_cpp}): "
-            f"{verdict(threads <= fleet.GOAL_THREADS, f'{threads - fleet.GOAL_THREADS:.0f}')}"
+            f"{verdict(threads <= GOAL_THREADS, f'{threads - GOAL_THREADS:.0f}')}"
         )
-    startup = numbers.get(f"fleet{fleet.GOAL_STARTUP_ROBOTS}.startup_s")
+    startup = numbers.get(f"fleet{GOAL_STARTUP_ROBOTS}.startup_s")
     if startup is not None:
         lines.append(
-            f"- start-up of {fleet.GOAL_STARTUP_ROBOTS} robots under traffic, to every topic "
-            f"flowing: {startup:.2f} s (C++ {fleet.GOAL_STARTUP_S:g} s quoted): "
-            f"{verdict(startup <= fleet.GOAL_STARTUP_S, f'{startup - fleet.GOAL_STARTUP_S:.2f} s')}"
+            f"- start-up of {GOAL_STARTUP_ROBOTS} robots under traffic, to every topic "
+            f"flowing: {startup:.2f} s (C++ {GOAL_STARTUP_S:g} s quoted): "
+            f"{verdict(startup <= GOAL_STARTUP_S, f'{startup - GOAL_STARTUP_S:.2f} s')}"
         )
     idle = [key for key in numbers if key.startswith("idle") and key.endswith(".cpu_percent")]
     for key in idle:
         robots = int(key.removeprefix("idle").split(".")[0])
-        percent, goal = numbers[key], fleet.GOAL_IDLE_PERCENT
+        percent, goal = numbers[key], GOAL_IDLE_PERCENT
         judged = verdict(percent < goal, f"{percent - goal:.2f} points")
         lines.append(
             f"- at rest, {1 + 4 * robots} entries: {percent:.2f}% of a core (goal < {goal:g}%): "

@@ -16,9 +16,10 @@ import time
 from dataclasses import dataclass, field
 
 from benchmarks.bridged import backend, bridge_process, flow_through
-from benchmarks.harness import GZ_ENDS, Flow, FlowResult, bridge_argument, rss_mb, topic_name
+from benchmarks.harness import GZ_ENDS, Flow, FlowResult, bridge_argument, topic_name
 from benchmarks.report import write_section
 from benchmarks.tables import Row, table, verdict
+from testing.procstat import rss_mb
 
 GOAL_MB = 50.0
 #: Seconds of flooding before the RSS baseline is taken (buffers and queues fill first).

@@ -18,7 +18,7 @@ from benchmarks.costs import (
     per_message_ms,
     thread_split_ms,
 )
-from benchmarks.fleet import GOAL_CPU_RATIO, GOAL_THREADS, Quoted, Round
+from benchmarks.fleet_goals import GOAL_CPU_RATIO, GOAL_THREADS, Quoted, Round
 from benchmarks.harness import PYTHON_THREADS
 from benchmarks.reference import CPU_PER_MESSAGE, QUOTED, SUSTAINED_P99_MS, cpu_goal_ms
 from benchmarks.results import COSTS_PNG, FLEET_PNG, SUSTAINED_PNG, Stored

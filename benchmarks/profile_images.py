@@ -7,7 +7,7 @@ same helpers (``benchmarks.bridged``), and while it publishes samples the bridge
 ``py-spy record --nonblocking --threads`` twice at once: every busy sample, and (``--gil``) only
 the thread holding the GIL. Per-thread CPU comes from ``/proc/<pid>/task/<tid>/stat`` (thread
 names from ``py-spy dump --json``); the publisher's and subscriber's CPU from
-``/proc/<pid>/stat``. Loopback only: every process gets ``benchmarks.harness.bench_env``.
+``/proc/<pid>/stat``. Loopback only: every process gets ``benchmarks.harness.run_env``.
 """
 
 from __future__ import annotations
@@ -26,8 +26,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from benchmarks.bridged import backend, bridge_process, flow_through
-from benchmarks.harness import BIN, Flow, FlowResult, bridge_argument, cpu_seconds, topic_name
+from benchmarks.harness import BIN, Flow, FlowResult, bridge_argument, topic_name
 from benchmarks.report import write_section
+from testing.procstat import cpu_seconds
 
 KIND = "image1080"
 PY_SPY = BIN / "py-spy"

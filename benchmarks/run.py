@@ -6,7 +6,7 @@ Each module writes its own section; a module that fails is reported and the othe
 Last, the headline is rewritten from the figures stored by ``sustained``, ``costs`` and
 ``starvation`` (this run's, or their last run's when they were not run), and its plots drawn.
 The Gazebo ends of ZeroMQ flows are the C++ peer on the real ign-transport 11 (built on first
-use, see ``tests/gzpeer.py``); ``BENCH_GZ_END=python`` puts our Python workers there instead.
+use, see ``testing/gzpeer.py``); ``BENCH_GZ_END=python`` puts our Python workers there instead.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Usage: ``.venv/bin/python -m benchmarks.startup [--counts 1 3 8 66] [--rounds 5]
 
 Per count N: ``parameter_bridge`` with N inline entries ``/t<i>@std_msgs/msg/String@
 gz.msgs.StringMsg`` (both directions, as in the issue), started ``--rounds`` times without
-traffic, then as often while the C++ peer on Ignition Transport 11 (``tests/peer``, mode
+traffic, then as often while the C++ peer on Ignition Transport 11 (``testing/peer``, mode
 pub-many: one process, one node, as upstream ros_gz_bridge's ``test_gz_publisher``) already
 publishes on every one of those Gazebo topics at ``--hz``. The
 times come from the bridge's own log (``{time}`` of rcutils, wall clock) minus the wall clock
@@ -28,9 +28,10 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from benchmarks.harness import BIN, ROOT, bench_env, topic_name
+from benchmarks.harness import BIN, ROOT, topic_name
 from benchmarks.report import write_section
-from tests.gzpeer import start_peer, stop_processes, wait_for_line
+from testing.gzpeer import start_peer, stop_processes, wait_for_line
+from testing.run_env import run_env
 
 #: What the issue measured for the C++ bridge (three inline entries, last ``Creating`` line).
 QUOTED_CPP_S = 0.15
@@ -81,7 +82,7 @@ def creating_times(
     """Seconds from the start of ``command`` to its first and its ``count``-th ``Creating``
     line; the process is then stopped. ``extra_env`` is applied before the Fast DDS profile
     is chosen."""
-    env = bench_env(base={**os.environ, **(extra_env or {})}) | LOG_ENV
+    env = run_env(base={**os.environ, **(extra_env or {})}) | LOG_ENV
     started = time.time()
     proc = subprocess.Popen(
         list(command), env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
@@ -129,7 +130,7 @@ def bridge_rounds(
         if hz is not None:
             publish = ["ignition.msgs.StringMsg", str(hz), 'data: "flowing"']
             groups = [[topic] for topic in topics] if spread else [topics]
-            peers = [start_peer("pub-many", *publish, *group, env=bench_env()) for group in groups]
+            peers = [start_peer("pub-many", *publish, *group, env=run_env()) for group in groups]
             for peer in peers:
                 wait_for_line(peer, "^READY", timeout=30)
             time.sleep(1.0)  # flowing before the bridge starts

@@ -23,7 +23,6 @@ from benchmarks.harness import (
     Flood,
     Flow,
     FlowResult,
-    bench_env,
     bridge_argument,
     run_flow,
     topic_name,
@@ -32,7 +31,8 @@ from benchmarks.reference import CLOCK_UNDER_FLOOD, GOAL_CLOCK_SHARE, QUOTED
 from benchmarks.report import write_section
 from benchmarks.results import store
 from benchmarks.tables import verdict
-from tests.gzpeer import PeerProcess
+from testing.gzpeer import PeerProcess
+from testing.run_env import run_env
 
 CLOCK_HZ = 1000.0
 #: Seconds the flood runs before the first clock message.
@@ -147,7 +147,7 @@ def unbridged(seconds: float) -> list[ClockRun]:
     for phase, ends in ((HOP, ("gz-pub", "gz-sub")), (CEILING, ("ros-pub", "ros-sub"))):
         flood = Flood("image1080", topic_name(f"{phase.name}_flood"), lead=LEAD)
         flow = _flow(phase, ends, seconds, flood)
-        result = run_flow(flow, topic_name(f"{phase.name}_clock"), bench_env())
+        result = run_flow(flow, topic_name(f"{phase.name}_clock"), run_env())
         print(f"{phase.name}: {result}", file=sys.stderr, flush=True)
         runs.append(ClockRun(phase, result))
     return runs

@@ -4,7 +4,7 @@ Usage, from the repository root: ``.venv/bin/python -m benchmarks.transport [--s
 it writes the ``transport`` section of BENCHMARKS.md. Every case is one publisher process and
 one subscriber process exchanging ``ignition.msgs.Bytes`` whose data starts with the
 CLOCK_MONOTONIC send time (ns, int64 little-endian). C++ ends are the test peer
-(``tests/peer``, modes bench-pub/bench-sub); Python ends are this module run as
+(``testing/peer``, modes bench-pub/bench-sub); Python ends are this module run as
 ``... pub|sub ...``. Each case has two phases: back-to-back publishing (subscriber rate) and
 paced publishing (latency without queueing). Traffic stays on loopback (loopback-env settings).
 """
@@ -27,7 +27,7 @@ from typing import Any
 from benchmarks.report import write_section
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import create_gz_node
-from tests.gzpeer import peer_binary, start_process, stop_processes, wait_for_line
+from testing.gzpeer import peer_binary, start_process, stop_processes, wait_for_line
 
 BYTES_TYPE = "ignition.msgs.Bytes"
 STAMP = struct.Struct("<q")

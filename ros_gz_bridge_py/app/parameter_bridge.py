@@ -1,4 +1,5 @@
-"""``parameter_bridge``: the node parameters, the configuration sources, and the main loop.
+"""``parameter_bridge``: the main loop, the bridges made from the configuration (its sources are
+read by :mod:`~.sources`), and the ``--check`` and ``--discover`` modes.
 
 Configuration is parsed completely first (arguments, the ``config_file`` YAML, ``bridge_names``
 parameters), then every bridge is created; an entry that fails is reported with its location and
@@ -15,12 +16,10 @@ parameter), YAML entries that discovery completes and ``auto_bridge`` (both foll
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import sys
 from collections.abc import Sequence
 
 import rclpy
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
@@ -36,6 +35,7 @@ from ros_gz_bridge_py.app.settings import (
     declare_parameter_bridge_parameters,
     read_switches,
 )
+from ros_gz_bridge_py.app.sources import collect_sources, discovery_rules, placeholder_values
 from ros_gz_bridge_py.app.startup import finish_start_up
 from ros_gz_bridge_py.config import (
     USAGE,
@@ -43,26 +43,17 @@ from ros_gz_bridge_py.config import (
     ParseResult,
     TopicBridgeSpec,
     UsageError,
-    expand_topic_name,
     parse_cli_args,
-    parse_parameter_bridges,
-    read_yaml_file,
     templates,
 )
 from ros_gz_bridge_py.config.cli import cli_placeholders
-from ros_gz_bridge_py.config.discovered import AutoBridgeRules, auto_bridge_rules
+from ros_gz_bridge_py.config.discovered import AutoBridgeRules
 from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.config.patterns import TopicPattern
 from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.discovered import DiscoveredBridges, ros_publishers
-from ros_gz_bridge_py.core.discovery_plan import (
-    Plan,
-    Sighting,
-    plan,
-    ros_names_to_read,
-    sightings,
-)
+from ros_gz_bridge_py.core.discovery_plan import Plan, Sighting, plan, ros_names_to_read, sightings
 from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError
@@ -78,58 +69,6 @@ CHECK_OPTION = "--check"
 DISCOVER_OPTION = "--discover"
 #: Exit status for bad arguments, as the C++ bridge (``return -1``).
 USAGE_EXIT = 255
-BRIDGE_PARAMETER_KEYS = (
-    "ros_topic_name",
-    "gz_topic_name",
-    "ros_type_name",
-    "gz_type_name",
-    "direction",
-    "lazy",
-    "publisher_queue",
-    "subscriber_queue",
-    "qos_profile",
-    "frame_id",
-    "max_rate",
-    "service_name",
-    "gz_req_type_name",
-    "gz_rep_type_name",
-)
-
-
-def parameter_bridge_specs(node: Node, names: Sequence[str]) -> ParseResult:
-    """The ``bridges.<name>.*`` bridges (Jazzy 1.0.15+ form)."""
-    dynamic = ParameterDescriptor(dynamic_typing=True)
-    for name in names:
-        for key in BRIDGE_PARAMETER_KEYS:
-            node.declare_parameter(f"bridges.{name}.{key}", None, dynamic)
-
-    def get(full_name: str) -> object | None:
-        value: object | None = node.get_parameter(full_name).value
-        return value
-
-    return parse_parameter_bridges(names, get)
-
-
-def expand_gz_names(result: ParseResult, node: Node) -> ParseResult:
-    """Apply ``expand_gz_topic_names`` to the topic bridges of a config source."""
-    specs: list[BridgeSpec] = [
-        dataclasses.replace(
-            spec,
-            gz_topic=expand_topic_name(spec.gz_topic, node.get_namespace(), node.get_name()),
-        )
-        if isinstance(spec, TopicBridgeSpec)
-        else spec
-        for spec in result.specs
-    ]
-    return dataclasses.replace(result, specs=tuple(specs))
-
-
-def report(node: Node, result: ParseResult) -> None:
-    logger = node.get_logger()
-    for warning in result.warnings:
-        logger.warning(warning)
-    for error in result.errors:
-        logger.error(str(error))
 
 
 def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> int:
@@ -250,45 +189,6 @@ def split_seconds_option(
             msg = f"{option} takes a number of seconds > 0 to listen for, not {text!r}"
             raise UsageError(msg, f"argument '{option} {text}'")
     return seconds, rest
-
-
-def collect_sources(
-    node: Node, cli: ParseResult, params: ParameterBridgeParameters, values: templates.Placeholders
-) -> list[ParseResult]:
-    """Every configuration source, its problems reported; ``expand_gz_topic_names`` applied
-    to each (the command line's too, unlike C++: ros_gz issue 702)."""
-    sources = [expand_if(cli, node, params)]
-    if params.shared.config_file:
-        yaml_file = read_yaml_file(params.shared.config_file, values)
-        sources.append(expand_if(yaml_file, node, params))
-    if params.bridge_names:
-        sources.append(expand_if(parameter_bridge_specs(node, params.bridge_names), node, params))
-    for source in sources:
-        report(node, source)
-    return sources
-
-
-def placeholder_values(
-    params: ParameterBridgeParameters, cli_values: templates.Placeholders
-) -> dict[str, tuple[str, ...]]:
-    """The ``placeholders`` parameter's values, then the arguments'.
-
-    Raises:
-        ConfigError: an item of the parameter that is not NAME=VALUE.
-    """
-    from_parameter = templates.parse_assignments(params.placeholders, "parameter placeholders")
-    return templates.merge(from_parameter, cli_values)
-
-
-def discovery_rules(
-    node: Node, params: ParameterBridgeParameters, *, enabled: bool
-) -> AutoBridgeRules:
-    """``auto_bridge`` and its patterns; a bad pattern is logged and auto-bridging stays off."""
-    try:
-        return auto_bridge_rules(enabled, params.auto_bridge_allow, params.auto_bridge_deny)
-    except ConfigError as err:
-        node.get_logger().error(f"{err}; auto_bridge is off")
-        return AutoBridgeRules()
 
 
 def check(
@@ -438,21 +338,6 @@ def build_bridge(
             "(parameter_bridge -h shows the syntax)"
         )
     return bridge, discovered
-
-
-def expand_if(result: ParseResult, node: Node, params: ParameterBridgeParameters) -> ParseResult:
-    """``result`` with ``expand_gz_topic_names`` applied when it is set (patterns too)."""
-    if not params.shared.expand_gz_topic_names:
-        return result
-    expanded = expand_gz_names(result, node)
-    patterns = tuple(
-        dataclasses.replace(
-            pattern,
-            gz_topic=expand_topic_name(pattern.gz_topic, node.get_namespace(), node.get_name()),
-        )
-        for pattern in result.patterns
-    )
-    return dataclasses.replace(expanded, patterns=patterns)
 
 
 if __name__ == "__main__":

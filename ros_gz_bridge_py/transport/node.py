@@ -9,7 +9,7 @@ local (intra-process) delivery, the choice of wire spellings per message (docs/p
 ``node_graph.py``) are mixed in from modules of their own. A backend implements narrow hooks:
 open and close its publishers, subscriptions and service offers, send one message in one
 spelling, call a service, and tell what its discovery knows. The contract every backend must
-honour is tested by one suite, ``tests/unit/transport/test_contract.py``; a new backend is
+honour is tested by one suite, ``tests/unit/transport/test_node_contract.py``; a new backend is
 written by passing it.
 """
 

@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from tests.bridge.e2e_harness import ProcessGroup
+from testing.e2e_harness import ProcessGroup
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,7 @@ import pytest
 
 from ros_gz_bridge_py.config import USAGE
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     bridge_command,
@@ -20,7 +20,7 @@ from tests.bridge.behaviour_harness import (
     start_bridge,
     started,
 )
-from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
+from testing.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
 
 __all__ = ["gz_node", "started"]
 

@@ -17,7 +17,7 @@ from std_msgs.msg import String
 
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -28,7 +28,7 @@ from tests.bridge.behaviour_harness import (
     start_bridge,
     wait_gz_advertised,
 )
-from tests.gzpeer import Inbox, require_peer, unique_name, wait_until
+from testing.gzpeer import Inbox, require_peer, unique_name, wait_until
 
 __all__ = ["gz_node", "ros_side"]
 

@@ -19,7 +19,7 @@ from tf2_msgs.msg import TFMessage
 
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -31,7 +31,7 @@ from tests.bridge.behaviour_harness import (
     start_bridge,
     wait_gz_advertised,
 )
-from tests.gzpeer import require_peer, unique_name, wait_until
+from testing.gzpeer import require_peer, unique_name, wait_until
 
 __all__ = ["gz_node", "ros_side"]
 

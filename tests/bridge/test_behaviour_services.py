@@ -19,14 +19,14 @@ from rclpy.qos import QoSProfile
 from ros_gz_interfaces.msg import Entity
 from ros_gz_interfaces.srv import ControlWorld, DeleteEntity, SetEntityPose, SpawnEntity
 
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     WAIT,
     RosSide,
     ros_side,
     start_bridge,
     started,
 )
-from tests.gzpeer import PeerProcess, require_peer, start_peer, unique_name, wait_for_line
+from testing.gzpeer import PeerProcess, require_peer, start_peer, unique_name, wait_for_line
 
 __all__ = ["ros_side", "started"]
 

@@ -19,8 +19,7 @@ from rcl_interfaces.srv import ListParameters
 
 from ros_gz_bridge_py.transport import GzNode
 from ros_gz_bridge_py.transport.zmq.discovery import SILENCE_INTERVAL
-from tests.bridge.behaviour_harness import (
-    PARAMETER_BRIDGE,
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -31,7 +30,8 @@ from tests.bridge.behaviour_harness import (
     started,
     wait_gz_advertised,
 )
-from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
+from testing.e2e_harness import PARAMETER_BRIDGE
+from testing.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
 
 __all__ = ["gz_node", "ros_side", "started"]
 

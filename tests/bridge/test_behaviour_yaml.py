@@ -13,14 +13,14 @@ from pathlib import Path
 import pytest
 
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     gz_node,
     start_bridge,
     started,
 )
-from tests.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
+from testing.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
 
 __all__ = ["gz_node", "started"]
 

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.bridge.e2e_harness import RUN_TIMEOUT, ProcessGroup, RosChecker, wait_all
+from testing.e2e_harness import RUN_TIMEOUT, ProcessGroup, RosChecker, wait_all
+from testing.gzpeer import PeerProcess, wait_for_line
 from tests.bridge.e2e_values import ODOMETRY, mismatches
-from tests.gzpeer import PeerProcess, wait_for_line
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
 

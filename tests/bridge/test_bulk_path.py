@@ -28,7 +28,7 @@ from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     WAIT,
     RosSide,
     bridge_command,
@@ -37,9 +37,8 @@ from tests.bridge.behaviour_harness import (
     ros_side,
     started,
 )
-from tests.bridge.e2e_harness import parse_gz
-from tests.bridge.image_frames import pattern_bytes, rgb_frame, rgb_text_proto
-from tests.gzpeer import (
+from testing.e2e_harness import parse_gz
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,
@@ -48,6 +47,7 @@ from tests.gzpeer import (
     wait_for_line,
     wait_until,
 )
+from tests.bridge.image_frames import pattern_bytes, rgb_frame, rgb_text_proto
 
 __all__ = ["gz_node", "ros_side", "started"]
 

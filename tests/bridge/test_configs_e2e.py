@@ -4,7 +4,7 @@ For each YAML file of ``shared/data/configs`` (used unchanged) and each Gazebo l
 ``parameter_bridge --ros-args -p config_file:=<file>``, one C++ ign-transport 11 peer per
 Gazebo->ROS entry, an rclpy checker that subscribes to every ROS topic and publishes the
 ROS->Gazebo entry, and a typed C++ echo of that entry. As Harmonic, the peers put ``gz.msgs.*``
-names and Harmonic layouts on the wire (``--wire-type``, see ``tests/peer``); as Fortress, they
+names and Harmonic layouts on the wire (``--wire-type``, see ``testing/peer``); as Fortress, they
 are what they are: ``ignition.msgs.*`` publishers and typed ``ignition.msgs.*`` subscribers
 (as the DiffDrive system is), with the Fortress IMU layout. Each arrival is checked field by
 field against ``e2e_values`` (the rules of docs/conversions.md), and traffic against the configured
@@ -23,7 +23,7 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.msgs.names import Spelling, respell
-from tests.bridge.e2e_harness import (
+from testing.e2e_harness import (
     RUN_TIMEOUT,
     ConfigEntry,
     GzEcho,
@@ -33,6 +33,7 @@ from tests.bridge.e2e_harness import (
     read_entries,
     wait_all,
 )
+from testing.gzpeer import PeerProcess
 from tests.bridge.e2e_values import (
     CLOCK_FROM_ROS,
     IMU_FORTRESS,
@@ -42,7 +43,6 @@ from tests.bridge.e2e_values import (
     mismatches,
     sample_for,
 )
-from tests.gzpeer import PeerProcess
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
 

@@ -31,8 +31,7 @@ from std_msgs.msg import String
 
 from ros_gz_bridge_py.transport import create_gz_node
 from ros_gz_bridge_py.transport.api import SUBSCRIBER
-from tests.bridge.behaviour_harness import (
-    PARAMETER_BRIDGE,
+from testing.behaviour_harness import (
     WAIT,
     RosSide,
     bridge_command,
@@ -40,7 +39,8 @@ from tests.bridge.behaviour_harness import (
     publish_until,
     started,
 )
-from tests.gzpeer import (
+from testing.e2e_harness import PARAMETER_BRIDGE
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,
@@ -49,7 +49,7 @@ from tests.gzpeer import (
     wait_for_line,
     wait_until,
 )
-from tests.loopback import free_port, zenoh_env
+from testing.loopback import free_port, zenoh_env
 
 __all__ = ["probe", "started"]
 

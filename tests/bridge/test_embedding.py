@@ -21,7 +21,7 @@ from ros_gz_bridge_py import Bridge
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.core.bridge import BridgeOptions
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -31,7 +31,7 @@ from tests.bridge.behaviour_harness import (
     started,
     wait_gz_advertised,
 )
-from tests.gzpeer import (
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,

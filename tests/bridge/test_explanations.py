@@ -22,14 +22,9 @@ import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from std_msgs.msg import Int32, String
 
-from tests.bridge.behaviour_harness import (
-    PARAMETER_BRIDGE,
-    WAIT,
-    RosSide,
-    bridge_command,
-    started,
-)
-from tests.gzpeer import (
+from testing.behaviour_harness import WAIT, RosSide, bridge_command, started
+from testing.e2e_harness import PARAMETER_BRIDGE
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,

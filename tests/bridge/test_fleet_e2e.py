@@ -2,7 +2,7 @@
 
 One C++ ign-transport 11 peer plays the simulator (mode ``pub-fleet``: one node publishing
 ``/clock`` and every robot's odom, imu and joint_states, and subscribing to every robot's
-``cmd_vel``, see ``tests/fleet_sim.py``); one ``parameter_bridge`` with the example file and
+``cmd_vel``, see ``testing/fleet_sim.py``); one ``parameter_bridge`` with the example file and
 ``robot=robot_1,...,robot_10``; one rclpy checker process that subscribes to every ROS topic
 and publishes every robot's ``cmd_vel``. Each robot's messages carry its index, so every topic
 is checked to bring its own robot's values, both ways, at the issue's rates (about 4,600
@@ -23,9 +23,9 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.native import extension
-from tests import fleet_sim
-from tests.bridge.behaviour_harness import bridge_command
-from tests.bridge.e2e_harness import (
+from testing import fleet_sim
+from testing.behaviour_harness import bridge_command
+from testing.e2e_harness import (
     RUN_TIMEOUT,
     ProcessGroup,
     RosChecker,
@@ -34,8 +34,9 @@ from tests.bridge.e2e_harness import (
     status_rows,
     wait_all,
 )
+from testing.gzpeer import ROOT, PeerProcess, require_peer, wait_for_line
+from testing.procstat import threads_of
 from tests.bridge.e2e_values import mismatches
-from tests.gzpeer import ROOT, PeerProcess, require_peer, threads_of, wait_for_line
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros]
 

@@ -2,7 +2,7 @@
 
 Each test runs its own bridge process (``status_period:=0.5``) bridging one String topic
 Gazebo -> ROS, reads its counters from ``/diagnostics`` with rclpy and its memory and CPU from
-``/proc/<pid>``. The hostile peers (``tests/rogue.py``) are raw pyzmq sockets and raw discovery
+``/proc/<pid>``. The hostile peers (``testing/rogue.py``) are raw pyzmq sockets and raw discovery
 datagrams on loopback, bounded in count and time; the real publisher is the C++ ign-transport
 11 peer. Figures are printed (``-s`` shows them); asserts are the behaviour bounds of the
 issue, with the margins explained where they are made.
@@ -10,7 +10,6 @@ issue, with the margins explained where they are made.
 
 from __future__ import annotations
 
-import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -22,8 +21,8 @@ from std_msgs.msg import String
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.names import fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
-from tests.bridge.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge
-from tests.gzpeer import (
+from testing.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge
+from testing.gzpeer import (
     Inbox,
     PeerProcess,
     gz_processes,
@@ -33,7 +32,8 @@ from tests.gzpeer import (
     wait_for_line,
     wait_until,
 )
-from tests.rogue import FakePeer, RoguePublisher, TrapListeners, closed_ports, cpu_percent, usage
+from testing.procstat import PeakRss, cpu_percent, usage
+from testing.rogue import FakePeer, RoguePublisher, TrapListeners, closed_ports
 
 __all__ = ["gz_processes", "ign_peer", "ros_side"]
 
@@ -97,26 +97,6 @@ def bridge(ros_side: RosSide, request: pytest.FixtureRequest) -> Iterator[Bridge
     under_attack = BridgeUnderAttack(ros_side, request.node.name[5:25])
     yield under_attack
     under_attack.close()
-
-
-class PeakRss:
-    """Samples a process's resident memory every 10 ms on a thread, keeping the peak."""
-
-    def __init__(self, pid: int) -> None:
-        self._pid = pid
-        self.peak = usage(pid).rss_bytes
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        while not self._stop.wait(0.01):
-            self.peak = max(self.peak, usage(self._pid).rss_bytes)
-
-    def stop(self) -> int:
-        self._stop.set()
-        self._thread.join()
-        return self.peak
 
 
 def test_a_rogue_publishers_200_mb_frames_are_refused_counted_and_cost_no_memory(

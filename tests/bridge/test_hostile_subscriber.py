@@ -1,7 +1,7 @@
 """The real ``parameter_bridge`` against a Gazebo subscriber that never reads (issue 29).
 
 A bridge forwards camera images (sensor_msgs/Image of 3 MB, ROS -> Gazebo) to a rogue ZeroMQ
-subscriber (``tests/rogue.py``) that subscribes through valid discovery and never reads, and
+subscriber (``testing/rogue.py``) that subscribes through valid discovery and never reads, and
 to a healthy Gazebo subscriber beside it. libzmq queues up to SNDHWM (1000) messages per
 subscriber whatever their size: before images were sent from a socket whose queue is sized
 for them, the bridge held every image it sent (+460 MB for 150 of them). Memory is the
@@ -23,10 +23,10 @@ from sensor_msgs.msg import Image
 from ros_gz_bridge_py.transport import GzNode
 from ros_gz_bridge_py.transport.names import fully_qualified_name
 from ros_gz_bridge_py.transport.settings import TransportSettings
-from tests.bridge.behaviour_harness import WAIT, RosSide, gz_node, ros_side, start_bridge
-from tests.bridge.test_hostile_gazebo import PeakRss
-from tests.gzpeer import Inbox, PeerProcess, unique_name, wait_until
-from tests.rogue import RogueSubscriber, usage
+from testing.behaviour_harness import WAIT, RosSide, gz_node, ros_side, start_bridge
+from testing.gzpeer import Inbox, PeerProcess, unique_name, wait_until
+from testing.procstat import PeakRss, usage
+from testing.rogue import RogueSubscriber
 
 __all__ = ["gz_node", "ros_side"]
 

@@ -20,7 +20,7 @@ import pytest
 from sensor_msgs.msg import CameraInfo, Image
 
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     WAIT,
     RosSide,
     gz_node,
@@ -29,15 +29,7 @@ from tests.bridge.behaviour_harness import (
     ros_side,
     started,
 )
-from tests.bridge.image_frames import (
-    UNSUPPORTED_FORMAT,
-    camera_info,
-    image_bridge_command,
-    pattern_bytes,
-    rgb_frame,
-    rgb_text_proto,
-)
-from tests.gzpeer import (
+from testing.gzpeer import (
     Inbox,
     PeerProcess,
     require_peer,
@@ -46,6 +38,14 @@ from tests.gzpeer import (
     unique_name,
     wait_for_line,
     wait_until,
+)
+from tests.bridge.image_frames import (
+    UNSUPPORTED_FORMAT,
+    camera_info,
+    image_bridge_command,
+    pattern_bytes,
+    rgb_frame,
+    rgb_text_proto,
 )
 
 __all__ = ["gz_node", "ros_side", "started"]

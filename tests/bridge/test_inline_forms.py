@@ -17,7 +17,7 @@ from typing import Any
 
 import pytest
 
-from tests.bridge.e2e_harness import (
+from testing.e2e_harness import (
     RUN_TIMEOUT,
     GzEcho,
     ProcessGroup,
@@ -25,6 +25,7 @@ from tests.bridge.e2e_harness import (
     parse_gz,
     wait_all,
 )
+from testing.gzpeer import PeerProcess, unique_name
 from tests.bridge.e2e_values import (
     CLOCK,
     IMU_FORTRESS,
@@ -38,7 +39,6 @@ from tests.bridge.e2e_values import (
     RosSample,
     mismatches,
 )
-from tests.gzpeer import PeerProcess, unique_name
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros]
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.bridge.e2e_harness import (
+from testing.e2e_harness import (
     RUN_TIMEOUT,
     GzEcho,
     ProcessGroup,
@@ -33,8 +33,8 @@ from tests.bridge.e2e_harness import (
     parse_gz,
     wait_all,
 )
+from testing.gzpeer import ROOT, PeerProcess
 from tests.bridge.e2e_values import CLOCK, ODOMETRY, TWIST_TO_GZ, GzSample, mismatches
-from tests.gzpeer import ROOT, PeerProcess
 
 
 def launch_problem() -> str | None:

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.bridge.behaviour_harness import WAIT, relative, start_bridge
-from tests.gzpeer import PeerProcess, unique_name, wait_until
+from testing.behaviour_harness import WAIT, relative, start_bridge
+from testing.gzpeer import PeerProcess, unique_name, wait_until
 
 pytestmark = [pytest.mark.ros]
 

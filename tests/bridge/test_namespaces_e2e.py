@@ -10,9 +10,8 @@ import pytest
 from sensor_msgs.msg import Image
 from std_msgs.msg import String
 
-from tests.bridge.behaviour_harness import WAIT, RosSide, bridge_command, probe, relative, started
-from tests.bridge.image_frames import image_bridge_command, rgb_text_proto
-from tests.gzpeer import (
+from testing.behaviour_harness import WAIT, RosSide, bridge_command, probe, relative, started
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,
@@ -21,6 +20,7 @@ from tests.gzpeer import (
     wait_for_line,
     wait_until,
 )
+from tests.bridge.image_frames import image_bridge_command, rgb_text_proto
 
 __all__ = ["probe", "started"]
 

@@ -25,7 +25,7 @@ import pytest
 
 from ros_gz_bridge_py.app.settings import NATIVE_ENV, switched_off
 from ros_gz_bridge_py.native import extension
-from tests.bridge.e2e_harness import (
+from testing.e2e_harness import (
     RUN_TIMEOUT,
     GzEcho,
     ProcessGroup,
@@ -33,6 +33,7 @@ from tests.bridge.e2e_harness import (
     parse_gz,
     wait_all,
 )
+from testing.gzpeer import ROOT, unique_name, wait_for_line
 from tests.bridge.e2e_values import (
     CLOCK,
     JOINT_STATES,
@@ -41,7 +42,6 @@ from tests.bridge.e2e_values import (
     GzSample,
     mismatches,
 )
-from tests.gzpeer import ROOT, unique_name, wait_for_line
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
 

@@ -19,7 +19,7 @@ from std_msgs.msg import String
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.loop import QUIET_COUNT_EVERY
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -28,7 +28,7 @@ from tests.bridge.behaviour_harness import (
     start_bridge,
     started,
 )
-from tests.gzpeer import (
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,

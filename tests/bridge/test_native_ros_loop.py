@@ -28,7 +28,7 @@ from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.loop import ROS_TO_GZ, shared_loop
 from ros_gz_bridge_py.transport import GzNode, create_gz_node
 from ros_gz_bridge_py.transport.api import MessageInfo
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -37,7 +37,7 @@ from tests.bridge.behaviour_harness import (
     ros_side,
     started,
 )
-from tests.gzpeer import (
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,

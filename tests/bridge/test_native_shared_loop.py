@@ -16,15 +16,9 @@ import pytest
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.native import extension
-from tests.bridge.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge, started
-from tests.gzpeer import (
-    PeerProcess,
-    require_peer,
-    start_peer,
-    threads_of,
-    unique_name,
-    wait_until,
-)
+from testing.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge, started
+from testing.gzpeer import PeerProcess, require_peer, start_peer, unique_name, wait_until
+from testing.procstat import threads_of
 
 __all__ = ["ros_side", "started"]
 

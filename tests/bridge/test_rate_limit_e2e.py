@@ -16,8 +16,8 @@ import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from std_msgs.msg import String
 
-from tests.bridge.behaviour_harness import WAIT, RosSide, bridge_command, probe, started
-from tests.gzpeer import (
+from testing.behaviour_harness import WAIT, RosSide, bridge_command, probe, started
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,

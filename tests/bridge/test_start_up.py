@@ -18,7 +18,7 @@ import uuid
 import pytest
 from rcl_interfaces.srv import ListParameters
 
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -26,12 +26,10 @@ from tests.bridge.behaviour_harness import (
     start_bridge,
     started,
 )
-from tests.gzpeer import PeerProcess, unique_name, wait_until
-from tests.ros.test_bridge_node import PARAMETER_SERVICES as NODE_SERVICES
+from testing.gzpeer import PeerProcess, unique_name, wait_until
+from tests.rclpy_services import PARAMETER_SERVICES
 
 __all__ = ["ros_side", "started"]
-
-PARAMETER_SERVICES = frozenset(NODE_SERVICES)
 
 
 def services_by_node(ros: RosSide) -> dict[str, set[str]]:

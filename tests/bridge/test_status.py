@@ -23,7 +23,7 @@ from std_msgs.msg import String
 
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import GzNode
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     STRING,
     WAIT,
     RosSide,
@@ -32,7 +32,7 @@ from tests.bridge.behaviour_harness import (
     ros_side,
     start_bridge,
 )
-from tests.gzpeer import Inbox, PeerProcess, unique_name, wait_for_line, wait_until
+from testing.gzpeer import Inbox, PeerProcess, unique_name, wait_for_line, wait_until
 
 __all__ = ["gz_node", "ros_side"]
 

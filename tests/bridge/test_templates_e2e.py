@@ -15,7 +15,7 @@ import pytest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from tests.bridge.behaviour_harness import (
+from testing.behaviour_harness import (
     WAIT,
     RosSide,
     bridge_command,
@@ -23,7 +23,7 @@ from tests.bridge.behaviour_harness import (
     publish_until,
     started,
 )
-from tests.gzpeer import (
+from testing.gzpeer import (
     PeerProcess,
     require_peer,
     start_peer,

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.bridge.e2e_harness import (
+from testing.e2e_harness import (
     RUN_TIMEOUT,
     ConfigEntry,
     GzEcho,
@@ -29,9 +29,9 @@ from tests.bridge.e2e_harness import (
     read_entries,
     wait_all,
 )
+from testing.gzpeer import PeerProcess, wait_for_line
+from testing.loopback import free_port, zenoh_env
 from tests.bridge.e2e_values import TWIST_TO_GZ, mismatches, sample_for
-from tests.gzpeer import PeerProcess, wait_for_line
-from tests.loopback import free_port, zenoh_env
 
 pytestmark = [pytest.mark.ros]
 

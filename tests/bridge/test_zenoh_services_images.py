@@ -21,12 +21,12 @@ from ros_gz_interfaces.srv import ControlWorld
 from sensor_msgs.msg import Image
 
 from ros_gz_bridge_py.msgs import message_class
-from tests.bridge.behaviour_harness import WAIT, RosSide, ros_side
-from tests.bridge.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
+from testing.behaviour_harness import WAIT, RosSide, ros_side
+from testing.e2e_harness import PARAMETER_BRIDGE, ProcessGroup, lines
+from testing.gzpeer import PeerProcess, unique_name, wait_for_line
+from testing.loopback import free_port, zenoh_env
 from tests.bridge.image_frames import rgb_frame
 from tests.bridge.test_zenoh_e2e import GAZEBO_SIDE, HERE
-from tests.gzpeer import PeerProcess, unique_name, wait_for_line
-from tests.loopback import free_port, zenoh_env
 
 __all__ = ["ros_side"]
 

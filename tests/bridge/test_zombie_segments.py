@@ -16,8 +16,8 @@ import time
 from pathlib import Path
 
 from ros_gz_bridge_py.ros.speed import PROFILE, SHM_DIR, ZOMBIE_MIN_AGE
-from tests.bridge.behaviour_harness import bridge_command
-from tests.gzpeer import start_process, unique_name, wait_for_line
+from testing.behaviour_harness import bridge_command
+from testing.gzpeer import start_process, unique_name, wait_for_line
 
 WAIT = 20.0
 #: An rclpy node that publishes once, so its shared-memory segment exists, then waits.

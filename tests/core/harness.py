@@ -4,7 +4,7 @@
   also spins the node of every bridge (its heartbeat and explain timers, its ROS->Gazebo
   callbacks). Whatever creates or destroys entities on a spun node goes through
   :meth:`RosWorld.run`, which holds the lock the spin loop holds (as ``RosSide`` of
-  ``tests/bridge/behaviour_harness.py`` does), so nothing changes under a running ``spin_once``.
+  ``testing/behaviour_harness.py`` does), so nothing changes under a running ``spin_once``.
 * :class:`Rig` is one :class:`~ros_gz_bridge_py.core.bridge.Bridge` on a ``MemoryGzNode`` of
   a private ``MemoryNetwork``; :meth:`Rig.gazebo` adds nodes on that network that play Gazebo
   processes (``native=Spelling.IGNITION`` for a Fortress one).
@@ -37,7 +37,8 @@ from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.msgs.names import Spelling
-from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
+from ros_gz_bridge_py.transport.memory.network import MemoryNetwork
+from ros_gz_bridge_py.transport.memory.node import MemoryGzNode
 
 #: History depth of the test node's endpoints: deeper than any burst a test sends, so the
 #: test's reader keeps every message until its executor takes it.

@@ -1,6 +1,6 @@
 """Gazebo -> ROS channels publish the same messages with the CDR writer as through rclpy.
 
-The writer's bytes are compared with rclpy's for every pair in tests/unit/test_cdr_writer.py;
+The writer's bytes are compared with rclpy's for every pair in tests/unit/ros/test_cdr_writer.py;
 here a real channel publishes them through rcl (GIL released) to a real rclpy subscription,
 and what arrives is compared with what the same channel publishes with ``cdr_write`` off. A
 message the writer refuses goes through rclpy's publish and arrives as rclpy makes it.

@@ -23,8 +23,9 @@ from ros_gz_bridge_py.core.status import channel_status, diagnostic_array, forma
 from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError, UndecodableError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import Rejection, TransportSettings
-from ros_gz_bridge_py.transport.memory.node import MemoryGzNode, MemoryNetwork
-from tests.polling import wait_until
+from ros_gz_bridge_py.transport.memory.network import MemoryNetwork
+from ros_gz_bridge_py.transport.memory.node import MemoryGzNode
+from testing.polling import wait_until
 
 STRING = "gz.msgs.StringMsg"
 IMAGE = "gz.msgs.Image"

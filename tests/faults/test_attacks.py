@@ -1,7 +1,7 @@
 """A short attack suite in the suite (``python -m benchmarks.attacks`` measures the long one
 and writes the Attacks section of SOAK.md).
 
-Two seconds of each attack of ``benchmarks/attacks.py`` (padded Odometry floods, a Pose_V of
+Two seconds of each attack of ``testing/attacks.py`` (padded Odometry floods, a Pose_V of
 4 M empty poses, Odometry followed by 768 KiB of unknown fields, from a rogue publisher beside
 real C++ /clock and Odometry publishers) against a bridge on each path. Asserted are the bounds
 that are not speed: the bridge lives, nothing it publishes carries the rogue's bulk, its memory
@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import pytest
 
-from benchmarks.attacks import AttackRun, attacks
-from tests.gzpeer import require_peer
+from testing.attacks import AttackRun, attacks
+from testing.gzpeer import require_peer
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
 

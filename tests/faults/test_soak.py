@@ -1,6 +1,6 @@
 """A short soak in the suite (``make soak`` runs the long one and writes SOAK.md).
 
-45 s of ``benchmarks/soak.py``: mixed traffic both ways, a service called five times a second,
+45 s of ``testing/soak.py``: mixed traffic both ways, a service called five times a second,
 the Gazebo Odometry publisher killed and restarted every 20 s, ROS subscriptions made and
 destroyed every 2 s, malformed discovery datagrams and a rogue publisher's garbage every 15 s.
 The bounds below are what "survives" means here, with room for a busy 2-core machine; the
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import pytest
 
-from benchmarks.soak import Soak
-from tests.gzpeer import require_peer
+from testing.gzpeer import require_peer
+from testing.soak import Soak
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
 

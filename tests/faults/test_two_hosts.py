@@ -26,9 +26,9 @@ from pathlib import Path
 import pytest
 
 from ros_gz_bridge_py.msgs import message_class
-from tests.bridge.e2e_harness import PARAMETER_BRIDGE, ProcessGroup
+from testing.e2e_harness import PARAMETER_BRIDGE, ProcessGroup
+from testing.gzpeer import PeerProcess, peer_binary, require_peer
 from tests.faults.netns import TwoHosts, require_namespaces, two_hosts
-from tests.gzpeer import PeerProcess, peer_binary, require_peer
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
 

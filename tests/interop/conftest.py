@@ -18,9 +18,9 @@ if _ROOT not in sys.path:
     sys.path.insert(0, _ROOT)
 
 from ros_gz_bridge_py.transport import create_gz_node  # noqa: E402
-from tests.gzpeer import gz_processes, ign_peer  # noqa: E402
+from testing.gzpeer import gz_processes, ign_peer, require_peer  # noqa: E402
 
-__all__ = ["gz_node", "gz_processes", "ign_peer", "stop_started_processes"]
+__all__ = ["gz_node", "gz_processes", "ign_peer", "module_gz_node", "stop_started_processes"]
 
 
 @pytest.fixture(autouse=True)
@@ -31,5 +31,13 @@ def stop_started_processes(gz_processes: None) -> None:
 @pytest.fixture
 def gz_node() -> Iterator[Any]:
     """A started node of ours (closed after the test)."""
+    with create_gz_node() as node:
+        yield node
+
+
+@pytest.fixture(scope="module")
+def module_gz_node() -> Iterator[Any]:
+    """One started node of ours for all the tests of a module (skips without the peer tools)."""
+    require_peer()
     with create_gz_node() as node:
         yield node

@@ -1,7 +1,7 @@
 """Our gz.msgs schemas against Debian's real Fortress (ign-msgs 8) ``.proto`` files.
 
 The Fortress files are compiled with protoc and compared with our committed descriptor set
-(whose freshness tests/unit/test_msgs.py checks): for every message we define that also exists
+(whose freshness tests/unit/msgs/test_pool.py checks): for every message we define that also exists
 in ign-msgs 8, each field both define must have the same number, name and wire type, and each
 enum value both define the same name. Additive fields (docs/protocol.md §9.5) are only on one
 side, so they are not compared. ``gz.msgs.IMU`` is the one known renumbering: it is skipped, and our

@@ -20,7 +20,7 @@ import pytest
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import TransportSettings
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
-from tests.gzpeer import Inbox, start_peer, unique_name, wait_for_line, wait_until
+from testing.gzpeer import Inbox, start_peer, unique_name, wait_for_line, wait_until
 
 pytestmark = pytest.mark.peer
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.gzpeer import PeerProcess, start_peer, start_process, unique_name, wait_for_line
+from testing.gzpeer import PeerProcess, start_peer, start_process, unique_name, wait_for_line
 
 pytestmark = pytest.mark.peer
 

@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.msgs import message_class
-from tests.gzpeer import Inbox, start_peer, unique_name, wait_for_line, wait_until
+from testing.gzpeer import Inbox, start_peer, unique_name, wait_for_line, wait_until
 
 pytestmark = pytest.mark.peer
 

@@ -11,7 +11,7 @@ import pytest
 
 from ros_gz_bridge_py.errors import TransportTimeoutError
 from ros_gz_bridge_py.msgs import message_class
-from tests.gzpeer import ign_service, start_peer, unique_name, wait_for_line
+from testing.gzpeer import ign_service, start_peer, unique_name, wait_for_line
 
 pytestmark = pytest.mark.peer
 

@@ -15,7 +15,7 @@ import pytest
 
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import spellings
-from tests.gzpeer import (
+from testing.gzpeer import (
     IGN_TOPIC,
     Inbox,
     ign_topic,

@@ -13,7 +13,7 @@ import sys
 
 import pytest
 
-from tests.gzpeer import ROOT
+from testing.gzpeer import ROOT
 
 pytestmark = [pytest.mark.slow]
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.gzpeer import ROOT
+from testing.gzpeer import ROOT
 
 
 def test_pip_reads_the_metadata_without_a_deprecation_warning(tmp_path: Path) -> None:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.gzpeer import ROOT
+from testing.gzpeer import ROOT
 
 pytestmark = [pytest.mark.slow]
 

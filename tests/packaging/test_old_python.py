@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.gzpeer import ROOT
+from testing.gzpeer import ROOT
 
 OLDER = ("3.10", "3.9", "3.8")
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from ros_gz_bridge_py.app.rclpy_check import install_distro, rclpy_problem
-from tests.gzpeer import ROOT
+from testing.gzpeer import ROOT
 
 #: The interpreter this venv was made from: the same Python, without the venv's packages.
 BASE_PYTHON = Path(sys.base_prefix) / "bin" / f"python{sys.version_info[0]}.{sys.version_info[1]}"

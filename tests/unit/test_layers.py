@@ -6,10 +6,11 @@ run. The layers, bottom up, are the folders (and root modules) of ``ros_gz_bridg
 
 from __future__ import annotations
 
-import ast
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parents[2] / "ros_gz_bridge_py"
+from tests.unit.import_graph import REPO, imports
+
+PACKAGE = REPO / "ros_gz_bridge_py"
 #: Bottom up; a part may import its own layer and those below.
 LAYERS: tuple[frozenset[str], ...] = (
     frozenset({"errors", "libc", "msgs", "watchers"}),
@@ -33,24 +34,9 @@ def part_of(module: str) -> str | None:
     return names[1] if len(names) > 1 else "__init__"
 
 
-def runtime_imports(path: Path) -> list[tuple[int, str]]:
+def runtime_imports(path: Path, root: Path = REPO) -> list[tuple[int, str]]:
     """(line, module) of every import that runs (not under ``if TYPE_CHECKING``)."""
-    tree = ast.parse(path.read_text(), str(path))
-    type_only = {
-        id(node)
-        for block in ast.walk(tree)
-        if isinstance(block, ast.If) and getattr(block.test, "id", "") == "TYPE_CHECKING"
-        for node in ast.walk(block)
-    }
-    found = []
-    for node in ast.walk(tree):
-        if id(node) in type_only:
-            continue
-        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            found.append((node.lineno, node.module))
-        elif isinstance(node, ast.Import):
-            found += [(node.lineno, alias.name) for alias in node.names]
-    return found
+    return [(item.line, item.module) for item in imports(path, root) if not item.type_only]
 
 
 def test_every_part_has_a_layer() -> None:
@@ -80,4 +66,4 @@ def test_the_check_sees_an_upward_import(tmp_path: Path) -> None:
         "if TYPE_CHECKING:\n"
         "    from ros_gz_bridge_py.app import settings\n"
     )
-    assert runtime_imports(sample) == [(1, "typing"), (2, "ros_gz_bridge_py.core.bridge")]
+    assert runtime_imports(sample, tmp_path) == [(1, "typing"), (2, "ros_gz_bridge_py.core.bridge")]

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import collections
 import functools
-import itertools
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -41,23 +40,11 @@ from ros_gz_bridge_py.transport.api import (
 )
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
+from ros_gz_bridge_py.transport.memory.network import DEFAULT_NETWORK, Announcement, MemoryNetwork
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.node import GzNode
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber
-
-_NETWORK_IDS = itertools.count(1)
-
-
-@dataclass(frozen=True)
-class Announcement:
-    """One publisher under one spelling (an ADVERTISE record)."""
-
-    fqn: str
-    msg_type: str
-    node: MemoryGzNode
-    #: Where its messages come from; one per node, as a ZeroMQ process's PUB address.
-    address: str
 
 
 class MemoryPublisher(Publisher):
@@ -72,26 +59,6 @@ class _Call(ServiceCall):
 
     caller: MemoryGzNode | None = field(default=None)
     done: bool = False
-
-
-class MemoryNetwork:
-    """Who announces and who registered, shared by the nodes on it (thread-safe)."""
-
-    def __init__(self) -> None:
-        self.name = f"memory-{next(_NETWORK_IDS)}"
-        self.lock = threading.RLock()
-        self.nodes: list[MemoryGzNode] = []
-        self.announcements: list[Announcement] = []
-        self.offers: list[ServiceOffer] = []
-
-    def spellings(self) -> dict[str, Spelling]:
-        """The native spelling of each node that has one, by process."""
-        with self.lock:
-            return {n.process_uuid: n.native for n in self.nodes if n.native is not None}
-
-
-#: The network of ``create_gz_node(NodeOptions(implementation="memory"))``.
-DEFAULT_NETWORK = MemoryNetwork()
 
 
 class MemoryGzNode(GzNode):

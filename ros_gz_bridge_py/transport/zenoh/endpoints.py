@@ -15,6 +15,7 @@ from ros_gz_bridge_py.transport.names import decompose
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zenoh.node import ZenohGzNode
+    from ros_gz_bridge_py.transport.zenoh.node_services import ZenohServices
 
 
 def undeclare(*entities: Any) -> None:
@@ -48,7 +49,7 @@ class ZenohServiceOffer(ServiceOffer):
 
     def __init__(
         self,
-        node: ZenohGzNode,
+        node: ZenohServices,
         service: str,
         fqn: str,
         types: tuple[str, str],

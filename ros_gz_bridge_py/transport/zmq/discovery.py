@@ -2,8 +2,8 @@
 
 One :class:`DiscoveryEngine` serves one discovery port (a node runs one for topics on the
 msg port and one for services on the srv port, §2.1). It owns no socket and no clock: the
-runner feeds it datagrams and the time, and sends what it returns. Bad datagrams are counted
-in :attr:`DiscoveryEngine.counts` and never raise.
+runner feeds it datagrams and the time, and sends what it returns (:mod:`~.discovery_events`).
+Bad datagrams are counted in :attr:`DiscoveryEngine.counts` and never raise.
 """
 
 from __future__ import annotations
@@ -12,12 +12,21 @@ import collections
 import logging
 import math
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.wire_types import PeerSpellings, RemoteSubscriber
+from ros_gz_bridge_py.transport.zmq.discovery_events import (
+    Event,
+    Outgoing,
+    PublisherAdded,
+    PublisherRemoved,
+    Result,
+    SubscriberAdded,
+    SubscriberRemoved,
+)
 from ros_gz_bridge_py.transport.zmq.wire import (
     WIRE_VERSION,
     DiscoveryMessage,
@@ -47,51 +56,6 @@ INIT_DELAY = 2 * HEARTBEAT_INTERVAL
 def _silent_after(seen: float) -> float:
     """When a peer last heard from at ``seen`` is checked for silence."""
     return seen + SILENCE_INTERVAL + ACTIVITY_INTERVAL
-
-
-@dataclass(frozen=True, slots=True)
-class Outgoing:
-    """A datagram to send: to the multicast group (``relay_ip`` None) or to one relay."""
-
-    data: bytes
-    relay_ip: str | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class PublisherAdded:
-    """A remote publisher record appeared (a new entry, §2.4 ADVERTISE)."""
-
-    record: PublisherRecord
-
-
-@dataclass(frozen=True, slots=True)
-class PublisherRemoved:
-    """A remote publisher record went away (UNADVERTISE, BYE, silence, replaced address)."""
-
-    record: PublisherRecord
-
-
-@dataclass(frozen=True, slots=True)
-class SubscriberAdded:
-    """A remote node subscribed to one of our topics (NEW_CONNECTION with our ctrl)."""
-
-    topic: str
-    process_uuid: str
-    node_uuid: str
-    msg_type: str
-
-
-@dataclass(frozen=True, slots=True)
-class SubscriberRemoved:
-    """A remote node unsubscribed from one of our topics (END_CONNECTION)."""
-
-    topic: str
-    process_uuid: str
-    node_uuid: str
-
-
-Event = PublisherAdded | PublisherRemoved | SubscriberAdded | SubscriberRemoved
-Result = tuple[list[Outgoing], list[Event]]
 
 
 class DiscoveryEngine:

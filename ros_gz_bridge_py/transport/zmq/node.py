@@ -4,7 +4,7 @@ Each :class:`ZmqGzNode` is a full gz participant with its own process UUID (two 
 Python process look like two processes on the wire), with two discovery engines (topics and
 services, :mod:`~.discovery`) and the sockets of docs/protocol.md §2.1 (:mod:`~.sockets`).
 The service side is :class:`~.services.ServiceRouter`, received data is routed by
-:mod:`~.routes`, and what discovery knows is read by :mod:`~.graph`.
+:mod:`~.routes`, and what discovery knows is answered by :class:`~.node_graph.ZmqGraphView`.
 
 Threading model: one I/O thread (``gz-io``) owns the discovery engines and every socket
 except PUB and the queued subscriptions' own SUB sockets; other threads post commands to it
@@ -30,23 +30,14 @@ from typing import Any, TypeVar, cast
 import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError
-from ros_gz_bridge_py.transport.api import (
-    GraphEndpoint,
-    Scope,
-    ServiceHandler,
-    TopicInfo,
-)
+from ros_gz_bridge_py.transport.api import Scope, ServiceHandler
 from ros_gz_bridge_py.transport.budget import TURN_MESSAGES
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
-from ros_gz_bridge_py.transport.node import GzNode
 from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, TransportSettings
-from ros_gz_bridge_py.transport.zmq import graph
-from ros_gz_bridge_py.transport.zmq.discovery import (
-    INIT_DELAY,
-    DiscoveryEngine,
+from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine
+from ros_gz_bridge_py.transport.zmq.discovery_events import (
     Event,
-    Outgoing,
     PublisherAdded,
     PublisherRemoved,
     SubscriberAdded,
@@ -55,6 +46,7 @@ from ros_gz_bridge_py.transport.zmq.discovery import (
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
 from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
 from ros_gz_bridge_py.transport.zmq.intake import DataIntake, Reader
+from ros_gz_bridge_py.transport.zmq.node_graph import ZmqGraphView
 from ros_gz_bridge_py.transport.zmq.routes import DataRouter
 from ros_gz_bridge_py.transport.zmq.services import PendingCall, RouterSockets, ServiceRouter
 from ros_gz_bridge_py.transport.zmq.socket_owner import receive_message
@@ -73,18 +65,9 @@ T = TypeVar("T")
 #: Poll timeout while a retry is pending, and the longest poll otherwise (§2.5: 250 ms).
 RETRY_POLL = 0.005
 MAX_POLL = 0.25
-#: Our counters for the discovery engines' counts of bad or foreign datagrams (§2.3).
-_ENGINE_COUNTS = {
-    "datagrams_received": "received",
-    "datagrams_malformed": "malformed",
-    "datagrams_wrong_version": "wrong_version",
-    "peers_expired": "peers_expired",
-    "unknown_types": "unknown_type",
-    "addresses_refused": "addresses_refused",
-}
 
 
-class ZmqGzNode(GzNode):
+class ZmqGzNode(ZmqGraphView):
     """A Gazebo Transport node speaking the ZeroMQ protocol (gz-transport wire version 10)."""
 
     subscription_class = ZmqSubscription
@@ -202,9 +185,7 @@ class ZmqGzNode(GzNode):
     def _add_stats(self, counts: dict[str, int]) -> dict[str, int]:
         """The I/O thread's and the readers' received counts, and the discovery counters."""
         counts["messages_received"] = self._router.received + self._intake.received
-        for ours, theirs in _ENGINE_COUNTS.items():
-            counts[ours] = counts.get(ours, 0) + self._msg.counts[theirs] + self._srv.counts[theirs]
-        return counts
+        return super()._add_stats(counts)
 
     # --- topics -----------------------------------------------------------------------------
 
@@ -359,69 +340,7 @@ class ZmqGzNode(GzNode):
         """``call``'s callback runs exactly once on the I/O thread."""
         self._post(lambda: self._services.start_call(call))
 
-    # --- what discovery knows ---------------------------------------------------------------
-
-    def _discovered(self, read: Callable[[], T]) -> T:
-        """``read`` on the I/O thread once discovery is initialised (two heartbeats, §2.5),
-        as gz's listings wait."""
-        remaining = self._msg.started + INIT_DELAY - time.monotonic()
-        if remaining > 0:
-            time.sleep(remaining)
-        return self._call(read)
-
-    def topic_list(self) -> list[str]:
-        """Topics with a publisher in this partition."""
-        return self._discovered(lambda: graph.names(self._msg, self.partition, services=False))
-
-    def topic_info(self, topic: str) -> list[TopicInfo]:
-        """Publishers of ``topic``."""
-        return self._discovered(lambda: graph.infos(self._msg, self.fqn(topic)))
-
-    def service_list(self) -> list[str]:
-        """Services with a provider in this partition."""
-        return self._discovered(lambda: graph.names(self._srv, self.partition, services=True))
-
-    def service_info(self, service: str) -> list[TopicInfo]:
-        """Providers of ``service``."""
-        return self._discovered(lambda: graph.infos(self._srv, self.fqn(service)))
-
-    def observe(self, topic: str) -> list[GraphEndpoint]:
-        """Publishers and subscribers of ``topic`` in other processes, every partition."""
-        return self._call(lambda: graph.observe(self._msg, self.fqn(topic), self.process_uuid))
-
-    def graph(self) -> list[GraphEndpoint]:  # GzNode.graph: observe for every topic
-        return self._call(lambda: graph.endpoints(self._msg, self.process_uuid))
-
-    def peer_processes(self) -> int:
-        """Other processes heard on either discovery port and not yet expired."""
-        return self._call(lambda: len({*self._msg.processes(), *self._srv.processes()}))
-
-    def listening(self) -> str:
-        """Backend, partition, discovery group and ports, the interface and any relays."""
-        relays = f", relays {', '.join(self.settings.relays)}" if self.settings.relays else ""
-        return (
-            f"ZeroMQ discovery on {self.settings.multicast_ip} ports {self.settings.msg_port} "
-            f"(topics) and {self.settings.srv_port} (services) via {self.host}{relays}, "
-            f"partition '{self.partition}'"
-        )
-
-    def ask_subscribers(self) -> None:
-        """SUBSCRIBERS_REQ, if every peer is gz-transport 13+ (11/12 print an error for it)."""
-
-        def command() -> None:
-            spellings = self._msg.spellings
-            if spellings.modern and not spellings.legacy_processes:
-                self._datagrams(self._io.msg_udp, self._msg.subscribers_request())
-
-        with contextlib.suppress(TransportError):
-            self._post(command)
-
     # --- the I/O thread ---------------------------------------------------------------------
-
-    def _datagrams(self, udp: DiscoverySocket, datagrams: list[Outgoing]) -> None:
-        for out in datagrams:
-            if not udp.send(out.data, out.relay_ip):
-                self.count("send_failures")
 
     def _io_main(self) -> None:
         poller = zmq.Poller()
@@ -522,6 +441,3 @@ class ZmqGzNode(GzNode):
             self._intake.publisher_gone(event.record, list(self._msg.all_publishers()))
         elif isinstance(event, SubscriberAdded | SubscriberRemoved):
             self._update_subscribers(event.topic)
-
-    def _update_subscribers(self, fqn: str) -> None:
-        self.subscriber_book.set_subscribers(fqn, self._msg.remote_subscribers(fqn))

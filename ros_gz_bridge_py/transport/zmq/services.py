@@ -24,7 +24,8 @@ import zmq
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.transport.api import ONE_WAY_TYPES, ReplyCallback, ServiceCall
 from ros_gz_bridge_py.transport.handles import ServiceOffer, offer_key
-from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine, Outgoing
+from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine
+from ros_gz_bridge_py.transport.zmq.discovery_events import Outgoing
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqServiceOffer
 from ros_gz_bridge_py.transport.zmq.wire import (
     Frame,

@@ -193,7 +193,8 @@ def test_to_gz_more_good_beams_than_slots_is_an_error(good_beams: int) -> None:
 
 
 def test_light_tree_of_a_valid_dvl_converts_like_the_rclpy_message() -> None:
-    # tests/unit/test_ros_cdr.py fills num_good_beams with more than 4: only the error path.
+    # tests/unit/ros/test_light_reader.py fills num_good_beams with more than 4: only the error
+    # path.
     msg = ros_dvl(good_beams=4)
     tree = light_reader.read(serialize_message(msg), Dvl)
     assert tree is not None

@@ -90,7 +90,7 @@ def test_default_fix_sends_nine_zeros_of_unknown_type() -> None:
 
 
 def test_light_tree_of_a_valid_fix_converts_like_the_rclpy_message() -> None:
-    # tests/unit/test_ros_cdr.py fills an invalid covariance type: only the error path.
+    # tests/unit/ros/test_light_reader.py fills an invalid covariance type: only the error path.
     msg = ros_fix()
     tree = light_reader.read(serialize_message(msg), NavSatFix)
     assert tree is not None

@@ -12,7 +12,7 @@ from ros_gz_bridge_py.transport.wire_types import (
 )
 from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine
 from ros_gz_bridge_py.transport.zmq.wire import DiscoveryMessage, DiscoveryType, encode_discovery
-from tests.unit.transport.test_discovery import record
+from tests.unit.transport.peers import record
 
 GZ, IGN = "gz.msgs.Twist", "ignition.msgs.Twist"
 NAMES = (GZ, IGN)

@@ -1,0 +1,131 @@
+"""How BENCHMARKS.md is put together: the headline first, the other sections where they were,
+what counts as a sustainable 1080p rate, the bridge's CPU split by thread, and the fleet's
+goals."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from benchmarks import fleet_goals, report, results
+from benchmarks.costs import split_text, thread_split_ms
+from benchmarks.fleet_goals import Round
+from benchmarks.harness import FlowResult, thread_group_seconds
+from benchmarks.sustained import highest
+
+
+@pytest.fixture
+def report_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    path = tmp_path / "BENCHMARKS.md"
+    monkeypatch.setattr(report, "REPORT", path)
+    monkeypatch.setattr(report, "machine_line", lambda: "test machine")
+    return path
+
+
+def _sections(text: str) -> list[str]:
+    return [
+        line.split()[1].split(":")[0] for line in text.splitlines() if line.endswith("begin -->")
+    ]
+
+
+def test_the_headline_goes_first_and_the_others_keep_their_places(report_file: Path) -> None:
+    report.write_section("transport", "## T\n")
+    report.write_section("images", "## I\n")
+    report.write_section("headline", "## H one\n", first=True)
+    report.write_section("transport", "## T again\n")
+    report.write_section("headline", "## H two\n", first=True)
+    report.write_section("memory", "## M\n")
+
+    text = report_file.read_text(encoding="utf-8")
+    assert text.startswith(report.TITLE + "\n<!-- headline:begin -->\n## H two\n")
+    assert _sections(text) == ["headline", "transport", "images", "memory"]
+    assert "H one" not in text
+    assert "## T again" in text
+    assert "\n\n\n" not in text
+
+
+def _flow(share: float, p99_ms: float, error: str = "") -> FlowResult:
+    return FlowResult(1000, round(share * 1000), 30.0, 1000.0, p99_ms * 1000, None, error)
+
+
+def test_the_highest_sustainable_rate_is_the_last_of_an_unbroken_run() -> None:
+    good, late, short = _flow(1.0, 40), _flow(1.0, 100), _flow(0.98, 40)
+    assert highest({30.0: good, 60.0: good, 90.0: late, 120.0: good}) == 60.0
+    assert highest({30.0: good, 60.0: short}) == 30.0
+    assert highest({60.0: good, 30.0: good}) == 60.0
+    assert highest({30.0: _flow(1.0, 40, "bridge did not start")}) is None
+
+
+def _burn(seconds: float) -> None:
+    end = time.thread_time() + seconds
+    while time.thread_time() < end:
+        pass
+
+
+def test_thread_cpu_is_grouped_by_the_names_libzmq_and_fast_dds_give_their_threads() -> None:
+    burnt, read = threading.Event(), threading.Event()
+
+    def named_burner() -> None:
+        tid = threading.get_native_id()
+        Path(f"/proc/self/task/{tid}/comm").write_text("ZMQbg/IO/9", encoding="utf-8")
+        _burn(0.3)
+        burnt.set()
+        read.wait(10)  # a thread's run time is read while it exists
+
+    before = thread_group_seconds(os.getpid())
+    thread = threading.Thread(target=named_burner)
+    thread.start()
+    _burn(0.2)  # this thread keeps the process name: Python
+    assert burnt.wait(10)
+    after = thread_group_seconds(os.getpid())
+    read.set()
+    thread.join()
+    grown = {group: after[group] - before[group] for group in before}
+    assert set(grown) == {"Python", "libzmq I/O", "Fast DDS"}
+    assert grown["libzmq I/O"] >= 0.25
+    assert grown["Python"] >= 0.15
+
+
+def test_the_split_is_per_delivered_message_and_survives_the_results_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    threads = {"Python": 20.0, "libzmq I/O": 1.5, "Fast DDS": 0.5}
+    flow = dataclasses.replace(_flow(0.5, 1), bridge_threads=threads)  # half delivered
+    split = thread_split_ms(1000.0, flow)
+    assert split == pytest.approx({"Python": 0.4, "libzmq I/O": 0.03, "Fast DDS": 0.01})
+    assert split_text(split) == "0.400 / 0.030 / 0.010"
+    assert thread_split_ms(1000.0, _flow(1.0, 1)) is None  # not measured: no split
+
+    monkeypatch.setattr(results, "RESULTS", tmp_path / "results.json")
+    results.store("costs", {"row": flow}, load_before=0.5)
+    stored = results.load("costs")
+    assert stored is not None
+    assert stored.flows["row"].bridge_threads == threads
+
+
+def test_the_fleet_goals_are_judged_on_the_bridge_rows_against_the_quoted_cpp_bridge() -> None:
+    def row(robots: int, us: float, threads: int, startup: float, **shares: float) -> Round:
+        # One second, 10,000 messages: the CPU percentage is the µs per message.
+        delivered = {kind: shares.get(kind, 1.0) for kind in fleet_goals.KINDS}
+        return Round(robots, False, 1.0, us, delivered, 10_000, threads, 100.0, startup)
+
+    ceiling = dataclasses.replace(row(25, 1.0, 99, 0.0), ceiling=True)
+    lines = fleet_goals.goal_lines(
+        [row(10, 30.0, 15, 1.0), row(25, 40.0, 25, 3.0, imu=0.98), ceiling]
+    )
+    verdicts = {line.split(":")[0].split(" (")[0]: line.rsplit("— ", 1)[1] for line in lines}
+    assert verdicts == {
+        "- CPU per delivered message at 10 robots <= 0.8x C++": "**met**",  # 30 <= 61.0
+        "- CPU per delivered message at 25 robots <= 0.8x C++": "**met**",  # 40 <= 44.3
+        "- flat": "**missed**",  # 40 is 33% above 30
+        "- threads <= 20 for any fleet": "**missed**",  # 25; the ceiling's 99 is not the bridge
+        "- start-up at 25 robots <= C++": "**missed**",
+        "- delivered >= 99% per kind at 25 robots": "**missed**",
+        "- /clock >= 99% at 50 robots": "not measured",
+    }
+    assert "at most 25" in next(line for line in lines if "threads" in line)
