@@ -29,16 +29,9 @@ static int put_length_delimited(struct rgb_out *out, int32_t field, const uint8_
     return status;
 }
 
-/* A ROS number as Python holds it: an integer (possibly above INT64_MAX) or a float. */
-struct number {
-    int is_float, is_unsigned;
-    int64_t i;
-    uint64_t u;
-    double d;
-};
-
-static struct number ros_number(int32_t kind, uint64_t bits) {
-    struct number v = {0, 0, 0, 0, 0.0};
+/* A ROS number of `kind` from its bits, as Python holds it. */
+static struct rgb_number ros_number(int32_t kind, uint64_t bits) {
+    struct rgb_number v = {0, 0, 0, 0, 0.0};
     switch (kind) {
     case ROS_BOOL:
     case ROS_UINT8:
@@ -59,22 +52,10 @@ static struct number ros_number(int32_t kind, uint64_t bits) {
         v.i = (int64_t)bits;
         break;
     case ROS_UINT64:
-        v.u = bits;
-        v.i = (int64_t)bits;
-        v.is_unsigned = bits > INT64_MAX;
-        break;
-    case ROS_FLOAT: {
-        uint32_t b = (uint32_t)bits;
-        float f;
-        memcpy(&f, &b, 4);
-        v.is_float = 1;
-        v.d = f;
-        break;
-    }
+        return rgb_u64(bits);
+    case ROS_FLOAT:
     case ROS_DOUBLE:
-        v.is_float = 1;
-        memcpy(&v.d, &bits, 8);
-        break;
+        return rgb_float_bits(bits, rgb_ros_size(kind));
     default:
         break;
     }
@@ -83,7 +64,7 @@ static struct number ros_number(int32_t kind, uint64_t bits) {
 
 /* The wire value of `v` in a field of protobuf `type`, or RGB_FALLBACK where Python's
  * assignment would refuse it; *zero: proto3 leaves the field out. */
-static int pb_value(int32_t type, int32_t conv, struct number v, uint64_t *wire, int *zero) {
+static int pb_value(int32_t type, int32_t conv, struct rgb_number v, uint64_t *wire, int *zero) {
     if (type == PB_DOUBLE || type == PB_FLOAT) {
         if (!v.is_float) return RGB_FALLBACK;
         if (type == PB_DOUBLE) {

@@ -201,33 +201,20 @@ int pb_descend(struct ctx *c, struct at a, const int32_t *steps, int32_t nsteps,
 }
 
 /* The value of one scalar element of protobuf `type` from its wire form. */
-struct value pb_decode_scalar(int32_t type, const struct field *f, uint64_t raw) {
-    struct value val = {0, 0, 0, 0, 0.0};
+struct rgb_number pb_decode_scalar(int32_t type, const struct field *f, uint64_t raw) {
+    struct rgb_number val = {0, 0, 0, 0, 0.0};
     switch (type) {
-    case PB_DOUBLE: {
-        uint64_t bits = raw;
-        val.is_float = 1;
-        memcpy(&val.d, &bits, 8);
-        break;
-    }
-    case PB_FLOAT: {
-        uint32_t bits = (uint32_t)raw;
-        float x;
-        memcpy(&x, &bits, 4);
-        val.is_float = 1;
-        val.d = (double)x;
-        break;
-    }
+    case PB_DOUBLE:
+        return rgb_float_bits(raw, 8);
+    case PB_FLOAT:
+        return rgb_float_bits(raw, 4);
     case PB_INT64:
     case PB_SFIXED64:
         val.i = (int64_t)raw;
         break;
     case PB_UINT64:
     case PB_FIXED64:
-        val.u = raw;
-        val.is_unsigned = raw > INT64_MAX;
-        val.i = (int64_t)raw;
-        break;
+        return rgb_u64(raw);
     case PB_INT32:
     case PB_ENUM:
     case PB_SFIXED32:
@@ -263,7 +250,7 @@ uint64_t pb_raw_of(const struct field *f) {
 }
 
 /* The value of singular scalar `number` of protobuf `type` in `v` (0 when absent). */
-int pb_scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct value *val) {
+int pb_scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct rgb_number *val) {
     struct field f;
     int found, status = pb_last_of(c, v, number, &f, &found);
     if (status) return status;

@@ -34,7 +34,7 @@ static int put_u32(struct rgb_out *out, uint32_t value) {
 
 /* Writes `val` as ROS `kind` the way the Python path would, or RGB_FALLBACK where Python
  * would not write it this way (a value out of the type's range with `conv` exact). */
-static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct value val) {
+static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb_number val) {
     size_t size = rgb_ros_size(kind);
     uint8_t b[8];
     int status = align(out, size);
@@ -211,7 +211,7 @@ static int column_element(void *ctx, const struct field *f) {
         if (found && s.wire != WIRE_LEN) return RGB_FALLBACK;
         return found ? put_string(c->out, s.payload.p, s.payload.n) : put_string(c->out, NULL, 0);
     }
-    struct value val;
+    struct rgb_number val;
     status = pb_scalar(c->c, element, c->number, c->type, &val);
     if (status) return status;
     return put_value(c->out, c->kind, CONV_EXACT, val);
@@ -275,7 +275,7 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         case OP_NUM: {
             status = path(c, &op, v, &at);
             if (status) return status;
-            struct value val;
+            struct rgb_number val;
             status = pb_scalar(c, at, (uint32_t)op[0], op[1], &val);
             if (status) return status;
             status = put_value(out, op[2], op[3], val);
@@ -335,7 +335,7 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
                 struct scalars writing = {type, 0, kind, out};
                 status = pb_for_each(c, at, number, scalar_element, &writing);
             } else {
-                struct value zero = {rgb_wire_of(type) != WIRE_VARINT, 0, 0, 0, 0.0};
+                struct rgb_number zero = {rgb_wire_of(type) != WIRE_VARINT, 0, 0, 0, 0.0};
                 for (int32_t k = 0; k < count && !status; k++)
                     status = put_value(out, kind, CONV_EXACT, zero);
             }
@@ -392,14 +392,14 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             if (status) return status;
             int32_t part = op[0];
             op += 1;
-            struct value sec, nsec;
+            struct rgb_number sec, nsec;
             status = pb_scalar(c, at, 1, PB_INT64, &sec);
             if (!status) status = pb_scalar(c, at, 2, PB_INT32, &nsec);
             if (status) return status;
             int64_t s = (int32_t)(uint32_t)(uint64_t)sec.i;
             if (s < 0) return RGB_CONVERSION;
             int64_t total = s * 1000000000LL + (int64_t)(uint32_t)(uint64_t)nsec.i;
-            struct value result = {0, 0, 0, 0, 0.0};
+            struct rgb_number result = {0, 0, 0, 0, 0.0};
             if (part == 0) {
                 result.i = (int32_t)(uint32_t)(uint64_t)(total / 1000000000LL);
                 status = put_value(out, ROS_INT32, CONV_EXACT, result);
@@ -413,8 +413,8 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             struct timespec now;
             clock_gettime(CLOCK_REALTIME, &now);
             if (now.tv_sec < 0 || now.tv_sec > INT32_MAX) return RGB_FALLBACK;
-            struct value sec = {0, 0, (int64_t)now.tv_sec, 0, 0.0};
-            struct value nsec = {0, 0, (int64_t)now.tv_nsec, 0, 0.0};
+            struct rgb_number sec = {0, 0, (int64_t)now.tv_sec, 0, 0.0};
+            struct rgb_number nsec = {0, 0, (int64_t)now.tv_nsec, 0, 0.0};
             status = put_value(out, ROS_INT32, CONV_EXACT, sec);
             if (!status) status = put_value(out, ROS_UINT32, CONV_EXACT, nsec);
             break;

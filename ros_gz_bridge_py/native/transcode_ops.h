@@ -35,16 +35,6 @@ struct view {
     size_t n;
 };
 
-/* A scalar as Python would hold it: an integer (signed, or unsigned above INT64_MAX) or a
- * float. */
-struct value {
-    int is_float;
-    int is_unsigned;
-    int64_t i;
-    uint64_t u;
-    double d;
-};
-
 /* ---- reading the wire --------------------------------------------------------------------- */
 
 /* Reads a varint at *pos; 0 on success, RGB_UNDECODABLE when it is cut off or longer than 10
@@ -174,10 +164,10 @@ int pb_last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, i
 /* The submessage reached through `steps` (an empty view where one is absent). */
 int pb_descend(struct ctx *c, struct at a, const int32_t *steps, int32_t nsteps, struct at *out);
 /* One scalar element of protobuf `type` from its wire form, and a field's raw bits. */
-struct value pb_decode_scalar(int32_t type, const struct field *f, uint64_t raw);
+struct rgb_number pb_decode_scalar(int32_t type, const struct field *f, uint64_t raw);
 uint64_t pb_raw_of(const struct field *f);
 /* The value of singular scalar `number` of protobuf `type` in `v` (0 when absent). */
-int pb_scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct value *val);
+int pb_scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct rgb_number *val);
 /* Calls `each(arg, element)` for every element of repeated field `number` in `v`. */
 typedef int (*element_fn)(void *ctx, const struct field *f);
 int pb_for_each(struct ctx *c, struct at v, uint32_t number, element_fn each, void *arg);

@@ -31,7 +31,7 @@ import socket
 import threading
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import zmq
 
@@ -51,6 +51,18 @@ from ros_gz_bridge_py.transport.zmq.socket_owner import SocketOwner, Topic
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
+#: Where a driver's messages go: the subscription's callback.
+Deliver = Callable[[Frame, MessageInfo], None]
+Hook = Callable[[], None]
+
+
+class Driven(TypedDict):
+    """What each driver is made with besides its owner's topic: the callback, and how many
+    messages its queue keeps."""
+
+    deliver: Deliver
+    size: int
+
 
 #: Longest poll of a reader's own thread while idle (s). A close or a posted command wakes it.
 IDLE_POLL = 0.25
@@ -60,14 +72,7 @@ class _Driver:
     """What both drivers share: the owner, the queue of the messages the driver delivers, and
     closing (see the module docstring)."""
 
-    def __init__(
-        self,
-        context: Any,
-        topic: Topic,
-        *,
-        deliver: Callable[[Frame, MessageInfo], None],
-        size: int,
-    ) -> None:
+    def __init__(self, context: Any, topic: Topic, *, deliver: Deliver, size: int) -> None:
         self.fqn = topic.fqn
         self._received = 0
         self._deliver = deliver
@@ -164,19 +169,13 @@ class SubscriptionReader(_Driver):
     """A socket owner read and delivered by a thread of its own (the Python path)."""
 
     def __init__(
-        self,
-        context: Any,
-        topic: Topic,
-        *,
-        deliver: Callable[[Frame, MessageInfo], None],
-        size: int,
-        on_start: Callable[[], None] | None = None,
+        self, context: Any, topic: Topic, *, on_start: Hook | None = None, **driver: Unpack[Driven]
     ) -> None:
         self._wake_r, self._wake_w = socket.socketpair()
         self._wake_r.setblocking(False)
         self._wake_w.setblocking(False)
         self._wake_fd = self._wake_r.fileno()
-        super().__init__(context, topic, deliver=deliver, size=size)
+        super().__init__(context, topic, **driver)
         self._on_start = on_start
         name = f"gz-sub {self._owner.name}"
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
@@ -255,17 +254,11 @@ class NativeReader(_Driver):
     its share runs on the loop's thread (``NativeHost``)."""
 
     def __init__(
-        self,
-        context: Any,
-        topic: Topic,
-        *,
-        deliver: Callable[[Frame, MessageInfo], None],
-        size: int,
-        native: NativeLoop,
+        self, context: Any, topic: Topic, *, native: NativeLoop, **driver: Unpack[Driven]
     ) -> None:
         self._native = native
         self._native_dropped = 0
-        super().__init__(context, topic, deliver=deliver, size=size)
+        super().__init__(context, topic, **driver)
         native.watch(self._owner.watch)
         native.attach(self._owner.sock.underlying, self._owner.connections.monitor.underlying, self)
 

@@ -1,8 +1,9 @@
-"""The reader keeps libzmq's queue in front of its own within the bytes bound: when a payload
-is large enough that RCVHWM messages of its size would pass ``max_queued_bytes``, the SUB
-socket's RCVHWM is lowered (``hwm.py``) and its connections made anew, so that the publisher
-keeps being heard: libzmq 4.3.5 applies a lowered HWM to the open connections too, and these
-stall for good (the first test shows it on raw sockets; the reader must not be caught by it)."""
+"""A topic's socket owner (socket_owner.py) keeps libzmq's queue in front of its reader's within
+the bytes bound: when a payload is large enough that RCVHWM messages of its size would pass
+``max_queued_bytes``, the SUB socket's RCVHWM is lowered (``hwm.py``) and its connections made
+anew, so that the publisher keeps being heard: libzmq 4.3.5 applies a lowered HWM to the open
+connections too, and these stall for good (the first test shows it on raw sockets; the owner
+must not be caught by it). Driven here by a reader with its own thread."""
 
 from __future__ import annotations
 
