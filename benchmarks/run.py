@@ -73,6 +73,7 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
             [
                 *("--robots", "10", "25", "50"),
                 *("--seconds", "5" if quick else "20"),
+                *("--rounds", "1" if quick else "2"),
                 *("--idle-seconds", "5" if quick else "20"),
             ]
         ),
