@@ -1,6 +1,7 @@
 """The rounds of the fleet benchmark: the fleet through a bridge, the same ROS traffic from one
 rclpy process (the ceiling), and the fleet's bridge alone at rest (``benchmarks.fleet`` says
-what each runs). :func:`start_bridged` is also the fleet of ``benchmarks.fleet_cpu_map``."""
+what each runs). :func:`start_bridged` and :func:`start_ceiling` are also the fleets of
+``benchmarks.fleet_cpu_map``."""
 
 from __future__ import annotations
 
@@ -104,6 +105,10 @@ class BridgedFleet:
     silent: tuple[str, ...]
     silent_status: tuple[str, ...]
 
+    @property
+    def measured(self) -> PeerProcess:
+        return self.bridge
+
     def finish(self) -> tuple[float, float]:
         """Stop the bridge, then the simulator: the share of the subscribers' commands the
         simulator received, and the share of its schedule the simulator kept."""
@@ -173,24 +178,53 @@ def _numbers(proc: PeerProcess, prefix: str) -> list[int]:
     return [int(line.split()[-1]) for line in proc.output().splitlines() if line.startswith(prefix)]
 
 
-def ceiling_round(robots: int, seconds: float, env: Mapping[str, str], order: int = 0) -> Round:
-    """The same ROS topics from one rclpy process to the same subscriber processes, which
-    command it as they command the bridge."""
-    load = os.getloadavg()[0]
+@dataclass
+class CeilingFleet:
+    """The ceiling running: the subscribers, and the one rclpy process in the bridge's place."""
+
+    robots: int
+    subscribers: Subscribers
+    publisher: PeerProcess
+    #: When the publisher started, and when every topic flowed (wall clock; None: never).
+    started: float
+    flowing: float | None
+    silent: tuple[str, ...]
+
+    @property
+    def measured(self) -> PeerProcess:
+        return self.publisher
+
+    def commands_taken(self) -> int:
+        return counts_of(self.publisher)["cmd_vel"]
+
+    def finish(self) -> tuple[float, float]:
+        """The share of the subscribers' commands the publisher took, over the whole run (as
+        the bridge's: what they sent, then what arrived), and 1 (no simulator)."""
+        sent = self.subscribers.counts()["cmd_vel"]
+        return (self.commands_taken() / sent if sent else 0.0), 1.0
+
+
+def start_ceiling(robots: int, env: Mapping[str, str]) -> CeilingFleet:
+    """The subscribers, then the ceiling's rclpy process, until every topic flows."""
     subscribers = Subscribers.start(robots, env)
     command = [sys.executable, "-m", "benchmarks.fleet_ros", "pub", str(robots)]
     started = time.time()
     publisher = start_process(command, env)
     flowing, silent = subscribers.wait_flowing()
     time.sleep(SETTLE)
-    taken_before = counts_of(publisher)["cmd_vel"]
-    window = measure(subscribers, publisher, seconds)
-    taken = counts_of(publisher)["cmd_vel"] - taken_before
-    # Over the whole run, as the bridge's: what the subscribers sent, then what arrived.
-    commands_sent = subscribers.counts()["cmd_vel"]
-    commands_taken = counts_of(publisher)["cmd_vel"]
+    return CeilingFleet(robots, subscribers, publisher, started, flowing, silent)
+
+
+def ceiling_round(robots: int, seconds: float, env: Mapping[str, str], order: int = 0) -> Round:
+    """The same ROS topics from one rclpy process to the same subscriber processes, which
+    command it as they command the bridge."""
+    load = os.getloadavg()[0]
+    fleet = start_ceiling(robots, env)
+    taken_before = fleet.commands_taken()
+    window = measure(fleet.subscribers, fleet.publisher, seconds)
+    taken = fleet.commands_taken() - taken_before
     delivered = delivered_shares(robots, window)
-    delivered["cmd_vel"] = commands_taken / commands_sent if commands_sent else 0.0
+    delivered["cmd_vel"] = fleet.finish()[0]
     return Round(
         robots,
         ceiling=True,
@@ -201,8 +235,8 @@ def ceiling_round(robots: int, seconds: float, env: Mapping[str, str], order: in
         threads=window.threads,
         rss=window.rss,
         rss_peak=window.rss_peak,
-        startup_s=None if flowing is None else flowing - started,
-        silent=silent,
+        startup_s=None if fleet.flowing is None else fleet.flowing - fleet.started,
+        silent=fleet.silent,
         sub_cpu=window.sub_cpu,
         load=load,
         order=order,
