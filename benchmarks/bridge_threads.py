@@ -39,11 +39,18 @@ OTHER_PYTHON = "other unnamed threads (Python)"
 ORDER = (*(name for name, _ in ROLES[:4]), MAIN, OTHER_PYTHON, *(name for name, _ in ROLES[4:]))
 
 
-def role_of(comm: str, tid: int, pid: int) -> str:
-    """The role of thread ``tid`` of process ``pid`` named ``comm``."""
+def role_of(comm: str, tid: int, pid: int, process: str | None = None) -> str:
+    """The role of thread ``tid`` of process ``pid`` named ``comm``; a name no role knows is
+    an unnamed Python thread's where it is the process's name (``process``, the main thread's)
+    or not known, else a role of its own (``other: <name>``, digits as N)."""
     if tid == pid:
         return MAIN
-    return next((name for name, pattern in ROLES if pattern.search(comm)), OTHER_PYTHON)
+    known = next((name for name, pattern in ROLES if pattern.search(comm)), None)
+    if known is not None:
+        return known
+    if process is None or comm == process:
+        return OTHER_PYTHON
+    return "other: " + re.sub(r"\d+", "N", comm)
 
 
 @dataclass(frozen=True)
@@ -97,9 +104,10 @@ def by_role(
     """What each role's threads did between two readings of ``pid`` (a thread born in the
     window counts from zero; one that ended in it is missing from ``after`` and left out)."""
     roles = {name: RoleUse() for name in ORDER}
+    process = after[pid].comm if pid in after else None
     for tid, now in after.items():
         then = before.get(tid, Reading(now.comm, 0, 0, 0))
-        use = roles[role_of(now.comm, tid, pid)]
+        use = roles.setdefault(role_of(now.comm, tid, pid, process), RoleUse())
         use.threads += 1
         use.cpu_s += (now.run_ns - then.run_ns) / 1e9
         use.voluntary += now.voluntary - then.voluntary

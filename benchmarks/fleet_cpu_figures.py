@@ -47,8 +47,9 @@ class CpuMap:
     syscalls: dict[str, Counter[str]] = field(default_factory=dict)
     profile_window: Delivered = field(default_factory=Delivered)
     profiles: dict[str, Profile] = field(default_factory=dict)
-    #: The OS names of the bridge's threads, as seen.
+    #: The OS names of the bridge's threads, as seen, and its main thread's.
     names: frozenset[str] = frozenset()
+    process: str | None = None
     #: Why a part was not measured.
     notes: list[str] = field(default_factory=list)
 
@@ -62,7 +63,8 @@ class CpuMap:
 
     def present(self) -> list[str]:
         """The roles that had threads, in table order."""
-        return [role for role in ORDER if role in self.roles and self.roles[role].threads]
+        others = sorted(role for role in self.roles if role not in ORDER)
+        return [r for r in (*ORDER, *others) if r in self.roles and self.roles[r].threads]
 
     def us(self, role: str) -> float:
         """The role's CPU per delivered message in the clean window, µs."""

@@ -87,6 +87,7 @@ def measure(robots: int, args: argparse.Namespace, ceiling: bool) -> CpuMap:
         result.cpu_percent = 100 * (cpu[1] - cpu[0]) / result.clean.seconds
         result.roles = by_role(pid, readings[0], readings[1])
         result.names = frozenset(reading.comm for reading in readings[1].values())
+        result.process = readings[1][pid].comm
         _count_syscalls(fleet, result, args)
         _record_profile(fleet, result, args, profile_file)
         result.commanded = fleet.finish()[0]
@@ -95,7 +96,7 @@ def measure(robots: int, args: argparse.Namespace, ceiling: bool) -> CpuMap:
     if profile_file.exists():
         profiles: dict[str, perf_profile.Profile] = defaultdict(perf_profile.Profile)
         for sample in perf_profile.samples(profile_file):
-            profiles[role_of(sample.comm, sample.tid, pid)].add(sample)
+            profiles[role_of(sample.comm, sample.tid, pid, result.process)].add(sample)
         result.profiles = dict(profiles)
     print(f"{result.total_us:.1f} µs per delivered message", file=sys.stderr, flush=True)
     return result
@@ -116,7 +117,7 @@ def _count_syscalls(fleet: RunningFleet, result: CpuMap, args: argparse.Namespac
     result.syscall_window = _delivered(fleet, count)
     by_role_calls: dict[str, Counter[str]] = defaultdict(Counter)
     for (comm, tid), calls in counted.items():
-        by_role_calls[role_of(comm, tid, pid)].update(calls)
+        by_role_calls[role_of(comm, tid, pid, result.process)].update(calls)
     result.syscalls = dict(by_role_calls)
 
 

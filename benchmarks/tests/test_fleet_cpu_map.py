@@ -32,6 +32,9 @@ def test_roles_come_from_the_os_names_of_either_data_plane() -> None:
     assert role_of("dds.shm.wdog", 1009, PID) == "Fast DDS other"
     assert role_of("parameter_bridg", PID, PID) == MAIN
     assert role_of("parameter_bridg", 1010, PID) == OTHER_PYTHON
+    # A name no role knows: an unnamed Python thread's if it is the process's, else its own.
+    assert role_of("parameter_bridg", 1011, PID, "parameter_bridg") == OTHER_PYTHON
+    assert role_of("native-all7", 1012, PID, "parameter_bridg") == "other: native-allN"
 
 
 def test_a_named_threads_run_time_and_wake_ups_are_read_from_proc() -> None:
