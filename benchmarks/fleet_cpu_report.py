@@ -97,7 +97,8 @@ def _stages_table(found: CpuMap) -> list[str]:
                 rest_n += 1
         if rest_n:
             lines.append(
-                f"| {role} | the rest ({rest_n} stages, each under {SHOWN_STAGE:.0%}) | "
+                f"| {role} | the rest ({rest_n} stage{'s' if rest_n > 1 else ''}, each under "
+                f"{SHOWN_STAGE:.0%}) | "
                 f"{rest:.0%} | {rest * found.us(role):.2f} |"
             )
     return lines

@@ -73,8 +73,13 @@ LIBRARIES = (
     ("C and C++ runtime", re.compile(r"libc\.so|libstdc\+\+|libm\.so|libgcc|ld-linux|\[vdso\]")),
 )
 KERNEL = "[kernel.kallsyms]"
-#: The frame that names the system call a kernel sample is in.
-SYSCALL = re.compile(r"^(?:__x64_sys|__se_sys|__do_sys|__ia32_sys)_(\w+)$")
+#: A kernel frame that names a system call: its handler (``__x64_sys_poll``) or, where the
+#: kernel inlined that, the function it calls (``ksys_write``, ``__sys_recvfrom``).
+SYSCALL = re.compile(r"^(?:__x64_sys|__se_sys|__do_sys|__ia32_sys|ksys|__sys|do_sys)_(\w+)$")
+#: The kernel's system call entry, whose callee is the handler, and its way back, where a
+#: thread that woke another is often switched out.
+ENTRY = "do_syscall_64"
+RETURN = "exit_to_user_mode_loop"
 #: Cross-cuts: a name and a test on a sample's frames (innermost first).
 SWITCHED = re.compile(r"^(__schedule|finish_task_switch)")
 WAKE = re.compile(r"^(try_to_wake_up|wake_up_q)$")
@@ -172,11 +177,18 @@ def library(path: str) -> str:
 
 
 def syscall(sample: Sample) -> str | None:
-    """The system call a sample is in, None if it is not in one."""
-    for frame in sample.frames:
-        if match := SYSCALL.match(frame.symbol):
+    """The system call a sample is in, None if it is not in one: named by the frames just
+    inside the kernel's entry, the outermost that names one (:data:`SYSCALL`)."""
+    symbols = [frame.symbol for frame in sample.frames]
+    if ENTRY not in symbols:
+        return None
+    inside = symbols[: symbols.index(ENTRY)]
+    for symbol in reversed(inside):
+        if match := SYSCALL.match(symbol):
             return match[1]
-    return None
+    if RETURN in inside:
+        return "the return to user space (rescheduled there, rseq)"
+    return "the entry"
 
 
 def stage(sample: Sample) -> str:

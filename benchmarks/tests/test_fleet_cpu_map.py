@@ -101,6 +101,7 @@ ROOT_FRAMES = f"""\
 PERF_SCRIPT = f"""gz-native 12199
 \tffffffff816da390 do_sys_poll ([kernel.kallsyms])
 \tffffffff816db4f1 __x64_sys_poll ([kernel.kallsyms])
+\tffffffff821ed511 do_syscall_64 ([kernel.kallsyms])
 \tffffffff81000130 entry_SYSCALL_64_after_hwframe ([kernel.kallsyms])
 \t           fc26f __GI___poll (inlined)
 \t           5e2c0 [unknown] ({LIBZMQ})
@@ -111,6 +112,7 @@ gz-native 12199
 \tffffffff81100000 _raw_spin_unlock_irqrestore ([kernel.kallsyms])
 \tffffffff81100100 try_to_wake_up ([kernel.kallsyms])
 \tffffffff81100200 __x64_sys_futex ([kernel.kallsyms])
+\tffffffff821ed511 do_syscall_64 ([kernel.kallsyms])
 \t           a0000 __new_sem_post (inlined)
 \t           a0000 boost::interprocess::ipcdetail::semaphore_post (/opt/libfastrtps.so.2.14)
 \t           a1000 eprosima::fastdds::rtps::SharedMemTransport::send (/opt/libfastrtps.so.2.14)
@@ -125,6 +127,14 @@ gz-native 12199
 ZMQbg/IO/0 12200
 \t          123456 _PyEval_EvalFrameDefault ({PYTHON})
 
+ZMQbg/IO/0 12200
+\tffffffff81734c91 eventfd_write ([kernel.kallsyms])
+\tffffffff816b930a vfs_write ([kernel.kallsyms])
+\tffffffff816b9856 ksys_write ([kernel.kallsyms])
+\tffffffff821ed511 do_syscall_64 ([kernel.kallsyms])
+\t           f838f __GI___libc_write (/usr/lib/x86_64-linux-gnu/libc.so.6)
+\t           5e21e [unknown] ({LIBZMQ})
+
 """
 
 
@@ -132,9 +142,9 @@ def test_perf_samples_fall_into_stages_parts_and_cross_cuts() -> None:
     samples = list(perf_profile.parse(PERF_SCRIPT))
     assert [(s.comm, s.tid) for s in samples] == [("gz-native", 12199)] * 3 + [
         ("ZMQbg/IO/0", 12200)
-    ]
+    ] * 2
     # An inlined frame takes the object of the real frame at its address, else unknown.
-    assert samples[0].frames[3].library == "unknown"
+    assert samples[0].frames[4].library == "unknown"
     assert samples[0].frames[-4].library == NATIVE
     loop = perf_profile.Profile()
     for sample in samples[:3]:
@@ -161,6 +171,18 @@ def test_perf_samples_fall_into_stages_parts_and_cross_cuts() -> None:
     other.add(samples[3])
     assert other.stages == Counter({"Python interpreter (outside the stages above)": 1})
     assert other.cuts == Counter({"the Python interpreter itself": 1})
+    # A call whose handler the kernel inlined is named by the function it calls (ksys_write).
+    assert perf_profile.syscall(samples[4]) == "write"
+    assert perf_profile.stage(samples[4]) == "kernel: write"
+    returning = perf_profile.Sample(
+        "ZMQbg/IO/0",
+        12200,
+        tuple(
+            perf_profile.Frame(symbol, "[kernel.kallsyms]")
+            for symbol in ("__schedule", "schedule", "exit_to_user_mode_loop", "do_syscall_64")
+        ),
+    )
+    assert perf_profile.syscall(returning) == "the return to user space (rescheduled there, rseq)"
 
 
 def _found(us_loop: float, *, ceiling: bool = False) -> CpuMap:
