@@ -113,6 +113,7 @@ struct PumpObject {
     size_t watch_above, grown;
     struct handed *handover;
     size_t nhanded, handed_cap;
+    size_t handed_bytes; /* the bytes of the copies handed (a read ends past max_bytes) */
     struct rgb_out out;
     int64_t period_ns, next_ns; /* max_rate: next admission time (period 0: no limit) */
     unsigned long long received, rate_limited, published, dropped, skipped;
@@ -216,6 +217,7 @@ static void hand_frames(PumpObject *self, int kind, int route, int status, zmq_m
             return;
         }
     }
+    for (int i = 0; i < n; i++) self->handed_bytes += h->size[i];
 }
 
 /* Hands Python the figures of a payload refused as too large (route `route`): its list's items,
@@ -365,10 +367,16 @@ int pump_monitor_ready(PumpObject *self, void *monitor) {
            (events & ZMQ_POLLIN_);
 }
 
+/* Reads up to `budget` messages: 1 once none waits, 0 when more may wait, -1 when the socket
+ * cannot be read. The read also ends early (0) once a payload outgrew the watched size, so the
+ * reader replaces the socket before a budget more of them arrive, and once the copies handed to
+ * Python hold max_bytes, so that Python learns their route before more are copied: either
+ * used to wait for a whole budget of 32 MB messages (2 GB, /clock starved meanwhile). */
 int pump_read(PumpObject *self, void *sock, int budget) {
     for (int i = 0; i < budget; i++) {
         int read = read_message(self, sock);
         if (read <= 0) return read < 0 ? -1 : 1;
+        if (self->grown || self->handed_bytes >= self->max_bytes) return 0;
     }
     return 0;
 }
@@ -411,6 +419,7 @@ static void clear_handover(PumpObject *self) {
     for (size_t i = 0; i < self->nhanded; i++)
         for (int k = 0; k < self->handover[i].nframes; k++) free(self->handover[i].data[k]);
     self->nhanded = 0;
+    self->handed_bytes = 0;
 }
 
 static void free_route(struct route *r) {

@@ -178,3 +178,64 @@ def test_a_payload_above_the_watched_size_is_told(native: Any, publisher: Any) -
         assert rig.pump.take_grown() == 0
     finally:
         rig.close()
+
+
+def _one_run_with_reports(rig: Rig) -> list[Any]:
+    """One loop run that reports (waiting for the first message to be read)."""
+    deadline = time.monotonic() + 5
+    reported: list[Any] = []
+    while not reported and time.monotonic() < deadline:
+        _woken, reported = rig.loop.run(100, [])
+    assert reported, "the loop did not hand the pump to Python"
+    return list(rig.pump.take_handed())
+
+
+def test_a_read_hands_python_at_most_max_bytes_of_unrouted_copies(
+    native: Any, publisher: Any
+) -> None:
+    """Messages of a sender whose route Python has not learned yet are copied to Python; a
+    read ends once the copies hold ``max_bytes``, so Python learns the route before more are
+    copied (before: a whole read budget, 64 messages of 32 MB were 2 GB, the loop's other
+    channels waiting meanwhile)."""
+    size, limit, count = 10_000, 25_000, 40
+    rig = Rig(native, publisher, capacity=1000, max_bytes=limit)
+    try:
+        rig.connected()
+        rig.settle()
+        payload = message_class("gz.msgs.StringMsg")(data="x" * size).SerializeToString()
+        for _ in range(count):
+            rig.send(b"unknown-sender", payload)
+        time.sleep(0.5)  # all of them in the SUB socket's queue before the loop reads
+        handed = _one_run_with_reports(rig)
+        assert len(handed) == 3  # 3 copies of 10 kB pass 25 kB: the read ends there
+        assert all(item[0] == 0 and item[1][2] == payload for item in handed)
+        rig.pump.learn(b"unknown-sender", TYPE, True)
+        rig.settle()
+        received, _limited, published, dropped, _skipped, lost = rig.pump.counts()
+        assert lost == 0
+        assert received + dropped == count - 3  # the rest went natively once learned
+        assert published == received
+    finally:
+        rig.close()
+
+
+def test_a_read_ends_at_a_payload_above_the_watched_size(native: Any, publisher: Any) -> None:
+    """The reader replaces its socket for a payload above the watched size before more such
+    payloads queue in the old one: the read that took it ends there and tells Python."""
+    rig = Rig(native, publisher, capacity=1000, max_bytes=1 << 26)
+    try:
+        rig.connected()
+        rig.settle()
+        rig.pump.watch(1000)
+        larger = message_class("gz.msgs.StringMsg")(data="y" * 8000).SerializeToString()
+        taken_before = rig.pump.traffic()[0]
+        for _ in range(10):
+            rig.send(LEGIT, larger)
+        time.sleep(0.5)
+        _one_run_with_reports(rig)
+        assert rig.pump.take_grown() == len(larger)
+        assert rig.pump.traffic()[0] - taken_before == len(larger)  # one read, not ten
+        rig.settle()
+        assert rig.pump.traffic()[0] - taken_before == 10 * len(larger)
+    finally:
+        rig.close()
