@@ -14,8 +14,13 @@ writing its own section:
   ``native_paths`` is what they share);
 - ``discovery``: how soon a new Gazebo topic exists in ROS, and what many discovered topics cost;
 - ``startup``, ``first_call``: how soon the channels exist, and the first service call;
-- ``fleet``: what a fleet of robots costs in one process (``fleet_rounds`` runs them,
-  ``fleet_goals`` judges them, ``fleet_ros`` is their ROS side);
+- ``fleet``: what a fleet of robots costs through one bridge process, as users run it, against
+  the same run's rclpy ceiling (``fleet_rounds`` runs them, ``fleet_goals`` sums them up and
+  judges them, ``fleet_ros`` is their ROS side and ``fleet_subscribers`` its processes);
+- ``fleet_cpu_map``: where a fleet message's CPU goes in the bridge, per thread, stage and
+  candidate, beside the same run's ceiling (not in ``make bench``; ``fleet_cpu_figures`` holds
+  what it found, ``fleet_cpu_report`` writes it; it reads the bridge from outside through
+  ``bridge_threads``, ``perf_syscalls`` and ``perf_profile``);
 - ``memory``: the bridge's memory under a long flood and beside a slow subscriber;
 - ``profile_images``: where the time goes on the 1080p image path (not in ``make bench``);
 - ``soak``, ``attacks``: SOAK.md from the runs of ``testing.soak`` and ``testing.attacks``.

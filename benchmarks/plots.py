@@ -18,7 +18,7 @@ from benchmarks.costs import (
     per_message_ms,
     thread_split_ms,
 )
-from benchmarks.fleet_goals import GOAL_CPU_RATIO, GOAL_THREADS, Quoted, Round
+from benchmarks.fleet_goals import CPP_CEILING_RATIO, GOAL_RATIO, Round, sizes
 from benchmarks.harness import PYTHON_THREADS
 from benchmarks.reference import CPU_PER_MESSAGE, QUOTED, SUSTAINED_P99_MS, cpu_goal_ms
 from benchmarks.results import COSTS_PNG, FLEET_PNG, SUSTAINED_PNG, Stored
@@ -163,64 +163,56 @@ def native_overload_plot(series: Mapping[str, Sequence[tuple[float, float]]], re
     return _save(figure, relative)
 
 
-def fleet_plot(rows: Sequence[Round], quoted: Mapping[int, Quoted]) -> str:
-    """``benchmarks.fleet`` against the number of robots: CPU per delivered message,
-    start-up, threads and the worst delivered share, the bridge beside the rclpy ceiling and
-    the C++ figures quoted from issue 28."""
+def fleet_plot(rows: Sequence[Round]) -> str:
+    """``benchmarks.fleet`` against the number of robots: CPU per delivered message of the
+    bridge and of the same run's rclpy ceiling, their ratio round by round against the goal,
+    the worst delivered share and ``/clock``'s, and the peak RSS, each side by side."""
     _agg()
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
-    bridge = [row for row in rows if not row.ceiling and not row.error]
-    ceiling = [row for row in rows if row.ceiling and not row.error]
-    cpp = sorted(quoted.items())
+    measured = [size for size in sizes(rows) if size.measured]
+    robots = [size.robots for size in measured]
     figure, axes = plt.subplots(2, 2, figsize=(9, 6.5))
-    cpu, startup, threads, delivered = axes.flat
-    robots = [row.robots for row in bridge]
-    cpp_robots = [count for count, _ in cpp]
-    cpp_us = [q.cpp_us_per_message() for _, q in cpp]
-    cpu.plot(robots, [row.us_per_message for row in bridge], "o-", label="parameter_bridge")
-    cpu.plot(
-        [row.robots for row in ceiling], [row.us_per_message for row in ceiling], "s--",
-        label="rclpy publisher alone (ceiling)",
-    )  # fmt: skip
-    cpu.plot(cpp_robots, cpp_us, "k^:", label="C++ bridge (issue 28, quoted)")
-    cpu.plot(
-        cpp_robots, [GOAL_CPU_RATIO * us for us in cpp_us], ":", color="grey",
-        label=f"goal: {GOAL_CPU_RATIO:g}x C++",
-    )  # fmt: skip
-    cpu.set_ylabel("µs CPU per delivered message")
-    started = [row for row in bridge if row.startup_s is not None]
-    startup.plot(
-        [row.robots for row in started], [row.startup_s for row in started], "o-",
+    cpu, ratio, delivered, memory = axes.flat
+    cpu.plot(robots, [size.us for size in measured], "o-", label="parameter_bridge")
+    cpu.plot(robots, [size.ceiling_us for size in measured], "s--", label="rclpy ceiling")
+    cpu.set_ylabel("µs CPU per delivered message (median)")
+    for size in measured:
+        pairs = size.pair_ratios()
+        ratio.plot([size.robots] * len(pairs), pairs, "o", color="tab:blue", alpha=0.5)
+    ratio.plot(robots, [size.ratio for size in measured], "o-", label="bridge / ceiling")
+    ratio.axhline(GOAL_RATIO, color="grey", linestyle=":", label=f"goal: {GOAL_RATIO:g}x")
+    ratio.axhline(
+        CPP_CEILING_RATIO, color="black", linestyle=":", label="C++ bridge (issue 36, quoted)"
+    )
+    ratio.set_ylabel("bridge / ceiling, per delivered message")
+    for ceiling, style, colour, side in (
+        (False, "o-", "tab:blue", "bridge"),
+        (True, "s--", "tab:orange", "ceiling"),
+    ):
+        delivered.plot(
+            robots, [100 * size.worst(ceiling) for size in measured], style, color=colour,
+            label=f"{side}, worst kind in any round",
+        )  # fmt: skip
+        delivered.plot(
+            robots, [100 * size.delivered(ceiling)["clock"] for size in measured], style,
+            color=colour, alpha=0.4, label=f"{side}, /clock (median)",
+        )  # fmt: skip
+    delivered.set_ylabel("delivered, % of offered")
+    memory.plot(
+        robots, [max(r.rss_peak for r in size.bridge) for size in measured], "o-",
         label="parameter_bridge",
     )  # fmt: skip
-    for count, q in cpp:
-        startup.plot([count, count], list(q.startup_cpp), "k^:")
-    startup.plot([], [], "k^:", label="C++ bridge (issue 28, quoted)")
-    startup.set_ylabel("start-up to every topic flowing, s")
-    threads.plot(robots, [row.threads for row in bridge], "o-", label="parameter_bridge")
-    threads.plot(cpp_robots, [q.threads_cpp for _, q in cpp], "k^:", label="C++ (issue 28)")
-    threads.axhline(GOAL_THREADS, color="grey", linestyle=":", label="goal")
-    threads.set_ylabel("threads")
-    delivered.plot(
-        robots, [100 * min(row.delivered.values()) for row in bridge], "o-",
-        label="parameter_bridge, worst kind",
+    memory.plot(
+        robots, [max(r.rss_peak for r in size.ceiling) for size in measured], "s--",
+        label="rclpy ceiling",
     )  # fmt: skip
-    delivered.plot(
-        robots,
-        [100 * row.delivered["clock"] for row in bridge],
-        "o--",
-        label="parameter_bridge, /clock",
-    )
-    for count, q in cpp:
-        delivered.plot([count, count], [100 * d for d in q.delivered_cpp], "k^:")
-    delivered.plot([], [], "k^:", label="C++ bridge (issue 28, quoted)")
-    delivered.set_ylabel("delivered, % of offered")
+    memory.set_ylabel("peak RSS, MB")
     for axes_ in axes.flat:
         axes_.set_xlabel("robots")
         axes_.grid(alpha=0.3)
         axes_.legend(fontsize=7)
-    figure.suptitle("A fleet in one bridge process (issue 28)")
+    figure.suptitle("A fleet through one bridge process, against the same run's rclpy ceiling")
     return _save(figure, FLEET_PNG)
 
 

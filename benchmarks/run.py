@@ -1,7 +1,7 @@
 """``make bench``: every benchmark in one go, each bounded, rewriting BENCHMARKS.md.
 
 Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
-about 25 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
+about 30 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
 Each module writes its own section; a module that fails is reported and the others still run.
 Last, the headline is rewritten from the figures stored by ``sustained``, ``costs`` and
 ``starvation`` (this run's, or their last run's when they were not run), and its plots drawn.
@@ -73,6 +73,7 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
             [
                 *("--robots", "10", "25", "50"),
                 *("--seconds", "5" if quick else "20"),
+                *("--rounds", "1" if quick else "2"),
                 *("--idle-seconds", "5" if quick else "20"),
             ]
         ),

@@ -24,8 +24,11 @@ through valid discovery (``testing/rogue.py``) then sends, one attack after the 
 
 Per attack: the messages the rogue sent, the real /clock and Odometry messages that reached ROS
 during it (percent of the publishers' nominal rates), the bridge's CPU during it, its peak RSS
-above its resting size (before the first attack), and its RSS ``after`` seconds after the attack,
-above the same resting size.
+above its resting size (before the first attack), its RSS ``after`` seconds after the attack,
+above the same resting size, and how long after the attack its RSS was first back within
+``settle_mb`` of that size (None: not within ``SETTLE_LIMIT`` seconds). On a loaded machine the
+bridge may still be reading the rogue's queued frames ``after`` seconds on; the settling time
+says whether it gives the memory back, whatever the load.
 """
 
 from __future__ import annotations
@@ -60,6 +63,10 @@ ODOM_TEXT = (
 )
 #: Seconds to wait for the bridge, the peers and the ROS side to be connected.
 START_LIMIT = 60.0
+#: Seconds after an attack to wait for the bridge's RSS to be back near its resting size.
+SETTLE_LIMIT = 30.0
+#: How often the RSS is read while it settles.
+SETTLE_PERIOD = 0.1
 
 
 def _varint(value: int) -> bytes:
@@ -144,6 +151,9 @@ class Outcome:
     resting_mb: float
     peak_above_mb: float
     after_above_mb: float
+    #: Seconds from the attack's end until the RSS was first within ``settle_mb`` of resting;
+    #: None if it was not within ``SETTLE_LIMIT`` seconds.
+    settled_s: float | None
     #: The largest serialized message of each topic on ROS so far.
     largest: dict[str, int] = field(default_factory=dict)
     bridge_alive: bool = True
@@ -152,10 +162,13 @@ class Outcome:
 class AttackRun:
     """One bridge (one path) and its real peers, attacked in turn."""
 
-    def __init__(self, native: bool, *, seconds: float, after: float) -> None:
+    def __init__(
+        self, native: bool, *, seconds: float, after: float, settle_mb: float = 50.0
+    ) -> None:
         self.path = "native" if native else "python"
         self.seconds = seconds
         self.after = after
+        self.settle_mb = settle_mb
         self.env = soak_env()
         # the bridge runs this tree's package, whichever checkout the venv was installed from
         path = self.env.get("PYTHONPATH")
@@ -281,8 +294,7 @@ class AttackRun:
             end, cpu_end = time.monotonic(), cpu_seconds(pid)
         finally:
             rogue.close()
-        time.sleep(self.after)
-        after = rss_mb(pid) if self.bridge.poll() is None else 0.0
+        after, settled = self._settle(end, resting)
         highest = peak.stop() / MB
         first, last = self._counts_at(start), self._counts_at(end)
         span = end - start
@@ -301,9 +313,28 @@ class AttackRun:
             resting_mb=round(resting, 1),
             peak_above_mb=round(highest - resting, 1),
             after_above_mb=round(after - resting, 1),
+            settled_s=None if settled is None else round(settled, 1),
             largest=dict(self._counts().get("largest", {})),
             bridge_alive=self.bridge.poll() is None,
         )
+
+    def _settle(self, end: float, resting: float) -> tuple[float, float | None]:
+        """The RSS ``after`` seconds past ``end``, and the seconds past ``end`` at which the RSS
+        was first within ``settle_mb`` of ``resting`` (read until both are known, at most
+        ``SETTLE_LIMIT`` seconds past ``end``)."""
+        after: float | None = None
+        settled: float | None = None
+        while self.bridge.poll() is None:
+            now = time.monotonic()
+            rss = rss_mb(self.bridge.pid)
+            if settled is None and rss - resting < self.settle_mb:
+                settled = now - end
+            if after is None and now >= end + self.after:
+                after = rss
+            if after is not None and (settled is not None or now >= end + SETTLE_LIMIT):
+                return after, settled
+            time.sleep(SETTLE_PERIOD)
+        return 0.0, settled
 
     def _status(self) -> None:
         """The bridge's status table (SIGUSR1), for the report."""

@@ -46,6 +46,8 @@ _HEADERS = (
 )
 _SOURCE_SUFFIXES = {".cc", ".hh", ".txt"}
 _GRACE_SECONDS = 1.0
+#: Seconds to wait for a finished process's last output to be read.
+_DRAIN_SECONDS = 10.0
 
 
 class PeerProcess(subprocess.Popen[str]):
@@ -96,7 +98,11 @@ class PeerProcess(subprocess.Popen[str]):
         return line
 
     def output(self) -> str:
-        """Everything printed so far (for failure messages)."""
+        """Everything printed so far (for failure messages); all of it once the process has
+        been waited for (the reader thread may still be draining the pipe when ``wait``
+        returns, more so on a busy machine)."""
+        if self.returncode is not None:
+            self._reader.join(_DRAIN_SECONDS)
         with contextlib.suppress(queue.Empty):
             while (line := self._arrived.get_nowait()) is not None:
                 self.lines.append(line)

@@ -21,17 +21,23 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / CLOCK_TICKS
 
 
-def rss_bytes(pid: int) -> int:
-    """The resident set size (VmRSS) of process ``pid``; 0 where it has none (a zombie)."""
+def rss_bytes(pid: int, field: str = "VmRSS") -> int:
+    """The resident set size (VmRSS) of process ``pid``, or another memory ``field`` of its
+    status (``VmHWM``: the peak resident set size so far); 0 where it has none (a zombie)."""
     with open(f"/proc/{pid}/status", encoding="ascii") as status:
         for line in status:
-            if line.startswith("VmRSS:"):
+            if line.startswith(f"{field}:"):
                 return int(line.split()[1]) * 1024
     return 0
 
 
 def rss_mb(pid: int) -> float:
     return rss_bytes(pid) / MB
+
+
+def peak_rss_mb(pid: int) -> float:
+    """The peak resident set size of ``pid`` since it started (the kernel's VmHWM), MB."""
+    return rss_bytes(pid, "VmHWM") / MB
 
 
 def threads_of(process: subprocess.Popen[str]) -> int:

@@ -102,7 +102,7 @@ def test_verdicts_follow_the_figures_shown() -> None:
     assert ">= 120 Hz: **missed** by 90 Hz" in row(missed, "Highest sustainable")
 
 
-def fleet_run(us_at_10: float, threads: int, idle_percent: float) -> Stored:
+def fleet_run(ratio_at_10: float, clock_at_50: float, idle_percent: float) -> Stored:
     return stored(
         {
             "commit": "eee5555",
@@ -111,9 +111,14 @@ def fleet_run(us_at_10: float, threads: int, idle_percent: float) -> Stored:
             "load_after": 0.7,
             "flows": {},
             "numbers": {
-                "fleet10.us_per_message": us_at_10,
-                "fleet10.threads": threads,
-                "fleet25.startup_s": 0.7,
+                "fleet10.us_per_message": 40.0 * ratio_at_10,
+                "ceiling10.us_per_message": 40.0,
+                "fleet10.ratio": ratio_at_10,
+                "fleet10.ratio_min": ratio_at_10 - 0.05,
+                "fleet10.ratio_max": ratio_at_10 + 0.05,
+                "fleet25.delivered.imu": 0.97,
+                "ceiling25.delivered.imu": 0.99,
+                "fleet50.delivered.clock": clock_at_50,
                 "idle50.cpu_percent": idle_percent,
             },
         }
@@ -121,15 +126,21 @@ def fleet_run(us_at_10: float, threads: int, idle_percent: float) -> Stored:
 
 
 def test_the_fleet_verdicts_follow_the_figures_shown() -> None:
-    # C++ at 10 robots, quoted: 78.0 µs per delivered message, so the goal is 62.4 µs.
-    met = headline.section(None, None, None, "", fleet_run(37.1, 20, 0.9))
-    missed = headline.section(None, None, None, "", fleet_run(70.0, 60, 1.5))
+    met = headline.section(None, None, None, "", fleet_run(1.05, 0.97, 0.9))
+    missed = headline.section(None, None, None, "", fleet_run(1.4, 0.6, 1.5))
 
-    assert "- 10 robots (41 entries): 37.1 µs" in met
-    assert "(goal <= 62.4, 0.8x C++'s 78.0 quoted): **met**; 20 threads (C++ 20): **met**" in met
-    assert "**missed** by 7.6 µs; 60 threads (C++ 20): **missed** by 40" in missed
+    assert (
+        "- 10 robots (41 entries): 42.0 µs of CPU per delivered message, the same run's rclpy "
+        "ceiling 40.0 µs: 1.05x (goal <= 1.1x): **met** (rounds 1.00-1.10x" in met
+    )
+    assert "56.0 µs of CPU per delivered message" in missed
+    assert "1.40x (goal <= 1.1x): **missed** by 0.30x" in missed
+    assert "- /clock at 50 robots: 97.0% delivered (goal >= 95%): **met**" in met
+    assert "60.0% delivered (goal >= 95%): **missed** by 35.0 points" in missed
+    # imu at 25 robots: 97% is above 95% but below the ceiling's own 99%.
+    assert "imu 97.0% (99.0%); goal: every kind >= 95% and never below the ceiling's own: " in met
+    assert "own: **missed** by imu" in met
     assert "- at rest, 201 entries: 0.90% of a core (goal < 1%): **met**" in met
     assert "1.50% of a core (goal < 1%): **missed** by 0.50 points" in missed
-    assert "to every topic flowing: 0.70 s (C++ 2.6 s quoted): **met**" in met
-    assert "A fleet in one process (issue 28) (commit eee5555, 2026-11-28 06:00 UTC)" in met
+    assert "A fleet as users run it (issues 28, 36) (commit eee5555, 2026-11-28 06:00 UTC)" in met
     assert "- not measured yet (`benchmarks.fleet`)" in headline.section(None, None, None, "")

@@ -1,6 +1,5 @@
 """How BENCHMARKS.md is put together: the headline first, the other sections where they were,
-what counts as a sustainable 1080p rate, the bridge's CPU split by thread, and the fleet's
-goals."""
+what counts as a sustainable 1080p rate, and the bridge's CPU split by thread."""
 
 from __future__ import annotations
 
@@ -12,9 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import fleet_goals, report, results
+from benchmarks import report, results
 from benchmarks.costs import split_text, thread_split_ms
-from benchmarks.fleet_goals import Round
 from benchmarks.harness import FlowResult, thread_group_seconds
 from benchmarks.sustained import highest
 
@@ -106,26 +104,3 @@ def test_the_split_is_per_delivered_message_and_survives_the_results_file(
     stored = results.load("costs")
     assert stored is not None
     assert stored.flows["row"].bridge_threads == threads
-
-
-def test_the_fleet_goals_are_judged_on_the_bridge_rows_against_the_quoted_cpp_bridge() -> None:
-    def row(robots: int, us: float, threads: int, startup: float, **shares: float) -> Round:
-        # One second, 10,000 messages: the CPU percentage is the µs per message.
-        delivered = {kind: shares.get(kind, 1.0) for kind in fleet_goals.KINDS}
-        return Round(robots, False, 1.0, us, delivered, 10_000, threads, 100.0, startup)
-
-    ceiling = dataclasses.replace(row(25, 1.0, 99, 0.0), ceiling=True)
-    lines = fleet_goals.goal_lines(
-        [row(10, 30.0, 15, 1.0), row(25, 40.0, 25, 3.0, imu=0.98), ceiling]
-    )
-    verdicts = {line.split(":")[0].split(" (")[0]: line.rsplit("— ", 1)[1] for line in lines}
-    assert verdicts == {
-        "- CPU per delivered message at 10 robots <= 0.8x C++": "**met**",  # 30 <= 61.0
-        "- CPU per delivered message at 25 robots <= 0.8x C++": "**met**",  # 40 <= 44.3
-        "- flat": "**missed**",  # 40 is 33% above 30
-        "- threads <= 20 for any fleet": "**missed**",  # 25; the ceiling's 99 is not the bridge
-        "- start-up at 25 robots <= C++": "**missed**",
-        "- delivered >= 99% per kind at 25 robots": "**missed**",
-        "- /clock >= 99% at 50 robots": "not measured",
-    }
-    assert "at most 25" in next(line for line in lines if "threads" in line)

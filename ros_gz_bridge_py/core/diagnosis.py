@@ -285,6 +285,8 @@ class _SimilarTopics:
         self._found: dict[str, list[str]] = {}
 
     def __call__(self, topic: str, topics: Sequence[str]) -> list[str]:
+        if not topics:  # the explainer's first look, before it fetches the list: keep the cache
+            return []
         listed = tuple(topics)
         if listed != self._topics:
             self._topics, self._found = listed, {}

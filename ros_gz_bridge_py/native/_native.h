@@ -175,6 +175,7 @@ typedef struct {
     size_t watch_above, grown;
     struct handed *handover;
     size_t nhanded, handed_cap;
+    size_t handed_bytes; /* the bytes of the copies handed (a read ends past max_bytes) */
     struct rgb_out out;
     int64_t period_ns, next_ns; /* max_rate: next admission time (period 0: no limit) */
     unsigned long long received, rate_limited, published, dropped, skipped;

@@ -79,6 +79,7 @@ void pump_clear_handover(PumpObject *self) {
     for (size_t i = 0; i < self->nhanded; i++)
         for (int k = 0; k < self->handover[i].nframes; k++) free(self->handover[i].data[k]);
     self->nhanded = 0;
+    self->handed_bytes = 0;
 }
 
 /* A new entry of the hand-over (NULL, counted as lost, when memory runs out). */
@@ -117,6 +118,7 @@ static void hand_frames(PumpObject *self, int kind, int route, int status, zmq_m
             return;
         }
     }
+    for (int i = 0; h != NULL && i < n; i++) self->handed_bytes += h->size[i];
 }
 
 static void drop_oldest(PumpObject *self) {
@@ -269,7 +271,11 @@ static int monitor_ready(PumpObject *self) {
            (events & ZMQ_POLLIN_);
 }
 
-/* Reads until the socket is empty or the budget is spent, then delivers. */
+/* Reads until the socket is empty or the budget is spent, then delivers. The read also ends
+ * early once a payload outgrew the watched size, so the socket's owner replaces the socket
+ * before a budget more of them arrive, and once the copies handed to Python hold max_bytes, so
+ * that Python learns their route before more are copied: either used to wait for a whole budget
+ * of 32 MB messages (2 GB, the loop's other members starved meanwhile). */
 static int turn(struct rgb_member *m, unsigned fired, const struct rgb_budget *budget) {
     PumpObject *self = RGB_OWNER(PumpObject, m);
     int events = 0;
@@ -280,6 +286,7 @@ static int turn(struct rgb_member *m, unsigned fired, const struct rgb_budget *b
         int read = read_message(self);
         if (read <= 0) self->readable = 0;
         if (read < 0) events |= RGB_EVENT_BROKEN;
+        if (self->grown || self->handed_bytes >= self->max_bytes) break;
     }
     int64_t slice_end = rgb_now_ns(CLOCK_MONOTONIC) + budget->slice_ns;
     for (int i = 0; i < budget->messages && self->count; i++) {

@@ -5,8 +5,9 @@ Two seconds of each attack of ``testing/attacks.py`` (padded Odometry floods, a 
 4 M empty poses, Odometry followed by 768 KiB of unknown fields, from a rogue publisher beside
 real C++ /clock and Odometry publishers) against a bridge on each path. Asserted are the bounds
 that are not speed: the bridge lives, nothing it publishes carries the rogue's bulk, its memory
-is back near its resting size four seconds after each attack, the empty poses never take the
-memory of a parse, and /clock and the real Odometry still flow during each.
+comes back near its resting size after each attack (how soon is the benchmark's figure: on a
+loaded machine the bridge may still be reading queued frames seconds on), the empty poses never
+take the memory of a parse, and /clock and the real Odometry still flow during each.
 """
 
 from __future__ import annotations
@@ -34,14 +35,14 @@ EMPTY_POSES_PEAK_MB = 300.0
 @pytest.mark.parametrize("native", [True, False], ids=["native", "python"])
 def test_the_bridge_rides_out_each_attack(native: bool) -> None:
     require_peer()
-    run = AttackRun(native, seconds=SECONDS, after=AFTER)
+    run = AttackRun(native, seconds=SECONDS, after=AFTER, settle_mb=BACK_WITHIN_MB)
     outcomes = run.run(attacks())
     assert [o.attack for o in outcomes] == [a.name for a in attacks()], outcomes
     for outcome in outcomes:
         assert outcome.bridge_alive, outcome
         assert outcome.sent > 0, outcome
         assert max(outcome.largest.values()) < LARGEST, outcome
-        assert outcome.after_above_mb < BACK_WITHIN_MB, outcome
+        assert outcome.settled_s is not None, outcome
         # /clock and the real Odometry publisher flow during the attack: a fifth of their rate
         # is far below what any run measured (95-104%), and far above nothing (a socket whose
         # HWM was lowered while connected stalled the real publisher for good: 0%).

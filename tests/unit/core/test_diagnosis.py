@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+import difflib
+
+import pytest
 
 from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.converters.registry import default_registry
@@ -165,3 +168,25 @@ def test_a_discovered_bridge_names_the_rule_that_chose_its_types() -> None:
         "which the Gazebo side takes: use geometry_msgs/msg/Twist in ROS"
     ) in found[0].text
     assert "TwistStamped also pairs with gz.msgs.Twist: write an entry with" in found[1].text
+
+
+def test_similar_topics_are_found_once_while_the_list_stays_the_same(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The explainer asks first without the topic list, then with it, for every waiting channel
+    every few seconds: the first look must not throw away what was found (201 waiting channels
+    at rest cost 17% of a core when it did)."""
+    compared: list[str] = []
+
+    def close_matches(word: str, possibilities: list[str], n: int) -> list[str]:
+        compared.append(word)
+        return []
+
+    monkeypatch.setattr(difflib, "get_close_matches", close_matches)
+    absent = situation(Direction.GZ_TO_ROS, gz_topic="/odom_x")
+    listed = dataclasses.replace(absent, gz_topics=["/model/robot/odom_x", "/clock"])
+    for _ in range(3):
+        findings(absent, HINTS)
+        (finding,) = findings(listed, HINTS)
+        assert "similar topics: /model/robot/odom_x" in finding.text
+    assert compared == ["/odom_x"]

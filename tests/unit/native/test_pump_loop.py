@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.msgs import message_class
-from tests.unit.native.pump_rig import BUDGET, LEGIT, PAYLOAD, Rig
+from tests.unit.native.pump_rig import BUDGET, LEGIT, PAYLOAD, TYPE, Rig
 
 pytestmark = pytest.mark.ros
 
@@ -111,5 +111,67 @@ def test_a_payload_above_the_watched_size_is_told(native: Any, publisher: Any) -
         rig.send(LEGIT, larger)
         rig.settle()
         assert rig.grown == told
+    finally:
+        rig.close()
+
+
+def _one_run_with_reports(rig: Rig) -> Any:
+    """One loop run that reports (waiting for the first message to be read): its hand-over."""
+    deadline = time.monotonic() + 5
+    reported: list[Any] = []
+    while not reported and time.monotonic() < deadline:
+        _woken, reported = rig.loop.run(100, [])
+    assert reported, "the loop did not hand the pump to Python"
+    return rig.pump.take_handed()
+
+
+def test_a_read_hands_python_at_most_max_bytes_of_unrouted_copies(
+    native: Any, publisher: Any
+) -> None:
+    """Messages of a sender whose route Python has not learned yet are copied to Python; a
+    read ends once the copies hold ``max_bytes``, so Python learns the route before more are
+    copied (before: a whole read budget, 64 messages of 32 MB were 2 GB, the loop's other
+    channels waiting meanwhile)."""
+    size, limit, count = 10_000, 25_000, 40
+    rig = Rig(native, publisher, capacity=1000, max_bytes=limit)
+    try:
+        rig.connected()
+        rig.settle()
+        before = rig.pump.counts()
+        payload = message_class("gz.msgs.StringMsg")(data="x" * size).SerializeToString()
+        for _ in range(count):
+            rig.send(b"unknown-sender", payload)
+        time.sleep(0.5)  # all of them in the SUB socket's queue before the loop reads
+        handover = _one_run_with_reports(rig)
+        assert len(handover.unrouted) == 3  # 3 copies of 10 kB pass 25 kB: the read ends there
+        assert all(frames[2] == payload for frames in handover.unrouted)
+        rig.pump.learn(b"unknown-sender", TYPE, True)
+        rig.settle()
+        after = rig.pump.counts()
+        received, dropped = after.received - before.received, after.dropped - before.dropped
+        assert after.lost == 0
+        assert received + dropped == count - 3  # the rest went natively once learned
+        assert after.published - before.published == received
+    finally:
+        rig.close()
+
+
+def test_a_read_ends_at_a_payload_above_the_watched_size(native: Any, publisher: Any) -> None:
+    """The socket owner replaces its socket for a payload above the watched size before more
+    such payloads queue in the old one: the read that took it ends there and tells Python."""
+    rig = Rig(native, publisher, capacity=1000, max_bytes=1 << 26)
+    try:
+        rig.connected()
+        rig.settle()
+        rig.pump.watch(1000)
+        larger = message_class("gz.msgs.StringMsg")(data="y" * 8000).SerializeToString()
+        read_before = rig.pump.counts().bytes_read
+        for _ in range(10):
+            rig.send(LEGIT, larger)
+        time.sleep(0.5)
+        assert _one_run_with_reports(rig).grown == len(larger)
+        assert rig.pump.counts().bytes_read - read_before == len(larger)  # one read, not ten
+        rig.settle()
+        assert rig.pump.counts().bytes_read - read_before == 10 * len(larger)
     finally:
         rig.close()
