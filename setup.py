@@ -13,11 +13,17 @@ from setuptools import Extension, setup
 NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/_native.c",
     "ros_gz_bridge_py/native/encode.c",
+    "ros_gz_bridge_py/native/encode_load.c",
+    "ros_gz_bridge_py/native/encode_write.c",
     "ros_gz_bridge_py/native/loop.c",
+    "ros_gz_bridge_py/native/pb_read.c",
     "ros_gz_bridge_py/native/pump.c",
-    "ros_gz_bridge_py/native/ros_loop.c",
+    "ros_gz_bridge_py/native/pump_loop.c",
     "ros_gz_bridge_py/native/ros_pump.c",
+    "ros_gz_bridge_py/native/ros_pump_loop.c",
     "ros_gz_bridge_py/native/transcode.c",
+    "ros_gz_bridge_py/native/transcode_load.c",
+    "ros_gz_bridge_py/native/transcoders.c",
 ]
 
 setup(
@@ -26,10 +32,11 @@ setup(
             "ros_gz_bridge_py.native._native",
             sources=NATIVE_SOURCES,
             depends=[
+                "ros_gz_bridge_py/native/_native.h",
                 "ros_gz_bridge_py/native/encode.h",
-                "ros_gz_bridge_py/native/pump.h",
-                "ros_gz_bridge_py/native/ros_pump.h",
+                "ros_gz_bridge_py/native/encode_ops.h",
                 "ros_gz_bridge_py/native/transcode.h",
+                "ros_gz_bridge_py/native/transcode_ops.h",
                 "ros_gz_bridge_py/native/wire.h",
             ],
             extra_compile_args=[

@@ -1,14 +1,13 @@
 """The threads of a running bridge process by role, read from outside through ``/proc``.
 
 A thread's role comes from its OS name (``/proc/<pid>/task/<tid>/comm``, 15 characters), which
-the bridge gives its own threads and libzmq and Fast DDS give theirs; the names of both the
-two-loop data plane (``gz-native``, ``ros-loop``, ``gz-fallback``) and the unified one
-(``native-gz``, ``native-ros``, ``native-fallback``) are known, so the same readings hold
-before and after that change. A Python thread the bridge does
-not name keeps the process's name; the main thread (the rclpy executor) is the one whose id is
-the process's. Per thread: its run time (``schedstat``, nanoseconds) and its context switches
-(``status``: voluntary ones are the thread going to sleep, so each is a wake-up to come;
-involuntary ones are preemptions).
+the bridge gives its own threads (docs/threads.md) and libzmq and Fast DDS give theirs; the
+names of both the two-loop data plane (``gz-native``, ``ros-loop``, ``gz-fallback``) and the
+unified one (``native-gz``, ``native-ros``, ``native-fallback``) are known, so the same readings
+hold before and after that change. A Python thread the bridge does not name keeps the process's
+name; the main thread (the rclpy executor) is the one whose id is the process's. Per thread: its
+run time (``schedstat``, nanoseconds) and its context switches (``status``: voluntary ones are
+the thread going to sleep, so each is a wake-up to come; involuntary ones are preemptions).
 """
 
 from __future__ import annotations

@@ -31,12 +31,8 @@ from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.native import encoder as enc
 from ros_gz_bridge_py.native.encoder import compile_to_gz
-from ros_gz_bridge_py.native.program import (
-    ROS_KINDS,
-    Compiled,
-    NotExpressibleError,
-    compile_to_ros,
-)
+from ros_gz_bridge_py.native.program import Compiled, compile_to_ros
+from ros_gz_bridge_py.native.words import CONV_EXACT, CONV_WRAP, ROS_KINDS, NotExpressibleError
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
 #: The fuzz targets' modes, by the first input byte (fuzz/transcode_fuzz.c, fuzz/encode_fuzz.c).
@@ -321,8 +317,8 @@ _SYNTHETIC: dict[str, tuple[list[int], bytes]] = {
             4,
             [enc.R_NUM, _ROS["int16"], 0, enc.R_NUM, _ROS["uint32"], 1,
              enc.R_SEQ_NUM, _ROS["int8"], 2, enc.R_ARR, _ROS["uint16"], 3, 3],
-            [enc.W_NUM, 1, _PB_SINT32, _ROS["int16"], enc.CONV_EXACT, 0,
-             enc.W_NUM, 2, _PB_UINT32, _ROS["uint32"], enc.CONV_WRAP, 1,
+            [enc.W_NUM, 1, _PB_SINT32, _ROS["int16"], CONV_EXACT, 0,
+             enc.W_NUM, 2, _PB_UINT32, _ROS["uint32"], CONV_WRAP, 1,
              enc.W_PACKED, 3, _PB_SINT64, _ROS["int8"], 2,
              enc.W_PACKED, 4, _PB_FIXED32, _ROS["uint16"], 3],
         ),
@@ -333,7 +329,7 @@ _SYNTHETIC: dict[str, tuple[list[int], bytes]] = {
             1,
             [enc.R_SEQ_MSG, 0, 2, 6, enc.R_NUM, _ROS["int32"], 0, enc.R_STR, 1, enc.R_END],
             [enc.W_SEQ_MSG, 1, 0, 2, 10,
-             enc.W_NUM, 1, _PB_ENUM, _ROS["int32"], enc.CONV_EXACT, 0, enc.W_STR, 2, 1, enc.W_END],
+             enc.W_NUM, 1, _PB_ENUM, _ROS["int32"], CONV_EXACT, 0, enc.W_STR, 2, 1, enc.W_END],
         ),
         struct.pack("<Ii", 2, -3) + struct.pack("<I", 2) + b"x\0\0\0" + struct.pack("<iI", 9, 1)
         + b"\0",

@@ -18,10 +18,10 @@ from rclpy.serialization import deserialize_message
 from ros_gz_bridge_py.bulk.path import ros_cdr_to_gz
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.core.channel import Channel, ChannelContext, ChannelState
-from ros_gz_bridge_py.native.abi import rmw_layout_fits
+from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext, ChannelState
+from ros_gz_bridge_py.native.abi import rmw_layout_fits, ros_functions
 from ros_gz_bridge_py.native.channel import native_encoders
-from ros_gz_bridge_py.native.ros_pump import RosChannelPump, ros_functions
+from ros_gz_bridge_py.native.ros_pump import RosChannelPump
 from ros_gz_bridge_py.ros import light_reader
 from ros_gz_bridge_py.ros.qos import (
     SUBSCRIPTION_OVERRIDES,
@@ -149,6 +149,8 @@ class RosToGzChannel(Channel):
             encoders=self._encoders,
             max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
             refused=self._convert_and_publish,
+            capacity=max(self._qos.depth, MIN_DELIVERY_QUEUE),
+            max_bytes=self.ctx.options.max_queued_bytes,
             counted=self._counted,
             lost=self._lost,
             failed=self._native_failed,
@@ -173,12 +175,13 @@ class RosToGzChannel(Channel):
             self._announce()
 
     def _lost(self, count: int) -> None:
-        """Messages the native loop could not copy for the Python path (no memory, on its
+        """Messages the native loop left to the Python path and dropped on their way (no
+        memory to copy them, or the oldest past the bounds of their queue, on the loop's
         thread): among the channel's drops, and said."""
         self._dropped += count
         self._logger.warning(
-            f"{self.describe()}: {count} message(s) dropped: no memory to copy them for the "
-            "Python path"
+            f"{self.describe()}: {count} message(s) dropped on their way to the Python path "
+            "(no memory to copy them, or past the bounds of its queue)"
         )
 
     def _native_failed(self, reason: str) -> None:

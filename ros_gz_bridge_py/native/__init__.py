@@ -9,23 +9,38 @@ Python path, which stays the reference. :func:`extension` says which, and why no
 from __future__ import annotations
 
 import functools
-import importlib
-from types import ModuleType
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.native import _native
+
+
+class Extension(Protocol):
+    """What the compiled extension offers (typed in ``_native.pyi``)."""
+
+    Program: type[_native.Program]
+    Encoder: type[_native.Encoder]
+    Pump: type[_native.Pump]
+    RosPump: type[_native.RosPump]
+    Loop: type[_native.Loop]
+    EVENT_HANDED: int
+    EVENT_MONITOR: int
+    EVENT_BROKEN: int
 
 
 @functools.cache
-def _load() -> tuple[ModuleType | None, str]:
+def _load() -> tuple[Extension | None, str]:
     try:
-        native = importlib.import_module("ros_gz_bridge_py.native._native")
+        from ros_gz_bridge_py.native import _native  # noqa: PLC0415 - optional
     except ImportError as err:
         return None, (
             f"the native extension is not built ({err}); reinstall with a C compiler and "
             "Python headers (pip install .) to build it"
         )
-    return native, ""
+    return _native, ""
 
 
-def extension() -> ModuleType | None:
+def extension() -> Extension | None:
     """The compiled extension, or None where it is not built."""
     return _load()[0]
 

@@ -1,230 +1,43 @@
-/* The Python face of the native data plane (docs/native.md).
- *
- * Program: one pair's transcoder, loaded from the words program.py compiles.
- * Encoder: one pair's ROS -> Gazebo transcoder (encode.c).
- * Pump: the per-message loop of one Gazebo -> ROS channel (pump.c).
- * RosPump: the per-message loop of one ROS -> Gazebo channel (ros_pump.c). */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#include <structmember.h>
+/* The module of the native data plane (docs/native.md): its types (one a file, _native.h),
+ * the constants Python reads from here, defined once (the events of a loop's report), the
+ * named structures the types return, and the helpers the files share. */
+#include "_native.h"
 
-#include "encode.h"
-#include "pump.h"
-#include "transcode.h"
+#include <string.h>
 
-typedef struct {
-    PyObject_HEAD
-    struct rgb_program program;
-    int32_t *words; /* schema then ops, owned */
-    struct rgb_out out;
-    Py_ssize_t steps; /* fields the last to_cdr read: its work, for the tests */
-} ProgramObject;
+struct rgb_records rgb_records;
 
-static void program_dealloc(ProgramObject *self) {
-    rgb_out_free(&self->out);
-    PyMem_Free(self->words);
-    Py_TYPE(self)->tp_free((PyObject *)self);
-}
+/* The records' fields (documented in _native.pyi), in the order the types fill them. */
+#define FIELDS(name, ...) static PyStructSequence_Field name[] = {__VA_ARGS__, {NULL, NULL}}
+#define F(name) {name, NULL}
+FIELDS(pump_counts, F("received"), F("rate_limited"), F("published"), F("dropped"), F("skipped"),
+       F("lost"), F("taken"), F("bytes_read"));
+FIELDS(ros_pump_counts, F("received"), F("own_skipped"), F("rate_limited"), F("published"),
+       F("take_errors"), F("send_failures"), F("lost"), F("bytes_read"));
+FIELDS(handover, F("unrouted"), F("refused"), F("too_large"), F("grown"));
+FIELDS(refused, F("sender"), F("msg_type"), F("payload"), F("status"));
+FIELDS(too_large, F("sender"), F("msg_type"), F("items"), F("least"), F("size"));
 
-static int program_init(ProgramObject *self, PyObject *args, PyObject *kwds) {
-    static char *keywords[] = {"schema", "ops", NULL};
-    Py_buffer schema, ops;
-    /* A pump may be reading the words with the GIL released: they are never replaced. */
-    if (self->words != NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "a Program is loaded once; make a new Program");
-        return -1;
-    }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*y*", keywords, &schema, &ops)) return -1;
-    int result = -1;
-    if (schema.len % 4 || ops.len % 4) {
-        PyErr_SetString(PyExc_ValueError, "schema and ops are int32 words");
-        goto done;
-    }
-    size_t schema_len = (size_t)schema.len / 4, ops_len = (size_t)ops.len / 4;
-    int32_t *words = PyMem_Malloc((schema_len + ops_len + 1) * 4);
-    if (words == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    memcpy(words, schema.buf, (size_t)schema.len);
-    memcpy(words + schema_len, ops.buf, (size_t)ops.len);
-    const char *why = "";
-    if (rgb_load(&self->program, words, schema_len, words + schema_len, ops_len, &why)) {
-        PyMem_Free(words);
-        PyErr_Format(PyExc_ValueError, "not a native program: %s", why);
-        goto done;
-    }
-    self->words = words;
-    result = 0;
-done:
-    PyBuffer_Release(&schema);
-    PyBuffer_Release(&ops);
-    return result;
-}
-
-static Py_ssize_t clamp_ssize(size_t n) {
-    return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n;
-}
-
-/* to_cdr(payload) -> (status, bytes, (items, least) for RGB_TOO_LARGE, or None) */
-static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
-    if (self->words == NULL) {
-        PyErr_SetString(PyExc_ValueError, "program not loaded");
-        return NULL;
-    }
-    Py_buffer payload;
-    if (PyObject_GetBuffer(arg, &payload, PyBUF_SIMPLE)) return NULL;
-    size_t steps = 0;
-    enum rgb_status status = rgb_to_cdr_counted(&self->program, payload.buf, (size_t)payload.len,
-                                                &self->out, &steps);
-    PyBuffer_Release(&payload);
-    self->steps = steps > PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)steps;
-    PyObject *result;
-    if (status == RGB_TOO_LARGE)
-        result = Py_BuildValue("(i(nn))", (int)status, clamp_ssize(self->out.refused.items),
-                               clamp_ssize(self->out.refused.least));
-    else if (status != RGB_OK)
-        result = Py_BuildValue("(iO)", (int)status, Py_None);
-    else
-        result = Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
-    rgb_out_trim(&self->out);
-    return result;
-}
-
-static PyMethodDef program_methods[] = {
-    {"to_cdr", (PyCFunction)program_to_cdr, METH_O,
-     "to_cdr(payload) -> (status, cdr or None): 0 ok, 1 undecodable, 2 conversion, 3 fallback; "
-     "4 too large, with (items, least bytes of one) for None"},
-    {NULL, NULL, 0, NULL},
+#define RECORD(name, doc, fields) {"ros_gz_bridge_py.native._native." name, doc, fields, \
+                                    sizeof fields / sizeof *fields - 1}
+static PyStructSequence_Desc records[] = {
+    RECORD("PumpCounts", "A Pump's counts so far.", pump_counts),
+    RECORD("RosPumpCounts", "A RosPump's counts so far.", ros_pump_counts),
+    RECORD("Handover", "What a Pump left to Python.", handover),
+    RECORD("Refused", "A payload no program took.", refused),
+    RECORD("TooLarge", "A payload refused as too large.", too_large),
 };
 
-static PyMemberDef program_members[] = {
-    {"steps", T_PYSSIZET, offsetof(ProgramObject, steps), READONLY,
-     "the protobuf fields the last to_cdr read (its work)"},
-    {NULL, 0, 0, 0, NULL},
-};
-
-static PyObject *program_kept_bytes(ProgramObject *self, void *closure) {
-    (void)closure;
-    return PyLong_FromSize_t(self->out.cap + self->out.scratch_cap);
+PyObject *rgb_record(PyTypeObject *type, PyObject *values) {
+    if (values == NULL) return NULL;
+    PyObject *record = PyStructSequence_New(type);
+    for (Py_ssize_t i = 0; record != NULL && i < PyTuple_GET_SIZE(values); i++)
+        PyStructSequence_SetItem(record, i, Py_NewRef(PyTuple_GET_ITEM(values, i)));
+    Py_DECREF(values);
+    return record;
 }
 
-static PyGetSetDef program_getset[] = {
-    {"kept_bytes", (getter)program_kept_bytes, NULL,
-     "the bytes of output buffer and scratch kept for the next to_cdr", NULL},
-    {NULL, NULL, NULL, NULL, NULL},
-};
-
-static PyTypeObject ProgramType = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.Program",
-    .tp_basicsize = sizeof(ProgramObject),
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "One pair's Gazebo -> ROS transcoder (docs/native.md).",
-    .tp_new = PyType_GenericNew,
-    .tp_init = (initproc)program_init,
-    .tp_dealloc = (destructor)program_dealloc,
-    .tp_methods = program_methods,
-    .tp_members = program_members,
-    .tp_getset = program_getset,
-};
-
-typedef struct {
-    PyObject_HEAD
-    struct rgb_encoder encoder;
-    int32_t *words; /* owned */
-} EncoderObject;
-
-static void encoder_dealloc(EncoderObject *self) {
-    PyMem_Free(self->words);
-    Py_TYPE(self)->tp_free((PyObject *)self);
-}
-
-static int encoder_init(EncoderObject *self, PyObject *args, PyObject *kwds) {
-    static char *keywords[] = {"words", NULL};
-    Py_buffer words;
-    /* A loop may be reading the words with the GIL released: they are never replaced. */
-    if (self->words != NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "an Encoder is loaded once; make a new Encoder");
-        return -1;
-    }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*", keywords, &words)) return -1;
-    int result = -1;
-    if (words.len % 4) {
-        PyErr_SetString(PyExc_ValueError, "an encoder is int32 words");
-        goto done;
-    }
-    int32_t *copy = PyMem_Malloc((size_t)words.len + 4);
-    if (copy == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    memcpy(copy, words.buf, (size_t)words.len);
-    const char *why = "";
-    if (rgb_encoder_load(&self->encoder, copy, (size_t)words.len / 4, &why)) {
-        PyMem_Free(copy);
-        PyErr_Format(PyExc_ValueError, "not a native encoder: %s", why);
-        goto done;
-    }
-    self->words = copy;
-    result = 0;
-done:
-    PyBuffer_Release(&words);
-    return result;
-}
-
-/* to_pb(cdr) -> (status, bytes or None); the output buffer is the call's own, so channels
- * on several threads may share one encoder. */
-static PyObject *encoder_to_pb(EncoderObject *self, PyObject *arg) {
-    if (self->words == NULL) {
-        PyErr_SetString(PyExc_ValueError, "encoder not loaded");
-        return NULL;
-    }
-    Py_buffer cdr;
-    if (PyObject_GetBuffer(arg, &cdr, PyBUF_SIMPLE)) return NULL;
-    struct rgb_out out = {.data = NULL};
-    enum rgb_status status = rgb_to_pb(&self->encoder, cdr.buf, (size_t)cdr.len, &out);
-    PyBuffer_Release(&cdr);
-    PyObject *result;
-    if (status != RGB_OK) {
-        result = Py_BuildValue("(iO)", (int)status, Py_None);
-    } else {
-        const char *data = out.len ? (const char *)out.data : ""; /* empty: no buffer */
-        result = Py_BuildValue("(iy#)", 0, data, (Py_ssize_t)out.len);
-    }
-    rgb_out_free(&out);
-    return result;
-}
-
-static PyMethodDef encoder_methods[] = {
-    {"to_pb", (PyCFunction)encoder_to_pb, METH_O,
-     "to_pb(cdr) -> (status, payload or None): 0 ok, 1 undecodable, 3 fallback"},
-    {NULL, NULL, 0, NULL},
-};
-
-static PyTypeObject EncoderType = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "ros_gz_bridge_py.native._native.Encoder",
-    .tp_basicsize = sizeof(EncoderObject),
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "One pair's ROS -> Gazebo transcoder (docs/native.md §6).",
-    .tp_new = PyType_GenericNew,
-    .tp_init = (initproc)encoder_init,
-    .tp_dealloc = (destructor)encoder_dealloc,
-    .tp_methods = encoder_methods,
-};
-
-struct rgb_encoder *native_encoder_of(PyObject *object) {
-    if (!PyObject_TypeCheck(object, &EncoderType)) return NULL;
-    EncoderObject *encoder = (EncoderObject *)object;
-    return encoder->words == NULL ? NULL : &encoder->encoder;
-}
-
-struct rgb_program *native_program_of(PyObject *object) {
-    if (!PyObject_TypeCheck(object, &ProgramType)) return NULL;
-    ProgramObject *program = (ProgramObject *)object;
-    return program->words == NULL ? NULL : &program->program;
-}
-
-int native_addresses(PyObject *functions, void **out, Py_ssize_t count) {
+int rgb_addresses(PyObject *functions, void **out, Py_ssize_t count) {
     PyObject *sequence = PySequence_Fast(functions, "functions must be a sequence");
     if (sequence == NULL) return -1;
     int result = 0;
@@ -243,22 +56,67 @@ int native_addresses(PyObject *functions, void **out, Py_ssize_t count) {
     return result;
 }
 
+uint8_t *rgb_copy(const void *p, size_t n) {
+    uint8_t *copy = malloc(n ? n : 1);
+    if (copy != NULL && n) memcpy(copy, p, n);
+    return copy;
+}
+
+int64_t rgb_now_ns(clockid_t clock) {
+    struct timespec t;
+    clock_gettime(clock, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+int rgb_admit(int64_t *next_ns, int64_t period_ns) {
+    if (period_ns <= 0) return 1;
+    int64_t now = rgb_now_ns(CLOCK_MONOTONIC);
+    if (*next_ns != INT64_MIN && now < *next_ns) return 0;
+    /* on the schedule, or a fresh start after a pause */
+    int on_time = *next_ns != INT64_MIN && now - *next_ns < period_ns;
+    *next_ns = on_time ? *next_ns + period_ns : now + period_ns;
+    return 1;
+}
+
+struct rgb_member *rgb_member_of(PyObject *object) {
+    if (!PyObject_TypeCheck(object, &rgb_PumpType) && !PyObject_TypeCheck(object, &rgb_RosPumpType))
+        return NULL;
+    struct rgb_member *m = &((MemberObject *)object)->member;
+    return m->hooks != NULL ? m : NULL;
+}
+
+int rgb_member_idle(const struct rgb_member *m, const char *what) {
+    if (m->running != NULL && atomic_load(m->running)) {
+        PyErr_Format(PyExc_RuntimeError, "the %s's loop is running it", what);
+        return -1;
+    }
+    return 0;
+}
+
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, .m_name = "_native",
     .m_doc = "The native data plane of ros_gz_bridge_py (docs/native.md).", .m_size = -1,
 };
 
 PyMODINIT_FUNC PyInit__native(void) {
-    if (PyType_Ready(&ProgramType) < 0 || PyType_Ready(&EncoderType) < 0) return NULL;
+    PyTypeObject *types[] = {&rgb_ProgramType, &rgb_EncoderType, &rgb_PumpType, &rgb_RosPumpType,
+                             &rgb_LoopType};
+    PyTypeObject **made[] = {&rgb_records.pump_counts, &rgb_records.ros_pump_counts,
+                             &rgb_records.handover, &rgb_records.refused, &rgb_records.too_large};
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) return NULL;
-    Py_INCREF(&ProgramType);
-    Py_INCREF(&EncoderType);
-    if (PyModule_AddObject(m, "Program", (PyObject *)&ProgramType) < 0 ||
-        PyModule_AddObject(m, "Encoder", (PyObject *)&EncoderType) < 0 || pump_register(m) < 0 || loop_register(m) < 0 ||
-        ros_pump_register(m) < 0) {
-        Py_DECREF(m);
-        return NULL;
+    for (size_t i = 0; i < sizeof types / sizeof *types; i++)
+        if (PyModule_AddType(m, types[i]) < 0) goto failed;
+    for (size_t i = 0; i < sizeof made / sizeof *made; i++) {
+        if (*made[i] == NULL) *made[i] = PyStructSequence_NewType(&records[i]);
+        if (*made[i] == NULL || PyModule_AddType(m, *made[i]) < 0) goto failed;
     }
+    if (PyModule_AddIntConstant(m, "EVENT_HANDED", RGB_EVENT_HANDED) < 0 ||
+        PyModule_AddIntConstant(m, "EVENT_MONITOR", RGB_EVENT_MONITOR) < 0 ||
+        PyModule_AddIntConstant(m, "EVENT_BROKEN", RGB_EVENT_BROKEN) < 0)
+        goto failed;
     return m;
+failed:
+    Py_DECREF(m);
+    return NULL;
 }

@@ -1,20 +1,28 @@
-"""Whether the libraries in the process lay out the structures the native loops declare by hand.
+"""The foreign libraries the native loops call: their functions, and whether their structures
+are laid out as the loops declare them (docs/native.md §5, §7).
 
-The loops call libzmq and rcl/rmw without their headers (docs/native.md §5, §7): pump.c
-declares ``zmq_msg_t`` as the 64 bytes of libzmq 4.2 and later (4.0 had 32, early 4.1 48), and
-ros_pump.c declares ``rmw_message_info_t`` with the 16-byte ``rmw_gid_t`` of Iron and later
-(Humble and before: 24 bytes, so every field after the GID would be read at the wrong place).
-Where the loaded libraries are known to differ, the loop is not used: the channel takes the
-Python path, and the bridge logs once why. The versions are read from what is loaded: libzmq's
-through pyzmq (``zmq_version``), rclpy's from its package metadata, else ``ROS_DISTRO``.
+The loops call libzmq and rcl/rmw without linking them or reading their headers: their
+functions are the ones the libraries pyzmq and rclpy loaded, passed to C by address
+(:func:`zmq_functions`, :func:`ros_functions`), and the few structures passed to them are
+declared by hand. pump.c declares ``zmq_msg_t`` as the 64 bytes of libzmq 4.2 and later (4.0 had
+32, early 4.1 48); ros_pump.c declares ``rmw_message_info_t`` with the 16-byte ``rmw_gid_t`` of
+Iron and later (Humble and before: 24 bytes, so every field after the GID would be read at the
+wrong place). Where the loaded libraries are known to differ, or a function is missing, the
+loop is not used: the channel takes the Python path, and the bridge logs once why. The versions
+are read from what is loaded: libzmq's through pyzmq (``zmq_version``), rclpy's from its
+package metadata, else ``ROS_DISTRO``.
 """
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import functools
 import importlib.metadata
 import logging
 import os
+from pathlib import Path
+from typing import Any
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 
@@ -25,6 +33,9 @@ RCLPY_24_BYTE_GID = 3
 #: Distributions whose rmw_gid_t holds 24 bytes.
 DISTROS_24_BYTE_GID = frozenset({"ardent", "bouncy", "crystal", "dashing", "eloquent", "foxy",
                                  "galactic", "humble"})  # fmt: skip
+#: The functions a Pump calls (pump.c), in its order: libzmq's, then rcl's and rcutils'.
+_ZMQ_FUNCTIONS = ("zmq_msg_init", "zmq_msg_recv", "zmq_msg_close", "zmq_msg_data",
+                  "zmq_msg_size", "zmq_msg_more", "zmq_getsockopt")  # fmt: skip
 
 
 def zmq_problem(version: tuple[int, ...]) -> str:
@@ -82,3 +93,97 @@ def rmw_layout_fits() -> bool:
     if problem:
         _LOG.warning("ROS -> Gazebo channels convert in Python: %s", problem)
     return not problem
+
+
+# --- the functions ---------------------------------------------------------------------------
+
+
+def loaded_libraries() -> list[str]:
+    """The paths of the shared libraries this process has loaded (Linux), in load order."""
+    try:
+        maps = Path("/proc/self/maps").read_text()
+    except OSError:
+        return []
+    paths = [line.rpartition(" ")[2] for line in maps.splitlines()]
+    return list(dict.fromkeys(path for path in paths if ".so" in path))
+
+
+def libzmq_path() -> str | None:
+    """The libzmq pyzmq loaded (its wheel bundles one)."""
+    import zmq  # noqa: F401, PLC0415 - loads pyzmq's libzmq, which this finds
+
+    return next((path for path in loaded_libraries() if "/libzmq" in path), None)
+
+
+def _addresses(functions: list[Any]) -> tuple[int, ...] | None:
+    addresses = tuple(ctypes.cast(function, ctypes.c_void_p).value or 0 for function in functions)
+    return addresses if all(addresses) else None
+
+
+@functools.cache
+def _zmq_resolved() -> tuple[tuple[int, ...] | None, str]:
+    path = libzmq_path()
+    if path is None:
+        return None, "pyzmq's libzmq is not among the loaded libraries"
+    try:
+        libzmq, rcl = ctypes.CDLL(path), ctypes.CDLL("librcl.so")
+        functions = [getattr(libzmq, name) for name in _ZMQ_FUNCTIONS]
+        functions += [
+            rcl.rcl_publish_serialized_message,
+            ctypes.CDLL("librcutils.so").rcutils_reset_error,
+        ]
+    except (OSError, AttributeError) as err:
+        return None, f"libzmq or rcl cannot be used from C ({err})"
+    addresses = _addresses(functions)
+    return addresses, "" if addresses else "a function has no address"
+
+
+def zmq_functions() -> tuple[int, ...] | None:
+    """The addresses of the libzmq and rcl functions a Pump calls, or None (then no channel
+    takes the native path; :func:`why_no_zmq_functions` says why)."""
+    return _zmq_resolved()[0]
+
+
+def why_no_zmq_functions() -> str:
+    return _zmq_resolved()[1]
+
+
+@functools.cache
+def ros_functions() -> tuple[int, ...] | None:
+    """The addresses of the rcl, rmw, rcutils and libzmq functions a RosPump calls, or None
+    (logged once why)."""
+    path, rmw = libzmq_path(), _rmw_library()
+    if path is None or rmw is None:
+        return None
+    try:
+        rcl, rcutils = ctypes.CDLL("librcl.so"), ctypes.CDLL("librcutils.so")
+        functions = [
+            rcl.rcl_take_serialized_message,
+            rcl.rcl_subscription_set_on_new_message_callback,
+            rcutils.rcutils_reset_error,
+            rcutils.rcutils_get_default_allocator,
+            rcl.rcl_publisher_get_rmw_handle,
+            rmw.rmw_get_gid_for_publisher,
+            ctypes.CDLL(path).zmq_send,
+        ]
+    except (OSError, AttributeError) as err:
+        _LOG.warning(
+            "ROS -> Gazebo channels convert in Python: rcl cannot be used from C (%s)", err
+        )
+        return None
+    return _addresses(functions)
+
+
+def _rmw_library() -> Any:
+    """The loaded rmw library that has ``rmw_get_gid_for_publisher``: rmw_implementation's
+    dispatcher where rcl goes through it (a ROS install), else the implementation rcl is
+    linked with (the PyPI wheels link rmw_fastrtps_cpp)."""
+    candidates = [path for path in loaded_libraries() if "/librmw" in path]
+    candidates.sort(key=lambda path: "rmw_implementation" not in path)
+    for candidate in candidates:
+        with contextlib.suppress(OSError, AttributeError):
+            library = ctypes.CDLL(candidate)
+            library.rmw_get_gid_for_publisher  # noqa: B018 - does it have the function?
+            return library
+    _LOG.warning("ROS -> Gazebo channels convert in Python: no loaded rmw library gives GIDs")
+    return None

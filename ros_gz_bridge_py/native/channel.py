@@ -12,14 +12,17 @@ from __future__ import annotations
 import functools
 import logging
 from collections.abc import Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.native import extension, unavailable_reason
-from ros_gz_bridge_py.native.abi import zmq_layout_fits
+from ros_gz_bridge_py.native.abi import why_no_zmq_functions, zmq_functions, zmq_layout_fits
 from ros_gz_bridge_py.native.encoder import compile_to_gz
-from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
-from ros_gz_bridge_py.native.pump import foreign_functions, why_no_functions
+from ros_gz_bridge_py.native.program import compile_to_ros
+from ros_gz_bridge_py.native.words import NotExpressibleError
+
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.native._native import Encoder, Program
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 
@@ -45,7 +48,7 @@ def expressible(pairs: Iterable[Pair]) -> tuple[Reasons, Reasons]:
 
 def native_programs(
     layouts: dict[str, Pair], options: Any, gz_node: Any, *, frame_id: str = ""
-) -> dict[str, Any]:
+) -> dict[str, Program]:
     """The program of each wire spelling a channel of ``layouts`` runs natively (``frame_id``:
     the channel's header rewrite); empty when the channel takes the Python path."""
     if not (options.native and options.cdr_write and options.rcl_serialized_publish):
@@ -76,14 +79,14 @@ def native_path_available() -> bool:
     messages as the loop declares (native/abi.py); logged once where not."""
     if not _extension_available():
         return False
-    if foreign_functions() is None:
-        _LOG.warning("Every channel takes the Python path: %s", why_no_functions())
+    if zmq_functions() is None:
+        _LOG.warning("Every channel takes the Python path: %s", why_no_zmq_functions())
         return False
     return zmq_layout_fits()
 
 
 @functools.cache
-def program_of(pair: Pair, frame_id: str = "", wall_stamp: bool = False) -> Any | None:
+def program_of(pair: Pair, frame_id: str = "", wall_stamp: bool = False) -> Program | None:
     """The loaded program of ``pair`` with a header rewrite (compiled once), or None where it
     stays on Python."""
     native = extension()
@@ -96,19 +99,21 @@ def program_of(pair: Pair, frame_id: str = "", wall_stamp: bool = False) -> Any 
     return native.Program(compiled.schema, compiled.ops)
 
 
-def native_encoders(layouts: dict[str, Pair], options: Any) -> dict[str, Any]:
+def native_encoders(layouts: dict[str, Pair], options: Any) -> dict[str, Encoder]:
     """The encoder of each wire spelling a ROS -> Gazebo channel of ``layouts`` runs natively
     (docs/native.md §6); empty where the channel converts in Python."""
     if not (options.native and options.light_read) or not _extension_available():
         return {}
     encoders = {wire_type: encoder_of(pair) for wire_type, pair in layouts.items()}
-    if any(encoder is None for encoder in encoders.values()):
-        return {}
-    return encoders
+    return (
+        {wire_type: encoder for wire_type, encoder in encoders.items() if encoder is not None}
+        if None not in encoders.values()
+        else {}
+    )
 
 
 @functools.cache
-def encoder_of(pair: Pair) -> Any | None:
+def encoder_of(pair: Pair) -> Encoder | None:
     """The loaded ROS -> Gazebo encoder of ``pair`` (compiled once), or None."""
     native = extension()
     if native is None:

@@ -36,12 +36,10 @@ from ros_gz_bridge_py.converters.std_msgs import (
     HEADER,
 )
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native.program import (
-    ROS_KINDS,
-    VALUES,
+from ros_gz_bridge_py.native import words
+from ros_gz_bridge_py.native.words import (
     NotExpressibleError,
     Path,
-    gz_field,
     named,
     ros_kind,
     split_path,
@@ -52,7 +50,6 @@ from ros_gz_bridge_py.ros import cdr_types as cdr
 # Read ops, write ops (encode.c).
 R_END, R_NUM, R_STR, R_ARR, R_SEQ_NUM, R_SEQ_STR, R_SEQ_MSG = 0, 1, 2, 3, 4, 5, 6
 W_END, W_NUM, W_STR, W_STR_REP, W_CONST_STR, W_MSG, W_SEQ_MSG, W_PACKED, W_SEQ_STR = range(9)
-CONV_EXACT, CONV_WRAP = 0, 1
 _PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP, _PB_BOOL = 9, 11, 12, 10, 8
 _PB_FLOATS = frozenset({1, 2})
 
@@ -174,8 +171,8 @@ def _entry(ros: Path, gz: Path, how: Fill | Value | None, out: Node) -> None:
         _assign(how, ros, gz, out)
     elif how.to_gz is None:
         return
-    elif how.to_gz in VALUES:
-        out.set(gz, Copy(ros, wrap=VALUES[how.to_gz]))
+    elif how.to_gz in words.VALUES:
+        out.set(gz, Copy(ros, wrap=words.VALUES[how.to_gz]))
     else:
         msg = f"a Value of {how.to_gz.__qualname__}"
         raise NotExpressibleError(msg)
@@ -218,7 +215,7 @@ def _read_ops(
     ops: list[int] = []
     fields = cdr.fields_of(msg_class)
     if not fields:
-        return [R_NUM, ROS_KINDS["uint8"][0], -1]
+        return [R_NUM, words.ROS_KINDS["uint8"][0], -1]
     for name, rosidl in fields:
         path = (*prefix, name)
         kind = type(rosidl).__name__
@@ -268,9 +265,11 @@ def _sequences(node: Node) -> dict[Path, Node]:
 
 def _write_ops(node: Node, descriptor: Any, frame: _Frame) -> list[int]:
     ops: list[int] = []
-    ordered = sorted(node.fields.items(), key=lambda item: gz_field(descriptor, item[0]).number)
+    ordered = sorted(
+        node.fields.items(), key=lambda item: words.gz_field(descriptor, item[0]).number
+    )
     for name, value in ordered:
-        field = gz_field(descriptor, name)
+        field = words.gz_field(descriptor, name)
         for item in value if isinstance(value, list) else [value]:
             ops += _write_one(item, field, frame, repeated=isinstance(value, list))
     return ops
@@ -319,19 +318,26 @@ def _write_one(item: Any, gz_field: Any, frame: _Frame, *, repeated: bool) -> li
             raise NotExpressibleError(msg)
         kind = ros_kind(rosidl)[0]
         _check_number(gz_field, kind)
-        return [W_NUM, number, gz_field.type, kind, CONV_WRAP if item.wrap else CONV_EXACT, slot]
+        return [
+            W_NUM,
+            number,
+            gz_field.type,
+            kind,
+            words.CONV_WRAP if item.wrap else words.CONV_EXACT,
+            slot,
+        ]
     msg = f"{type(item).__name__} into {gz_field.full_name}"
     raise NotExpressibleError(msg)
 
 
-_FLOAT_KINDS = frozenset({ROS_KINDS["float"][0], ROS_KINDS["double"][0]})
+_FLOAT_KINDS = frozenset({words.ROS_KINDS["float"][0], words.ROS_KINDS["double"][0]})
 
 
 def _check_number(gz_field: Any, kind: int) -> None:
     """Only what Python assigns without a conversion of its own: floats into float fields,
     booleans into bool fields, integers into integer fields."""
     floats = gz_field.type in _PB_FLOATS
-    boolean = kind == ROS_KINDS["boolean"][0]
+    boolean = kind == words.ROS_KINDS["boolean"][0]
     if floats != (kind in _FLOAT_KINDS) or (gz_field.type == _PB_BOOL) != boolean:
         msg = f"{gz_field.full_name} from a ROS number of another sort"
         raise NotExpressibleError(msg)

@@ -1,16 +1,17 @@
-"""The one thread on which every native Gazebo -> ROS channel's fallback runs (docs/native.md §5).
+"""The one thread on which every native channel's fallback runs, in both directions
+(docs/native.md §5, §7).
 
-A payload no program took (the transcoder left it to Python: a string with a NUL, a number out
-of its ROS type's range, an output over the bound) goes to its channel's Python path, which
-converts it or says why not. That can be slow (a Pose_V of 4 M empty poses: a second of
-parsing), so it does not run on the loop's thread; and it must not cost a thread per channel
-either, or a rogue whose payloads fall back on many topics would add a thread to the process for
-each of them. So every channel has a :class:`FallbackLane` (its own drop-oldest queue, of the
-channel's bounds in messages and bytes, its drops counted) on the process's one
-:class:`FallbackWorker`, whose thread serves the lanes that hold something one payload each in
-turn: a channel's payload waits at most for the one being handled and one of each other lane
-whose turn came first, so a flood on one channel's fallback does not hold up another's behind
-its whole queue.
+A payload no program took (a transcoder left it to Python: a string with a NUL, a number out of
+its ROS type's range, an output over the bound) goes to its channel's Python path, which
+converts and publishes it or says why not. That can be slow (a Pose_V of 4 M empty poses: a
+second of parsing), so it never runs on a loop's thread; and it must not cost a thread per
+channel either, or a rogue whose payloads fall back on many topics would add a thread to the
+process for each of them. So every channel has a :class:`FallbackLane` (its own drop-oldest
+queue, of the channel's bounds in messages and bytes, its drops counted; made at its first
+payload by its :class:`ChannelFallback`) on the process's one :class:`FallbackWorker`, whose
+thread serves the lanes that hold something one payload each in turn: a channel's payload waits
+at most for the one being handled and one of each other lane whose turn came first, so a flood
+on one channel's fallback does not hold up another's behind its whole queue.
 
 The thread starts with the first lane (a channel's first fallback) and ends with the last (the
 channel closed). It trims the heap once it has been quiet for a second after handling
@@ -26,10 +27,10 @@ import logging
 import queue
 import threading
 from collections.abc import Callable
+from typing import Any, Generic, TypeVar
 
 from ros_gz_bridge_py.libc import name_os_thread
-from ros_gz_bridge_py.transport import MessageInfo
-from ros_gz_bridge_py.transport.delivery import DropOldestQueue, payload_size
+from ros_gz_bridge_py.transport.delivery import DropOldestQueue
 from ros_gz_bridge_py.transport.heap import BurstTrimmer
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
@@ -40,22 +41,33 @@ FALLBACK_TRIM_AFTER = 1024 * 1024
 #: Seconds between two looks at the trimmer while a burst waits for its trim.
 IDLE_EVERY = 0.25
 #: The thread's name (in Python and in the OS, for ``top -H``).
-THREAD_NAME = "gz-fallback"
+THREAD_NAME = "native-fallback"
 
-#: One payload on its way to the Python path, and what its callback is told.
-Refused = tuple[bytes, MessageInfo]
-Handler = Callable[[bytes, MessageInfo], None]
+#: What a lane's handler is told with each payload (a Gazebo message's info, or nothing).
+Info = TypeVar("Info")
 
 
-class FallbackLane:
+def _payload_size(item: tuple[bytes, object]) -> int:
+    return len(item[0])
+
+
+class FallbackLane(Generic[Info]):
     """One channel's queue on the fallback thread: :meth:`put` from the loop's thread,
     :meth:`close` from any."""
 
-    def __init__(self, worker: FallbackWorker, handler: Handler, size: int, max_bytes: int) -> None:
+    def __init__(
+        self,
+        worker: FallbackWorker,
+        handler: Callable[[bytes, Info], None],
+        size: int,
+        max_bytes: int,
+        name: str,
+    ) -> None:
         self._worker = worker
         self.handler = handler
-        self.queue: DropOldestQueue[Refused] = DropOldestQueue(
-            size, weigh=payload_size, max_bytes=max_bytes
+        self.name = name
+        self.queue: DropOldestQueue[tuple[bytes, Info]] = DropOldestQueue(
+            size, weigh=_payload_size, max_bytes=max_bytes
         )
         # Written under the worker's lock:
         self.closed = False
@@ -66,7 +78,7 @@ class FallbackLane:
         """Payloads dropped so far, oldest first (over the lane's count or bytes)."""
         return self.queue.dropped
 
-    def put(self, payload: bytes, info: MessageInfo) -> None:
+    def put(self, payload: bytes, info: Info) -> None:
         """Queue ``payload`` for the handler (nothing once closed)."""
         if self.closed:
             return
@@ -86,9 +98,9 @@ class FallbackWorker:
         self._trimmer = trimmer or BurstTrimmer(trim_after=FALLBACK_TRIM_AFTER)
         self._name = name
         self._changed = threading.Condition()
-        self._lanes: set[FallbackLane] = set()  # open
-        self._turns: collections.deque[FallbackLane] = collections.deque()  # holding payloads
-        self._serving: FallbackLane | None = None
+        self._lanes: set[FallbackLane[Any]] = set()  # open
+        self._turns: collections.deque[FallbackLane[Any]] = collections.deque()  # holding some
+        self._serving: FallbackLane[Any] | None = None
         self._thread: threading.Thread | None = None
 
     @property
@@ -96,10 +108,13 @@ class FallbackWorker:
         """The thread while there are lanes."""
         return self._thread
 
-    def lane(self, handler: Handler, size: int, max_bytes: int) -> FallbackLane:
-        """A new lane whose payloads go to ``handler``, keeping the newest ``size`` and at most
-        ``max_bytes`` of them (always one); starts the thread if it is not running."""
-        lane = FallbackLane(self, handler, size, max_bytes)
+    def lane(
+        self, handler: Callable[[bytes, Info], None], size: int, max_bytes: int, name: str
+    ) -> FallbackLane[Info]:
+        """A new lane (of channel ``name``) whose payloads go to ``handler``, keeping the newest
+        ``size`` and at most ``max_bytes`` of them (always one); starts the thread if it is not
+        running."""
+        lane = FallbackLane(self, handler, size, max_bytes, name)
         with self._changed:
             self._lanes.add(lane)
             if self._thread is None:
@@ -107,7 +122,7 @@ class FallbackWorker:
                 self._thread.start()
         return lane
 
-    def wake(self, lane: FallbackLane) -> None:
+    def wake(self, lane: FallbackLane[Any]) -> None:
         """``lane`` holds a payload: give it a turn."""
         with self._changed:
             if lane.closed or lane.waiting:
@@ -116,7 +131,7 @@ class FallbackWorker:
             self._turns.append(lane)
             self._changed.notify()
 
-    def close(self, lane: FallbackLane) -> None:
+    def close(self, lane: FallbackLane[Any]) -> None:
         """See :meth:`FallbackLane.close`."""
         with self._changed:
             if lane.closed:
@@ -154,7 +169,7 @@ class FallbackWorker:
             else:
                 self._serve(lane)
 
-    def _serve(self, lane: FallbackLane) -> None:
+    def _serve(self, lane: FallbackLane[Any]) -> None:
         """One payload of ``lane`` to its handler; the lane's next turn if it holds more."""
         try:
             self._handle(lane)
@@ -166,7 +181,7 @@ class FallbackWorker:
                     self._turns.append(lane)
                 self._changed.notify_all()
 
-    def _handle(self, lane: FallbackLane) -> None:
+    def _handle(self, lane: FallbackLane[Any]) -> None:
         try:
             payload, info = lane.queue.get(block=False)
         except queue.Empty:  # dropped since it was woken, or its turn came twice
@@ -174,7 +189,7 @@ class FallbackWorker:
         try:
             lane.handler(payload, info)
         except Exception:  # the thread serves every channel: it must survive anything
-            _LOG.exception("%s: the Python path of a payload that fell back failed", info.topic)
+            _LOG.exception("%s: the Python path of a payload that fell back failed", lane.name)
         self._trimmer.received(len(payload))
 
 
@@ -182,3 +197,41 @@ class FallbackWorker:
 def fallback_worker() -> FallbackWorker:
     """The process's fallback thread (started at the first channel's first fallback)."""
     return FallbackWorker()
+
+
+class ChannelFallback(Generic[Info]):
+    """A channel's way to the fallback thread: its lane, made at its first payload (a channel
+    whose payloads never fall back costs no thread) and closed with the channel. :meth:`put`
+    from the loop's thread, the rest from any."""
+
+    def __init__(
+        self, handler: Callable[[bytes, Info], None], size: int, max_bytes: int, name: str
+    ) -> None:
+        self._lane: FallbackLane[Info] | None = None
+        self._made = functools.partial(fallback_worker().lane, handler, size, max_bytes, name)
+        self._closed = False
+        self._closing = threading.Lock()  # no lane is made as the channel closes
+
+    def put(self, payload: bytes, info: Info) -> None:
+        """``payload`` to the handler on the fallback thread (nothing once closed)."""
+        lane = self._lane
+        if lane is None:
+            with self._closing:
+                if self._closed:
+                    return
+                lane = self._lane = self._made()
+        lane.put(payload, info)
+
+    @property
+    def dropped(self) -> int:
+        """Payloads dropped on the way so far, oldest first."""
+        return self._lane.dropped if self._lane is not None else 0
+
+    def close(self) -> None:
+        """No more payloads to the handler, after the one it handles if it is this channel's.
+        Idempotent."""
+        with self._closing:
+            self._closed = True
+            lane = self._lane
+        if lane is not None:
+            lane.close()

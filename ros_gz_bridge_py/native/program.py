@@ -14,14 +14,13 @@ the program cannot write) makes the pair :class:`NotExpressible`: it stays on th
 from __future__ import annotations
 
 import struct
-import sys
 from array import array
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any
 
-from ros_gz_bridge_py.converters._fields import Each, Fill, Table, Value, declaration_of, same
-from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time, to_int32, to_uint32
+from ros_gz_bridge_py.converters._fields import Each, Fill, Table, Value, declaration_of
+from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time
 from ros_gz_bridge_py.converters.covariance import fill_ros_covariance
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.converters.std_msgs import (
@@ -31,38 +30,29 @@ from ros_gz_bridge_py.converters.std_msgs import (
     HEADER,
 )
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.native.words import (
+    CONV_EXACT,
+    CONV_WRAP,
+    ROS_KINDS,
+    VALUES,
+    NotExpressibleError,
+    Path,
+    descend,
+    named,
+    ros_kind,
+    split_path,
+    text_words,
+    walk,
+)
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
 # Ops (transcode.c).
 OP_END, OP_NUM, OP_CONST, OP_STR, OP_CONST_STR, OP_HEADER_STR = 0, 1, 2, 3, 4, 5
 OP_FIXED_LIST, OP_SEQ_MSG, OP_COLUMN, OP_COLUMN_STR, OP_CLOCK, OP_CONST_BLOCK = 6, 7, 8, 9, 10, 11
 OP_WALL_STAMP = 12
-CONV_EXACT, CONV_WRAP = 0, 1
-#: ROS basic types as the program numbers them, with their struct codes.
-ROS_KINDS: dict[str, tuple[int, str]] = {
-    "boolean": (1, "?"),
-    "uint8": (2, "B"),
-    "octet": (2, "B"),
-    "int8": (3, "b"),
-    "int16": (4, "h"),
-    "uint16": (5, "H"),
-    "int32": (6, "i"),
-    "uint32": (7, "I"),
-    "int64": (8, "q"),
-    "uint64": (9, "Q"),
-    "float": (10, "f"),
-    "double": (11, "d"),
-}
 _PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP = 9, 11, 12, 10
 #: Most fields a message of the schema may have (transcode.c keeps one bit per field).
 _MAX_FIELDS = 64
-
-
-class NotExpressibleError(Exception):
-    """The pair's conversion has a step a native program cannot express."""
-
-
-Path = tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -136,10 +126,6 @@ Source = Copy | HeaderText | FixedList | Sequence | Column | ClockPart | FixedTe
 Assignments = dict[Path, Source]
 
 
-def split_path(path: str) -> Path:
-    return tuple(path.split(".")) if path else ()
-
-
 def _time(ros: Path, gz: Path, out: Assignments) -> None:
     """``fill_ros_time``: both parts narrowed as C++ does."""
     out[(*ros, "sec")] = Copy((*gz, "sec"), wrap=True)
@@ -169,10 +155,6 @@ _LEAVES: dict[Callable[[Any, Any], None], Callable[[Path, Path, Assignments], No
     FRAMES.to_ros: _frames,
     fill_ros_covariance: _covariance,
 }
-#: Value functions and whether they narrow (C integer semantics) on the way.
-#: The Value functions programs express, and whether each narrows as C++ does (both
-#: directions: ``encoder.py`` reads it too).
-VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint32: True}
 
 
 def _joint_state(out: Assignments) -> None:
@@ -194,19 +176,6 @@ _WHOLE: dict[tuple[str, str], Callable[[Assignments], None]] = {
     ("ros_gz_bridge_py.converters.rosgraph_msgs", "clock_to_ros"): _clock,
     ("ros_gz_bridge_py.converters.sensor_msgs", "joint_state_to_ros"): _joint_state,
 }
-
-
-_T = TypeVar("_T")
-
-
-def named(function: Callable[..., Any], table: Mapping[tuple[str, str], _T]) -> _T | None:
-    """``table``'s entry for ``function``, keyed by its module and name (the function itself,
-    not another of the same name)."""
-    key = (getattr(function, "__module__", ""), getattr(function, "__qualname__", ""))
-    module = sys.modules.get(key[0])
-    if key not in table or getattr(module, key[1], None) is not function:
-        return None
-    return table[key]
 
 
 def assignments_of(fill: Fill, ros: Path = (), gz: Path = ()) -> Assignments:
@@ -293,65 +262,16 @@ class _Schema:
 # ---- ops -------------------------------------------------------------------------------------
 
 
-def text_words(data: bytes) -> list[int]:
-    """A byte string as words: its length, then the bytes four to a word."""
-    padded = data + bytes(-len(data) % 4)
-    return [len(data), *array("i", padded)]
-
-
 def _bits(code: str, value: Any) -> tuple[int, int]:
     raw = struct.pack(f"<{code}", value).ljust(8, b"\0")
     lo, hi = struct.unpack("<ii", raw)
     return lo, hi
 
 
-def _walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
-    """The field numbers of the submessages on ``path`` (all but the last name), and the
-    descriptor of the field the last name names."""
-    steps = []
-    for name in path[:-1]:
-        field = gz_field(descriptor, name)
-        if field.message_type is None or field.is_repeated:
-            msg = f"{descriptor.full_name}.{name} is not a singular submessage"
-            raise NotExpressibleError(msg)
-        steps.append(field.number)
-        descriptor = field.message_type
-    return steps, gz_field(descriptor, path[-1])
-
-
-def _descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
-    """The field numbers of the submessages on ``path``, and the message it reaches."""
-    if not path:
-        return [], descriptor
-    steps, field = _walk(descriptor, path)
-    if field.message_type is None or field.is_repeated:
-        msg = f"{descriptor.full_name}.{'.'.join(path)} is not a singular submessage"
-        raise NotExpressibleError(msg)
-    return [*steps, field.number], field.message_type
-
-
-def gz_field(descriptor: Any, name: str) -> Any:
-    """The field ``name`` of a protobuf message ``descriptor``."""
-    field = descriptor.fields_by_name.get(name)
-    if field is None:
-        msg = f"{descriptor.full_name} has no field {name!r}"
-        raise NotExpressibleError(msg)
-    return field
-
-
 def _scalar_field(field: Any) -> None:
     if field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP):
         msg = f"{field.full_name} is not a plain scalar"
         raise NotExpressibleError(msg)
-
-
-def ros_kind(slot: Any) -> tuple[int, str]:
-    """The program's number and the struct code of a ROS basic type."""
-    basic = cdr.basic_of(slot)
-    if basic not in ROS_KINDS:
-        msg = f"ROS type {basic or type(slot).__name__} is not written natively"
-        raise NotExpressibleError(msg)
-    return ROS_KINDS[basic]
 
 
 class _Emitter:
@@ -382,13 +302,13 @@ class _Emitter:
     def source(self, slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
         kind = type(slot).__name__
         if isinstance(source, Copy) and kind in cdr.STRING_TYPES:
-            steps, field = _walk(gz, source.gz)
+            steps, field = walk(gz, source.gz)
             if field.type != _PB_STRING or field.is_repeated:
                 msg = f"{field.full_name} is not a string"
                 raise NotExpressibleError(msg)
             return [OP_STR, len(steps), *steps, field.number]
         if isinstance(source, Copy):
-            steps, field = _walk(gz, source.gz)
+            steps, field = walk(gz, source.gz)
             _scalar_field(field)
             kind_number, code = ros_kind(slot)
             if code in "fd" and field.cpp_type not in (5, 6):  # CPPTYPE_DOUBLE, CPPTYPE_FLOAT
@@ -397,13 +317,13 @@ class _Emitter:
             conv = CONV_WRAP if source.wrap else CONV_EXACT
             return [OP_NUM, len(steps), *steps, field.number, field.type, kind_number, conv]
         if isinstance(source, HeaderText) and kind in cdr.STRING_TYPES:
-            steps, _header_type = _descend(gz, source.gz)
+            steps, _header_type = descend(gz, source.gz)
             return [
                 OP_HEADER_STR, len(steps), *steps, int(source.last),
                 *text_words(source.key.encode()), *text_words(_plain(default)),
             ]  # fmt: skip
         if isinstance(source, FixedList) and kind == "Array":
-            steps, field = _walk(gz, source.gz)
+            steps, field = walk(gz, source.gz)
             if not field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
                 msg = f"{field.full_name} is not a repeated number"
                 raise NotExpressibleError(msg)
@@ -411,7 +331,7 @@ class _Emitter:
             return [OP_FIXED_LIST, len(steps), *steps, field.number, field.type, kind_number,
                     slot.size]  # fmt: skip
         if isinstance(source, Sequence) and kind in cdr.SEQUENCE_TYPES:
-            steps, field = _walk(gz, source.gz)
+            steps, field = walk(gz, source.gz)
             element_class = cdr.nested_class(slot.value_type)
             if field.message_type is None or not field.is_repeated:
                 msg = f"{field.full_name} is not a repeated message"
@@ -422,11 +342,11 @@ class _Emitter:
             body.append(OP_END)
             return [OP_SEQ_MSG, len(steps), *steps, field.number, len(body), *body]
         if isinstance(source, Column) and kind in cdr.SEQUENCE_TYPES:
-            steps, field = _walk(gz, source.gz)
+            steps, field = walk(gz, source.gz)
             if field.message_type is None or not field.is_repeated:
                 msg = f"{field.full_name} is not a repeated message"
                 raise NotExpressibleError(msg)
-            sub_steps, sub = _walk(field.message_type, source.field)
+            sub_steps, sub = walk(field.message_type, source.field)
             head = [len(steps), *steps, field.number, len(sub_steps), *sub_steps, sub.number]
             if type(slot.value_type).__name__ in cdr.STRING_TYPES and sub.type == _PB_STRING:
                 return [OP_COLUMN_STR, *head]
@@ -434,7 +354,7 @@ class _Emitter:
             kind_number, _code = ros_kind(slot.value_type)
             return [OP_COLUMN, *head, sub.type, kind_number]
         if isinstance(source, ClockPart) and cdr.basic_of(slot) is not None:
-            steps, _time_type = _descend(gz, source.gz)
+            steps, _time_type = descend(gz, source.gz)
             return [OP_CLOCK, len(steps), *steps, source.part]
         if isinstance(source, FixedText) and kind in cdr.STRING_TYPES:
             return [OP_CONST_STR, *text_words(_plain(source.value))]

@@ -1,90 +1,49 @@
-"""The native input of one ROS -> Gazebo channel, served by the shared loop (docs/native.md §7).
+"""The native input of one ROS -> Gazebo channel, a member of the ROS -> Gazebo loop
+(docs/native.md §7).
 
 :class:`RosChannelPump` holds the C ``RosPump`` (ros_pump.c) of one channel's input: the rclpy
 subscription it takes from (on a node no executor spins, so nothing else takes its messages),
-the channel's Gazebo publisher with a PUB socket of its own (only the loop's thread sends on
-it), and the encoder of each spelling. The process's one loop (ros_loop.py) runs it; the
-pump tells that loop when the spellings Gazebo subscribers take or the bridge's own publishers
-on the topic change, and the loop's thread calls back, between C runs, to sync them, to count
-and to hand over the messages an encoder left to the Python path.
+the channel's Gazebo publisher with a PUB socket of its own, and the encoder of each spelling.
+The process's ROS -> Gazebo loop (``loop.py``) runs it; the pump asks that loop for a turn when
+the spellings Gazebo subscribers take or the bridge's own publishers on the topic change, and
+its turns, on the loop's thread, sync them, count, and hand the messages an encoder left to
+Python to the channel's Python path on the process's one fallback thread (``fallback.py``), as
+the Gazebo -> ROS channels do. The socket is used by one thread at a time: what the fallback
+thread publishes is sent through the C pump, under the loop's mutex (``ZmqPublisher.sender``).
 """
 
 from __future__ import annotations
 
 import contextlib
-import ctypes
-import functools
-import logging
 import threading
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import zmq
 
 from ros_gz_bridge_py.native import extension
-from ros_gz_bridge_py.native.pump import libzmq_path, loaded_libraries
-from ros_gz_bridge_py.native.ros_loop import shared_loop
+from ros_gz_bridge_py.native.abi import ros_functions
+from ros_gz_bridge_py.native.fallback import ChannelFallback
+from ros_gz_bridge_py.native.loop import ROS_TO_GZ, shared_loop
+from ros_gz_bridge_py.transport.delivery import Payload
 
-_LOG = logging.getLogger("ros_gz_bridge_py.native")
-
-
-@functools.cache
-def ros_functions() -> tuple[int, ...] | None:
-    """The addresses of the rcl, rmw, rcutils and libzmq functions the loop calls, or None."""
-    path, rmw = libzmq_path(), _rmw_library()
-    if path is None or rmw is None:
-        return None
-    try:
-        rcl, rcutils, libzmq = (
-            ctypes.CDLL("librcl.so"),
-            ctypes.CDLL("librcutils.so"),
-            ctypes.CDLL(path),
-        )
-        functions = (
-            rcl.rcl_take_serialized_message,
-            rcl.rcl_subscription_set_on_new_message_callback,
-            rcutils.rcutils_reset_error,
-            rcutils.rcutils_get_default_allocator,
-            rcl.rcl_publisher_get_rmw_handle,
-            rmw.rmw_get_gid_for_publisher,
-            libzmq.zmq_send,
-        )
-    except (OSError, AttributeError) as err:
-        _LOG.warning(
-            "ROS -> Gazebo channels convert in Python: rcl cannot be used from C (%s)", err
-        )
-        return None
-    addresses = tuple(ctypes.cast(function, ctypes.c_void_p).value or 0 for function in functions)
-    return addresses if all(addresses) else None
-
-
-def _rmw_library() -> Any:
-    """The loaded rmw library that has ``rmw_get_gid_for_publisher``: rmw_implementation's
-    dispatcher where rcl goes through it (a ROS install), else the implementation rcl is
-    linked with (the PyPI wheels link rmw_fastrtps_cpp)."""
-    candidates = [path for path in loaded_libraries() if "/librmw" in path]
-    candidates.sort(key=lambda path: "rmw_implementation" not in path)
-    for candidate in candidates:
-        with contextlib.suppress(OSError, AttributeError):
-            library = ctypes.CDLL(candidate)
-            library.rmw_get_gid_for_publisher  # noqa: B018 - does it have the function?
-            return library
-    _LOG.warning("ROS -> Gazebo channels convert in Python: no loaded rmw library gives GIDs")
-    return None
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.native._native import Encoder, RosPump, RosPumpCounts
 
 
 class RosChannelPump:
     """The native input of one ROS -> Gazebo channel (see the module docstring).
 
-    ``refused(cdr)``: the channel's Python path for one admitted message;
+    ``refused(cdr)``: the channel's Python path for one admitted message (on the fallback
+    thread); ``capacity`` and ``max_bytes``: the bounds of its queue there;
     ``counted(received, own_skipped, rate_limited, published, send_failures)``: what the loop
-    did since it last said; ``lost(count)``: messages for the Python path that could not be
-    copied (no memory) since it last said; ``failed(reason)``: the channel's socket failed
-    and the loop took the channel off (nothing more is taken); ``own_publishers()``: the rcl
-    publishers of the bridge on the topic, and ``watch_own_publishers(changed)`` calls
-    ``changed()`` when they change (it returns the function that stops it). The publisher's
-    ``watch_wire_types`` does the same for the spellings. Every callback runs on the loop's
-    thread. Closing the publisher (or its node) first takes the channel off the loop.
+    did since it last said; ``lost(count)``: messages for the Python path that were dropped
+    (no memory to copy them, or over the queue's bounds) since it last said;
+    ``failed(reason)``: the channel's socket failed and the loop took the channel off (nothing
+    more is taken); ``own_publishers()``: the rcl publishers of the bridge on the topic, and
+    ``watch_own_publishers(changed)`` calls ``changed()`` when they change (it returns the
+    function that stops it). The publisher's ``watch_wire_types`` does the same for the
+    spellings. Closing the publisher (or its node) first takes the channel off the loop.
     """
 
     def __init__(
@@ -92,9 +51,11 @@ class RosChannelPump:
         *,
         subscription: Any,
         publisher: Any,
-        encoders: Mapping[str, Any],
+        encoders: Mapping[str, Encoder],
         max_rate: float,
         refused: Callable[[bytes], None],
+        capacity: int,
+        max_bytes: int,
         counted: Callable[[int, int, int, int, int], None],
         lost: Callable[[int], None],
         failed: Callable[[str], None],
@@ -112,22 +73,25 @@ class RosChannelPump:
             topic, sender, _payload, type_frame = publisher.wire_frames[wire_type]
             spellings.append((type_frame, topic, sender, encoders[wire_type]))
         self.name = name
-        self._subscription = subscription
         self._publisher = publisher
-        self.pump = native.RosPump(
+        self.pump: RosPump = native.RosPump(
             functions, subscription.handle.pointer, publisher.sock.underlying, spellings, max_rate
         )
-        self._refused = refused
+        self._fallback: ChannelFallback[None] = ChannelFallback(
+            lambda cdr, _none: refused(cdr), capacity, max_bytes, name
+        )
         self._counted = counted
         self._lost = lost
         self._failed = failed
         self._own_publishers = own_publishers
-        self._seen = (0, 0, 0, 0, 0, 0)
+        self._seen = self.pump.counts()
+        self._fallback_dropped = 0
         self._active: frozenset[str] | None = None
         self._ignored: frozenset[int] | None = None
         self._closed = False
         self._close_lock = threading.Lock()
-        self._loop = shared_loop()
+        self._loop = shared_loop(ROS_TO_GZ)
+        publisher.sender = self._send
         self._unwatch = (
             publisher.watch_wire_types(self.wake),
             watch_own_publishers(self.wake),
@@ -140,9 +104,7 @@ class RosChannelPump:
         try:
             self._loop.attach(self)
         except Exception:
-            self._in_use.close()
-            for unwatch in self._unwatch:
-                unwatch()
+            self._release()
             raise
 
     def __repr__(self) -> str:
@@ -152,20 +114,26 @@ class RosChannelPump:
         """Have the loop read the spellings and own publishers again soon (any thread; quick;
         nothing after :meth:`close`)."""
         if not self._closed:
-            self._loop.wake(self)
+            self._loop.ask(self)
 
     def close(self) -> None:
-        """Take the channel off the loop and stop rcl's callback; idempotent. The
-        subscription and the publisher's socket may go after: a second caller (the channel
-        and the node's close at once) returns only when the first is done."""
+        """Take the channel off the loop and stop rcl's callback, and after the message being
+        converted, the fallback thread; idempotent. The subscription and the publisher's
+        socket may go after: a second caller (the channel and the node's close at once)
+        returns only when the first is done."""
         with self._close_lock:
             if self._closed:
                 return
             self._closed = True
-            for unwatch in self._unwatch:
-                unwatch()
             self._loop.detach(self)
-            self._in_use.close()
+            self._release()
+
+    def _release(self) -> None:
+        for unwatch in self._unwatch:
+            unwatch()
+        self._fallback.close()
+        self._publisher.sender = None
+        self._in_use.close()
 
     def sync(self) -> None:
         """Tell the C side the spellings subscribers take and the publishers to skip."""
@@ -178,27 +146,55 @@ class RosChannelPump:
             self.pump.ignore(sorted(ignored))
             self._ignored = ignored
 
-    def turn(self, refused: list[bytes], failure: int) -> None:
-        """The loop says the channel moved: the messages left to Python, the counters, and
-        the failure of its socket (an errno of libzmq, 0 if none)."""
-        for cdr in refused:
-            self._refused(cdr)
-        received, own_skipped, rate_limited, published, _take_errors, send_failures, lost = (
-            self.pump.counts()
-        )
-        now = (received, own_skipped, rate_limited, published, send_failures, lost)
-        before, self._seen = self._seen, now
-        *deltas, lost_now = (a - b for a, b in zip(now, before, strict=True))
-        if any(deltas):
-            self._counted(*deltas)
-        if lost_now:
-            self._lost(lost_now)
+    def _send(self, type_frame: bytes, payload: Payload) -> None:
+        """What the channel's Python path publishes, sent by the C pump (the fallback thread)."""
+        if not self.pump.send(type_frame, payload) and self.pump.failure:
+            self._loop.ask(self)  # its socket failed: the loop takes it off
+
+    # --- the loop's thread (loop.py LoopMember) --------------------------------------------
+
+    @property
+    def bytes_read(self) -> int:
+        """CDR bytes taken so far (``loop.py`` trims after a burst)."""
+        return self.pump.counts().bytes_read
+
+    def turn(self, *, handed: bool, monitor: bool, broken: bool) -> float | None:
+        """The messages an encoder left to Python (to the fallback thread), the counters, the
+        spellings and own publishers, and the failure of the channel's socket."""
+        del monitor, broken  # no connection monitor; a broken pump says why in `failure`
+        for cdr in self.pump.take_handed() if handed else ():
+            self._fallback.put(cdr, None)
+        self._count()
         self.sync()  # a channel that moved has subscribers: a cheap safety net for them
+        failure = self.pump.failure
         if failure:
             self._failed(
-                f"its Gazebo socket failed ({zmq.strerror(failure)}); the channel takes no "
-                "more ROS messages (restart the bridge)"
+                f"its Gazebo socket failed ({zmq.strerror(failure)}); the channel takes no more "
+                "ROS messages (restart the bridge)"
             )
             # Off the loop now; the rest when the channel closes. Not close(): a close
             # waiting for this turn on another thread holds its lock.
             self._loop.detach(self)
+        return None
+
+    def _count(self) -> None:
+        now, before = self.pump.counts(), self._seen
+        self._seen = now
+        deltas = (
+            now.received - before.received,
+            now.own_skipped - before.own_skipped,
+            now.rate_limited - before.rate_limited,
+            now.published - before.published,
+            now.send_failures - before.send_failures,
+        )
+        if any(deltas):
+            self._counted(*deltas)
+        fallback_dropped = self._fallback.dropped
+        lost = now.lost - before.lost + fallback_dropped - self._fallback_dropped
+        self._fallback_dropped = fallback_dropped
+        if lost:
+            self._lost(lost)
+
+    def counts(self) -> RosPumpCounts:
+        """The C pump's counts so far."""
+        return self.pump.counts()

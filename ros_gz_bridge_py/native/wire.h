@@ -63,6 +63,34 @@ enum { WIRE_VARINT = 0, WIRE_I64 = 1, WIRE_LEN = 2, WIRE_SGROUP = 3, WIRE_EGROUP
  * the largest it accepts (converters/_limits.py MAX_OUTPUT). */
 #define RGB_OUTPUT_MAX ((size_t)128 << 20)
 
+/* A number as Python holds it: an integer (signed, or unsigned above INT64_MAX) or a float. */
+struct rgb_number {
+    int is_float, is_unsigned;
+    int64_t i;
+    uint64_t u;
+    double d;
+};
+
+/* A float (`size` 4) or double (8) from its bits, as Python holds it. */
+static inline struct rgb_number rgb_float_bits(uint64_t bits, size_t size) {
+    struct rgb_number n = {1, 0, 0, 0, 0.0};
+    if (size == 8) {
+        memcpy(&n.d, &bits, 8);
+    } else {
+        uint32_t low = (uint32_t)bits;
+        float f;
+        memcpy(&f, &low, 4);
+        n.d = (double)f;
+    }
+    return n;
+}
+
+/* An unsigned 64-bit integer, as Python holds it. */
+static inline struct rgb_number rgb_u64(uint64_t bits) {
+    struct rgb_number n = {0, bits > INT64_MAX, (int64_t)bits, bits, 0.0};
+    return n;
+}
+
 /* The wire size of a ROS basic type (0: not one). */
 static inline size_t rgb_ros_size(int32_t kind) {
     switch (kind) {

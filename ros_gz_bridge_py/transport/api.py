@@ -154,8 +154,8 @@ RejectCallback = Callable[[Rejection, str], None]
 
 
 class NativeHost(Protocol):
-    """The reader a :class:`NativeLoop` reads for (``zmq/reader.py``): its share of the work,
-    on the loop's thread."""
+    """The reader a :class:`NativeLoop` reads for (``zmq/reader.py`` ``NativeReader``): its
+    socket owner's share of the work, on the loop's thread."""
 
     def native_turn(
         self, unrouted: list[list[Any]], *, monitor: bool, broken: bool, grown: int = 0

@@ -25,7 +25,7 @@ from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.core.bridge import BridgeOptions
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.native import extension
-from ros_gz_bridge_py.native.ros_loop import shared_loop
+from ros_gz_bridge_py.native.loop import ROS_TO_GZ, shared_loop
 from ros_gz_bridge_py.transport import GzNode, create_gz_node
 from ros_gz_bridge_py.transport.api import MessageInfo
 from testing.behaviour_harness import (
@@ -120,8 +120,8 @@ def test_thirty_channels_run_on_one_loop_thread_and_all_deliver(
     fortress = start_peer("echo", topics[0], STRING, str(WAIT * 2), "--count", "1")
     started.append(fortress)
     wait_for_line(fortress, "^READY", timeout=WAIT)
-    shared_loop()  # the loop thread, if no earlier test started it
     python_threads, threads = len(threading.enumerate()), os_threads()
+    running = shared_loop(ROS_TO_GZ).thread is not None  # an earlier bridge's
 
     for topic in topics:
         bridge.add(spec(topic))
@@ -141,11 +141,12 @@ def test_thirty_channels_run_on_one_loop_thread_and_all_deliver(
     wait_for_line(fortress, rf'^MSG {STRING} data: "{topics[0]} \d+"', timeout=WAIT)
 
     names = [thread.name for thread in threading.enumerate()]
-    assert names.count("ros-loop") == 1
+    assert names.count(ROS_TO_GZ) == 1
     assert not [name for name in names if name.startswith("ros-pub")]
-    assert len(names) <= python_threads  # none per channel
-    assert os_threads() <= threads + 2  # nothing per channel (a middleware thread may start)
-    assert shared_loop().size() >= CHANNELS
+    assert len(names) <= python_threads + 1 - running  # the loop's own, none per channel
+    # nothing per channel (the loop's own; a middleware thread may start)
+    assert os_threads() <= threads + 3 - running
+    assert shared_loop(ROS_TO_GZ).size() >= CHANNELS
     for topic in topics:
         assert all(text.startswith(f"{topic} ") for text in inboxes[topic].texts())
 
@@ -208,7 +209,7 @@ def test_an_embedder_closes_its_gz_node_while_ros_messages_flow(
     received = Received()
     gz_node.subscribe(topic, received, STRING)
     bridge.add(spec(topic))
-    attached = shared_loop().size()
+    attached = shared_loop(ROS_TO_GZ).size()
     publisher = ros_side.run(lambda: ros_side.node.create_publisher(String, topic, 1000))
     publish_until(
         lambda i: ros_side.run(lambda: publisher.publish(String(data=f"warm-up {i}"))),
@@ -227,7 +228,7 @@ def test_an_embedder_closes_its_gz_node_while_ros_messages_flow(
     try:
         wait_until(lambda: len(received) > 100, WAIT, "the flood arriving")
         embedder_gz_node.close()  # its sockets go; the loop must not send on them after
-        assert shared_loop().size() == attached - 1
+        assert shared_loop(ROS_TO_GZ).size() == attached - 1
         time.sleep(0.5)  # messages keep coming to the subscription no loop takes from now
     finally:
         stop.set()

@@ -231,8 +231,8 @@ def test_queue_drops_are_counted(make_rig: Any) -> None:
 
 def test_ros_messages_the_native_loop_could_not_copy_are_drops(rig: Rig) -> None:
     """ROS -> Gazebo, the native loop counts the messages it had no memory to copy for the
-    Python path (tests/unit/native/test_failed_copy.py) and tells the channel, whose DROPPED
-    shows them (it showed 0 for every ROS -> Gazebo channel)."""
+    Python path (tests/unit/native/test_ros_pump_failed_copy.py) and tells the channel, whose
+    DROPPED shows them (it showed 0 for every ROS -> Gazebo channel)."""
     channel = ros_to_gz(rig.add(string_spec(unique("status_lost"), Direction.ROS_TO_GZ)))
     clock = FakeClock()
     tracker = StatusTracker(rig.bridge, now=clock)

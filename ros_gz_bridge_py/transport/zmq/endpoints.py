@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.zmq.wire import Frame, PublisherRecord, encode_data
 
@@ -37,6 +38,10 @@ class ZmqPublisher(Publisher):
         self.records = records
         #: Its own PUB socket, or None (the node's).
         self.sock = sock
+        #: Where a native loop sends on that socket: how Python's sends go too, so that the
+        #: socket is used by one thread at a time (``sender(type frame, payload)``,
+        #: ``native/ros_pump.py``); None: on the socket, from the publishing thread.
+        self.sender: Callable[[Frame, Payload], object] | None = None
         self._send_queue = send_queue
         #: The data frames with an empty payload per spelling, encoded once (§2.8.2).
         self.wire_frames: dict[str, list[Frame]] = {

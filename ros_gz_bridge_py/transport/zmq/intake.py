@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING, cast
 from ros_gz_bridge_py.transport.handles import Subscription
 from ros_gz_bridge_py.transport.throttle import Throttle
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
-from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader
+from ros_gz_bridge_py.transport.zmq.reader import NativeReader, SubscriptionReader
+from ros_gz_bridge_py.transport.zmq.socket_owner import Topic
 from ros_gz_bridge_py.transport.zmq.sockets import NodeSockets
 from ros_gz_bridge_py.transport.zmq.wire import PublisherRecord
 
@@ -27,6 +28,8 @@ if TYPE_CHECKING:
     from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
+#: A queued subscription's reader, whichever drives it.
+Reader = SubscriptionReader | NativeReader
 #: Seconds between two warnings about refused messages on the shared SUB socket.
 WARN_PERIOD = 5.0
 
@@ -39,7 +42,7 @@ class DataIntake:
     ) -> None:
         self._node = node
         self._context = sockets.context
-        self.readers: list[SubscriptionReader] = []
+        self.readers: list[Reader] = []
         self.shared = SubConnections(
             sockets.sub,
             drain=drain_shared,
@@ -56,19 +59,23 @@ class DataIntake:
 
     def open_reader(
         self, sub: Subscription, size: int, on_start: Callable[[], None] | None, max_bytes: int
-    ) -> SubscriptionReader:
-        """A queued subscription's own SUB socket and thread (``reader.py``)."""
+    ) -> Reader:
+        """A queued subscription's own SUB socket, read on a thread of its own or, where a
+        native loop reads it (``sub.native``), on that loop's (``reader.py``)."""
         node = self._node
-        reader = SubscriptionReader(
-            self._context, fqn=sub.fqn, partition=node.partition, accepts=sub.accepts_from,
-            takes=sub.accepts, deliver=sub.run, reject=sub.reject, size=size,
-            settings=node.settings, count=node.count, on_start=on_start, native=sub.native,
-            max_bytes=max_bytes, large_messages=sub.large_messages,
+        topic = Topic(
+            sub.fqn, node.partition, sub.accepts_from, sub.accepts, sub.reject, node.settings,
+            node.count, max_bytes, sub.large_messages,
         )  # fmt: skip
+        reader: Reader = (
+            SubscriptionReader(self._context, topic, deliver=sub.run, size=size, on_start=on_start)
+            if sub.native is None
+            else NativeReader(self._context, topic, deliver=sub.run, size=size, native=sub.native)
+        )
         self.readers.append(reader)
         return reader
 
-    def close_reader(self, reader: SubscriptionReader) -> None:
+    def close_reader(self, reader: Reader) -> None:
         if reader in self.readers:
             self.readers.remove(reader)
 
@@ -77,7 +84,7 @@ class DataIntake:
         and each queued subscription's reader; False if the address cannot be connected."""
         for sub in subs:
             if sub.delivery is not None:
-                cast(SubscriptionReader, sub.delivery).connect(record.address)
+                cast(Reader, sub.delivery).connect(record.address)
         if any(s.delivery is None for s in subs):
             return self.shared.connect(record.address)
         return True
@@ -94,7 +101,7 @@ class DataIntake:
         for sub in self._node.subscriptions(record.topic):
             sub.forget(address)
             if sub.delivery is not None:
-                cast(SubscriptionReader, sub.delivery).leave(address)
+                cast(Reader, sub.delivery).leave(address)
         if address in self.shared.connected and not any(r.address == address for r in remaining):
             self.shared.leave(address)
 

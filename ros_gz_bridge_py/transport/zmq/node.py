@@ -31,6 +31,7 @@ import zmq
 
 from ros_gz_bridge_py.errors import RemoteProtocolError, TransportError
 from ros_gz_bridge_py.transport.api import Scope, ServiceHandler
+from ros_gz_bridge_py.transport.budget import TURN_MESSAGES
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, TransportSettings
@@ -44,11 +45,11 @@ from ros_gz_bridge_py.transport.zmq.discovery_events import (
 )
 from ros_gz_bridge_py.transport.zmq.endpoints import ZmqPublisher, ZmqServiceOffer, ZmqSubscription
 from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
-from ros_gz_bridge_py.transport.zmq.intake import DataIntake
+from ros_gz_bridge_py.transport.zmq.intake import DataIntake, Reader
 from ros_gz_bridge_py.transport.zmq.node_graph import ZmqGraphView
-from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader, receive_message
 from ros_gz_bridge_py.transport.zmq.routes import DataRouter
 from ros_gz_bridge_py.transport.zmq.services import PendingCall, RouterSockets, ServiceRouter
+from ros_gz_bridge_py.transport.zmq.socket_owner import receive_message
 from ros_gz_bridge_py.transport.zmq.sockets import open_sockets, publisher_socket
 from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket, determine_host
 from ros_gz_bridge_py.transport.zmq.wire import (
@@ -64,8 +65,6 @@ T = TypeVar("T")
 #: Poll timeout while a retry is pending, and the longest poll otherwise (§2.5: 250 ms).
 RETRY_POLL = 0.005
 MAX_POLL = 0.25
-#: Messages read from one socket per loop turn, so no socket starves the others.
-READ_BATCH = 64
 
 
 class ZmqGzNode(ZmqGraphView):
@@ -243,6 +242,9 @@ class ZmqGzNode(ZmqGraphView):
         """The four data frames on the PUB socket (§2.8.2), from the publishing thread."""
         zmq_publisher = cast(ZmqPublisher, publisher)
         topic, sender, _, type_frame = zmq_publisher.wire_frames[wire_type]
+        if zmq_publisher.sender is not None:  # a native loop's socket
+            zmq_publisher.sender(type_frame, payload)
+            return
         own = zmq_publisher.sock
         send = self._io.pub.send if own is None else own.send
         # A socket of the publisher's own is used by one thread (see advertise); the lock
@@ -261,7 +263,7 @@ class ZmqGzNode(ZmqGraphView):
 
     def _open_delivery(
         self, sub: Subscription, size: int, on_start: Callable[[], None] | None, max_bytes: int
-    ) -> SubscriptionReader:
+    ) -> Reader:
         """A queued subscription reads its topic's SUB socket on its own thread (reader.py)."""
         return self._intake.open_reader(sub, size, on_start, max_bytes)
 
@@ -288,7 +290,7 @@ class ZmqGzNode(ZmqGraphView):
 
     def _close_subscription(self, sub: Subscription, *, last: bool) -> None:
         if sub.delivery is not None:
-            self._intake.close_reader(cast(SubscriptionReader, sub.delivery))
+            self._intake.close_reader(cast(Reader, sub.delivery))
         with contextlib.suppress(TransportError):
             self._call(lambda: self._end_subscription(cast(ZmqSubscription, sub), last=last))
 
@@ -394,7 +396,7 @@ class ZmqGzNode(ZmqGraphView):
         self._services.turn(now)
 
     def _read_discovery(self, udp: DiscoverySocket, engine: DiscoveryEngine) -> None:
-        for _ in range(READ_BATCH):
+        for _ in range(TURN_MESSAGES):
             received = udp.receive()
             if received is None:
                 break
@@ -407,7 +409,7 @@ class ZmqGzNode(ZmqGraphView):
             self.subscriber_book.set_spellings(spellings.snapshot())
 
     def _read_frames(self, sock: Any, handler: Callable[[list[Frame]], None]) -> None:
-        for _ in range(READ_BATCH):
+        for _ in range(TURN_MESSAGES):
             try:
                 frames = receive_message(sock)
             except zmq.Again:

@@ -21,6 +21,7 @@ from ros_gz_bridge_py.app.settings import (
     FASTDDS_PROFILE_ENV,
     LIGHT_READ_ENV,
     MESSAGE_PATH_SWITCHES,
+    NATIVE_ENV,
     SERIALIZED_PUBLISH_ENV,
     ImageBridgeParameters,
     ParameterBridgeParameters,
@@ -45,6 +46,7 @@ OFF_SWITCHES = {
     LIGHT_READ_ENV: "light_read",
     CDR_WRITE_ENV: "cdr_write",
     DDS_EVENT_BATCH_ENV: "dds_event_batch",
+    NATIVE_ENV: "native",
 }
 #: Each choice switch, the value that chooses, and the field it sets False.
 CHOICES = {

@@ -1,5 +1,5 @@
-"""Run by test_failed_copy.py with the failing-allocation shim preloaded: a ROS -> Gazebo
-channel on its loop (test_ros_loop's channel: a real rcl subscription, real ZeroMQ sockets)
+"""Run by test_ros_pump_failed_copy.py with the failing-allocation shim preloaded: a ROS -> Gazebo
+channel on its loop (ros_pump_rig's channel: a real rcl subscription, real ZeroMQ sockets)
 takes two std_msgs/String messages the native encoder leaves to Python (data that is not
 UTF-8): one of ``argv[3]`` CDR bytes, then one 4 bytes longer; allocations of ``argv[1]``
 bytes fail while the loop handles them, but for the first ``argv[2]``. Prints, as JSON, the
@@ -16,7 +16,7 @@ from typing import Any
 
 from ros_gz_bridge_py.native import extension
 from tests.unit.native.failing_alloc import while_failing
-from tests.unit.native.test_ros_loop import WAIT, Channel
+from tests.unit.native.ros_pump_rig import BUDGET, WAIT, Channel
 
 COUNTS = ("received", "own_skipped", "rate_limited", "published", "take_errors",
           "send_failures", "lost")  # fmt: skip
@@ -38,16 +38,20 @@ def outcome(loop: Any, channel: Channel, before: tuple[int, ...]) -> dict[str, A
     while (counts["received"] < 2 or len(refused) + counts["lost"] < 2) and (
         time.monotonic() < deadline
     ):
-        try:
-            moved = loop.run(100)[1]
-        except MemoryError:
-            memory_errors += 1
-            moved = []
-        for _pump, messages, _failure in moved:
-            refused += [len(message) for message in messages]
-        now = channel.pump.counts()
+        reported = loop.run(100, [])[1]
+        for _pump, _events in reported:
+            try:
+                refused += [len(message) for message in channel.pump.take_handed()]
+            except MemoryError:
+                memory_errors += 1
+        now = _counts(channel)
         counts = {name: b - a for name, a, b in zip(COUNTS, before, now, strict=True)}
     return {"refused": refused, "counts": counts, "memory_errors": memory_errors}
+
+
+def _counts(channel: Channel) -> tuple[int, ...]:
+    counts = channel.pump.counts()
+    return tuple(getattr(counts, name) for name in COUNTS)
 
 
 def main() -> None:
@@ -60,16 +64,16 @@ def main() -> None:
     context = Context()
     rclpy.init(context=context)
     channel = Channel(native, context, f"failed_copy_{uuid.uuid4().hex[:8]}")
-    loop = native.RosLoop()
+    loop = native.Loop(*BUDGET)
     loop.add(channel.pump)
     channel.remove_from(loop)
     try:
         # sent natively; it grows the buffer the loop takes into past the sizes that follow
         channel.publisher.publish(string_cdr(size + 100, b"a"))
         deadline = time.monotonic() + WAIT
-        while channel.pump.counts()[3] < 1 and time.monotonic() < deadline:
-            loop.run(100)
-        before = channel.pump.counts()
+        while channel.pump.counts().published < 1 and time.monotonic() < deadline:
+            loop.run(100, [])
+        before = _counts(channel)
         assert before[3] == 1, before
         channel.publisher.publish(string_cdr(size, b"\xff"))
         channel.publisher.publish(string_cdr(size + 4, b"\xff"))

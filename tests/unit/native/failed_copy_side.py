@@ -1,5 +1,5 @@
-"""Run by test_failed_copy.py with the failing-allocation shim preloaded: a pump on a loop
-(test_pump_loop's rig: real ZeroMQ sockets, a real rclpy publisher) is sent payloads while the
+"""Run by test_pump_failed_copy.py with the failing-allocation shim preloaded: a pump on a loop
+(pump_rig's rig: real ZeroMQ sockets, a real rclpy publisher) is sent payloads while the
 allocations of ``argv[2]`` bytes fail; ``argv[3]`` is the payload size. ``argv[1]`` says what is
 sent: ``copy``, a payload on each of the two ways a payload goes to Python, each followed by one
 a byte longer; ``grow``, one String the program takes, whose output needs a larger buffer.
@@ -15,11 +15,13 @@ from typing import Any
 
 from ros_gz_bridge_py.native import extension
 from tests.unit.native.failing_alloc import while_failing
-from tests.unit.native.test_pump_loop import LEGIT, TOPIC, TYPE, Rig
+from tests.unit.native.pump_rig import LEGIT, TOPIC, TYPE, Rig
 
 #: A sender the pump has no route for: its frames are handed to Python to judge.
 UNKNOWN = b"unknown-sender"
 COUNTS = ("received", "rate_limited", "published", "dropped", "skipped", "lost")
+#: How each kind of hand-over is reported: the frames of an unrouted message, a refused payload.
+UNROUTED, REFUSED = 0, 1
 
 
 def string_msg(size: int, fill: bytes) -> bytes:
@@ -36,7 +38,7 @@ def outcome(rig: Rig, sent: int) -> dict[str, Any]:
     """Runs the loop until each of the ``sent`` messages was published, handed to Python or
     counted as lost (10 s at most), keeping what was handed and the MemoryErrors of
     ``take_handed``."""
-    before = rig.pump.counts()
+    before = _counts(rig)
     handed: list[dict[str, Any]] = []
     memory_errors = 0
     deadline = time.monotonic() + 10
@@ -47,24 +49,27 @@ def outcome(rig: Rig, sent: int) -> dict[str, Any]:
         _woken, reported = rig.loop.run(100, [])
         for _pump, _events in reported:
             try:
-                items = rig.pump.take_handed()
+                handover = rig.pump.take_handed()
             except MemoryError:
                 memory_errors += 1
                 continue
-            for item in items:
-                if item[0] == 0:
-                    topic, sender, payload, msg_type = item[1]
-                    assert (topic, msg_type) == (TOPIC, TYPE)
-                    status = None
-                else:
-                    _kind, sender, _type, payload, status = item
-                size = None if payload is None else len(payload)  # None: "y#" of NULL
-                handed.append(
-                    {"kind": item[0], "sender": sender.decode(), "size": size, "status": status}
-                )
-        now = rig.pump.counts()
+            for topic, sender, payload, msg_type in handover.unrouted:
+                assert (topic, msg_type) == (TOPIC, TYPE)
+                handed.append(_handed(UNROUTED, sender, payload, None))
+            for refused in handover.refused:
+                handed.append(_handed(REFUSED, refused.sender, refused.payload, refused.status))
+        now = _counts(rig)
         counts = {name: b - a for name, a, b in zip(COUNTS, before, now, strict=True)}
     return {"handed": handed, "counts": counts, "memory_errors": memory_errors}
+
+
+def _counts(rig: Rig) -> tuple[int, ...]:
+    counts = rig.pump.counts()
+    return tuple(getattr(counts, name) for name in COUNTS)
+
+
+def _handed(kind: int, sender: bytes, payload: bytes, status: int | None) -> dict[str, Any]:
+    return {"kind": kind, "sender": sender.decode(), "size": len(payload), "status": status}
 
 
 def main() -> None:

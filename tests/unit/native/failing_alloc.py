@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import json
 import os
 import shutil
 import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -16,6 +18,8 @@ from typing import Any
 import pytest
 
 ROOT = Path(__file__).resolve().parents[3]
+#: What a bytes object of n bytes asks of PyObject_Malloc beyond n (its header and final NUL).
+BYTES_OVERHEAD = 33
 SOURCE = Path(__file__).with_suffix(".c")
 
 
@@ -66,4 +70,19 @@ def while_failing(size: int, run: Callable[[], dict[str, Any]], spared: int = 0)
     finally:
         fail_size(0)
     report["failures"] = failures() - before
+    return report
+
+
+def side(script: Path, *arguments: int | str) -> dict[str, Any]:
+    """What ``script`` reports (JSON on its output), run with the shim preloaded."""
+    result = subprocess.run(
+        [sys.executable, str(script), *map(str, arguments)],
+        env=environment(),
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-3000:]
+    report: dict[str, Any] = json.loads(result.stdout)
     return report

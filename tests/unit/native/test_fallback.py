@@ -68,7 +68,7 @@ def worker() -> Iterator[FallbackWorker]:
         thread.join(WAIT)
 
 
-def _close_all(*lanes: FallbackLane) -> None:
+def _close_all(*lanes: FallbackLane[MessageInfo]) -> None:
     for lane in lanes:
         lane.close()
 
@@ -77,7 +77,7 @@ def test_every_lane_is_served_by_one_thread(worker: FallbackWorker) -> None:
     """Ten channels that fall back cost one thread, not ten (before: a thread per channel)."""
     recorder = Recorder()
     before = threading.active_count()
-    lanes = [worker.lane(recorder.handler(f"lane{i}"), 10, 1 << 20) for i in range(10)]
+    lanes = [worker.lane(recorder.handler(f"lane{i}"), 10, 1 << 20, "/fallen") for i in range(10)]
     for i, lane in enumerate(lanes):
         lane.put(b"payload %d" % i, INFO)
     handled = recorder.wait_for(10)
@@ -95,8 +95,8 @@ def test_a_flooded_lane_does_not_starve_another(worker: FallbackWorker) -> None:
     the flood's hundred queued (before: a thread per channel; one thread serving queues in
     order of arrival would make it wait for all of them)."""
     recorder = Recorder()
-    flood = worker.lane(recorder.handler("flood", gated=True), 1000, 1 << 20)
-    light = worker.lane(recorder.handler("light"), 10, 1 << 20)
+    flood = worker.lane(recorder.handler("flood", gated=True), 1000, 1 << 20, "/fallen")
+    light = worker.lane(recorder.handler("light"), 10, 1 << 20, "/fallen")
     flood.put(b"flood 0", INFO)
     assert recorder.entered.wait(WAIT)
     for i in range(1, 100):
@@ -116,9 +116,9 @@ def test_each_lane_keeps_its_own_bounds_and_counts_its_drops(worker: FallbackWor
     """While the thread is held on a payload, a lane keeps its newest ``size`` payloads and
     at most ``max_bytes`` of them; its drops are its own."""
     recorder = Recorder()
-    held = worker.lane(recorder.handler("held", gated=True), 10, 1 << 20)
-    counted = worker.lane(recorder.handler("counted"), 3, 1 << 20)
-    weighed = worker.lane(recorder.handler("weighed"), 100, 2500)
+    held = worker.lane(recorder.handler("held", gated=True), 10, 1 << 20, "/fallen")
+    counted = worker.lane(recorder.handler("counted"), 3, 1 << 20, "/fallen")
+    weighed = worker.lane(recorder.handler("weighed"), 100, 2500, "/fallen")
     held.put(b"held", INFO)
     assert recorder.entered.wait(WAIT)
     for i in range(10):
@@ -143,8 +143,8 @@ def test_closing_a_lane_waits_for_none_of_another_lanes_payloads(worker: Fallbac
     """A channel closing while the thread is held by another channel's slow conversion returns
     at once, and its queued payloads are never handled."""
     recorder = Recorder()
-    slow = worker.lane(recorder.handler("slow", gated=True), 10, 1 << 20)
-    closing = worker.lane(recorder.handler("closing"), 10, 1 << 20)
+    slow = worker.lane(recorder.handler("slow", gated=True), 10, 1 << 20, "/fallen")
+    closing = worker.lane(recorder.handler("closing"), 10, 1 << 20, "/fallen")
     slow.put(b"slow", INFO)
     assert recorder.entered.wait(WAIT)
     closing.put(b"never", INFO)
@@ -164,7 +164,7 @@ def test_closing_a_lane_waits_for_none_of_another_lanes_payloads(worker: Fallbac
 def test_closing_a_lane_waits_for_its_own_payload_being_handled(worker: FallbackWorker) -> None:
     """After close returns, no handler of the lane runs (the channel's publisher may go)."""
     recorder = Recorder()
-    lane = worker.lane(recorder.handler("lane", gated=True), 10, 1 << 20)
+    lane = worker.lane(recorder.handler("lane", gated=True), 10, 1 << 20, "/fallen")
     lane.put(b"being handled", INFO)
     lane.put(b"queued", INFO)
     assert recorder.entered.wait(WAIT)
@@ -188,7 +188,7 @@ def test_the_thread_ends_with_the_last_lane_and_comes_back_with_the_next(
     worker: FallbackWorker,
 ) -> None:
     recorder = Recorder()
-    first = worker.lane(recorder.handler("first"), 10, 1 << 20)
+    first = worker.lane(recorder.handler("first"), 10, 1 << 20, "/fallen")
     first.put(b"1", INFO)
     recorder.wait_for(1)
     thread = worker.thread
@@ -197,7 +197,7 @@ def test_the_thread_ends_with_the_last_lane_and_comes_back_with_the_next(
     thread.join(WAIT)
     assert not thread.is_alive()
     assert worker.thread is None
-    second = worker.lane(recorder.handler("second"), 10, 1 << 20)
+    second = worker.lane(recorder.handler("second"), 10, 1 << 20, "/fallen")
     second.put(b"2", INFO)
     assert [lane for lane, _payload, _thread in recorder.wait_for(2)] == ["first", "second"]
     second.close()
@@ -215,7 +215,7 @@ def test_a_handler_that_raises_leaves_the_thread_serving(
             raise RuntimeError(msg)
         record(payload, info)
 
-    lane = worker.lane(handler, 10, 1 << 20)
+    lane = worker.lane(handler, 10, 1 << 20, "/fallen")
     lane.put(b"bad", INFO)
     lane.put(b"good", INFO)
     assert [payload for _lane, payload, _thread in recorder.wait_for(1)] == [b"good"]
@@ -229,7 +229,7 @@ def test_the_thread_trims_after_a_burst_once_quiet() -> None:
     trimmed = threading.Event()
     worker = FallbackWorker(BurstTrimmer(trimmed.set, trim_after=2000), name="test-fallback")
     recorder = Recorder()
-    lane = worker.lane(recorder.handler("lane"), 10, 1 << 20)
+    lane = worker.lane(recorder.handler("lane"), 10, 1 << 20, "/fallen")
     lane.put(b"x" * 1000, INFO)
     lane.put(b"y" * 1000, INFO)
     recorder.wait_for(2)

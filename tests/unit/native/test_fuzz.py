@@ -1,8 +1,9 @@
 """The native transcoders under libFuzzer, with AddressSanitizer and UndefinedBehaviorSanitizer,
 then with MemorySanitizer.
 
-Two targets: fuzz/transcode_fuzz.c links transcode.c (Gazebo -> ROS) with every compiled
-pair's program, fuzz/encode_fuzz.c links encode.c (ROS -> Gazebo) with every compiled pair's
+Two targets: fuzz/transcode_fuzz.c links the transcoder (transcode.c, pb_read.c,
+transcode_load.c: Gazebo -> ROS) with every compiled pair's program, fuzz/encode_fuzz.c links
+the encoder (encode.c, encode_write.c, encode_load.c: ROS -> Gazebo) with every compiled pair's
 encoder, each from a header generated here (tools/native_fuzz_programs.py). Each is built with
 clang-14 into ``.build/fuzz/<target>-<sanitizer>-<hash>/``, once per hash of its sources,
 header and flags; the builds share ``FUZZ_SECONDS`` (60 by default; ``make fuzz`` and
@@ -64,12 +65,16 @@ class Target:
 
 TARGETS = {
     "transcode": Target(
-        "transcode_fuzz.c", ("transcode.c", "transcode.h", "wire.h"), "programs.h", "corpus",
-        "artifacts", 1 / 2,
+        "transcode_fuzz.c",
+        ("transcode.c", "pb_read.c", "transcode_load.c", "transcode.h", "transcode_ops.h",
+         "wire.h"),
+        "programs.h", "corpus", "artifacts", 1 / 2,
     ),
     "encode": Target(
-        "encode_fuzz.c", ("encode.c", "encode.h", "transcode.h", "wire.h"), "encoders.h",
-        "encode-corpus", "encode-artifacts", 1 / 2,
+        "encode_fuzz.c",
+        ("encode.c", "encode_write.c", "encode_load.c", "encode.h", "encode_ops.h",
+         "transcode.h", "wire.h"),
+        "encoders.h", "encode-corpus", "encode-artifacts", 1 / 2,
     ),
 }  # fmt: skip
 

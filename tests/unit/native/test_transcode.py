@@ -20,7 +20,6 @@ import collections
 import os
 import random
 from collections.abc import Iterable
-from types import ModuleType
 from typing import Any
 
 import pytest
@@ -36,7 +35,7 @@ from tests.unit.native import gz_payloads as gzp
 from tools.native_fuzz_programs import compiled_pairs, distinctive
 
 
-def require_extension() -> ModuleType:
+def require_extension() -> native.Extension:
     """The built extension; skips the module without it, fails instead under CI=true."""
     extension = native.extension()
     if extension is not None:

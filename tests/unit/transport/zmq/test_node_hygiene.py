@@ -218,7 +218,7 @@ _FQ_ABORT = """
 import sys, time, zmq
 sys.path.insert(0, {root!r})
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
-from ros_gz_bridge_py.transport.zmq.reader import receive_message
+from ros_gz_bridge_py.transport.zmq.socket_owner import receive_message
 ctx = zmq.Context()
 pub = ctx.socket(zmq.PUB); pub.bind("tcp://127.0.0.1:*")
 address = pub.getsockopt_string(zmq.LAST_ENDPOINT)

@@ -1,10 +1,11 @@
-"""The process's loop at its counts (native/loop.py, docs/native.md §5 item 7): only the
-channels that read something are asked for their bytes, and a channel's burst of large
-messages is still trimmed once it is over.
+"""A loop at its counts (native/loop.py, docs/native.md §5 item 7): only the members that read
+something are asked for their bytes, and a member's burst of large messages is still trimmed
+once it is over.
 
-A loop of its own (``SharedLoop``, with its thread), real C pumps publishing on a real rclpy
-publisher, real ZeroMQ sockets; each channel's Python share is the test's: it learns the route
-of what the loop hands back, as a reader does, and counts how often the loop asks for its bytes.
+A loop of its own (``NativeLoop``, with its thread), real C pumps publishing on a real rclpy
+publisher, real ZeroMQ sockets; each member's Python share is the test's: it learns the route
+of what the loop hands back, as a socket owner does, and counts how often the loop asks for its
+bytes.
 """
 
 from __future__ import annotations
@@ -18,9 +19,9 @@ import zmq
 
 from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.native.abi import zmq_functions
 from ros_gz_bridge_py.native.channel import program_of
-from ros_gz_bridge_py.native.loop import COUNT_EVERY, LOOP_TRIM_AFTER, SharedLoop
-from ros_gz_bridge_py.native.pump import foreign_functions
+from ros_gz_bridge_py.native.loop import COUNT_EVERY, LOOP_TRIM_AFTER, NativeLoop
 
 pytestmark = pytest.mark.ros
 
@@ -40,33 +41,34 @@ class Channel:
     def __init__(
         self, native: Any, publisher: Any, context: zmq.Context[Any], port: int, i: int
     ) -> None:
-        functions = foreign_functions()
-        assert functions is not None
+        functions = zmq_functions()
         program = program_of(default_registry().get("std_msgs/msg/String", "gz.msgs.StringMsg"))
+        assert functions is not None
+        assert program is not None
         self.topic = f"@/test@/counted_{i}".encode()
         self.pump = native.Pump(
             self.topic, functions, publisher.handle.pointer, {TYPE: program}, 1000, 0.0, 1 << 28
         )
-        self.handle = publisher.handle
-        self.handed_event = 0
         self.sub = context.socket(zmq.SUB)
         self.sub.setsockopt(zmq.SUBSCRIBE, self.topic)
         self.sub.connect(f"tcp://127.0.0.1:{port}")
+        self.pump.read_from(self.sub.underlying, 0)
         self.asked = 0  # how often the loop asked for the bytes read
         self.learned = threading.Event()
 
     @property
     def bytes_read(self) -> int:
         self.asked += 1
-        read: int = self.pump.traffic()[0]
+        read: int = self.pump.counts().bytes_read
         return read
 
-    def loop_turn(self, events: int) -> float | None:
-        """What a reader does: learn the route of every message handed back as unrouted."""
-        for item in self.pump.take_handed() if events & self.handed_event else ():
-            if item[0] == 0:
-                self.pump.learn(item[1][1], item[1][3], True)
-                self.learned.set()
+    def turn(self, *, handed: bool, monitor: bool, broken: bool) -> float | None:
+        """What a socket owner does: learn the route of every message handed back as
+        unrouted."""
+        del monitor, broken
+        for frames in self.pump.take_handed().unrouted if handed else ():
+            self.pump.learn(frames[1], frames[3], True)
+            self.learned.set()
         return None
 
 
@@ -97,7 +99,7 @@ def test_only_channels_that_read_are_counted_and_a_burst_is_trimmed(
         trims.append(time.monotonic())
         trimmed.set()
 
-    loop = SharedLoop(native, trim=trim)
+    loop = NativeLoop(native, "test-native", trim=trim)
     context: zmq.Context[Any] = zmq.Context()
     pub = context.socket(zmq.PUB)
     pub.setsockopt(zmq.SNDHWM, 0)
@@ -105,8 +107,7 @@ def test_only_channels_that_read_are_counted_and_a_burst_is_trimmed(
     channels = [Channel(native, publisher, context, port, i) for i in range(CHANNELS)]
     try:
         for channel in channels:
-            channel.handed_event = loop.handed_event
-            loop.attach(channel, channel.sub.underlying, 0, channel.handle)
+            loop.attach(channel)
         deadline = time.monotonic() + WAIT
         while not all(channel.learned.is_set() for channel in channels):
             assert time.monotonic() < deadline, "a SUB socket never connected"
@@ -123,7 +124,7 @@ def test_only_channels_that_read_are_counted_and_a_burst_is_trimmed(
         assert [channel.asked for channel in channels[1:]] == asked[1:]
         assert burst.asked > asked[0]
         assert len(trims) == 1
-        assert burst.pump.traffic()[0] >= 4 * len(LARGE)
+        assert burst.pump.counts().bytes_read >= 4 * len(LARGE)
     finally:
         for channel in channels:
             loop.detach(channel)

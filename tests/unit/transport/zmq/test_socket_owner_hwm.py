@@ -1,8 +1,9 @@
-"""The reader keeps libzmq's queue in front of its own within the bytes bound: when a payload
-is large enough that RCVHWM messages of its size would pass ``max_queued_bytes``, the SUB
-socket's RCVHWM is lowered (``hwm.py``) and its connections made anew, so that the publisher
-keeps being heard: libzmq 4.3.5 applies a lowered HWM to the open connections too, and these
-stall for good (the first test shows it on raw sockets; the reader must not be caught by it)."""
+"""A topic's socket owner (socket_owner.py) keeps libzmq's queue in front of its reader's within
+the bytes bound: when a payload is large enough that RCVHWM messages of its size would pass
+``max_queued_bytes``, the SUB socket's RCVHWM is lowered (``hwm.py``) and its connections made
+anew, so that the publisher keeps being heard: libzmq 4.3.5 applies a lowered HWM to the open
+connections too, and these stall for good (the first test shows it on raw sockets; the owner
+must not be caught by it). Driven here by a reader with its own thread."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from ros_gz_bridge_py.transport.api import MessageInfo, Rejection
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes
 from ros_gz_bridge_py.transport.zmq.reader import SubscriptionReader
+from ros_gz_bridge_py.transport.zmq.socket_owner import Topic
 
 FQN = "@/reader_hwm@/big"
 TYPE = b"gz.msgs.StringMsg"
@@ -74,20 +76,18 @@ def reader_and_pub(
     def deliver(payload: Any, _info: MessageInfo) -> None:
         delivered.append(bytes(payload))
 
-    reader = SubscriptionReader(
-        context,
-        fqn=FQN,
-        partition="reader_hwm",
+    topic = Topic(
+        FQN,
+        "reader_hwm",
         accepts=lambda _sender, _type: True,
         takes=lambda _type: True,
-        deliver=deliver,
         reject=lambda reason, detail: rejected.append((reason, detail)),
-        size=1000,
         settings=settings,
         count=lambda *_args: None,
         max_bytes=LIMIT,
         large_messages=request.param,
     )
+    reader = SubscriptionReader(context, topic, deliver=deliver, size=1000)
     reader.connect(f"tcp://127.0.0.1:{port}")
     try:
         yield reader, pub, delivered
@@ -104,10 +104,10 @@ def _rcvhwm(reader: SubscriptionReader) -> int:
     done = threading.Event()
 
     def read() -> None:
-        seen.append(int(reader._sock.getsockopt(zmq.RCVHWM)))
+        seen.append(int(reader._owner.sock.getsockopt(zmq.RCVHWM)))
         done.set()
 
-    reader._post(read)
+    reader._owner.post(read)
     assert done.wait(5)
     return seen[0]
 
@@ -130,19 +130,19 @@ def test_the_reader_lowers_its_rcvhwm_and_still_hears_the_publisher(
     assert _rcvhwm(reader) == settings.rcvhwm
     for _ in range(50):  # the connection's count of reads lags behind (see above)
         pub.send_multipart([FQN.encode(), SENDER, b"more", TYPE])
-    first = reader._sock
+    first = reader._owner.sock
     big = b"x" * 300_000
     _send_until(pub, big, delivered)
     # room for twice the payload: 10 MB / 600 kB
     assert _rcvhwm(reader) == hwm_for_bytes(2 * len(big), LIMIT, settings.rcvhwm) == 16
-    assert reader._sock is not first  # a new socket, never a lowered HWM on open connections
+    assert reader._owner.sock is not first  # a new socket, never a lowered HWM on open connections
     _send_until(pub, b"after", delivered)  # the connection made anew carries on
-    second = reader._sock
+    second = reader._owner.sock
     _send_until(pub, b"y" * 600_000, delivered)  # within the room: the same socket
-    assert reader._sock is second
+    assert reader._owner.sock is second
     _send_until(pub, b"z" * 2_000_000, delivered)
     assert _rcvhwm(reader) == 2  # as low as it goes: no more watching
-    assert reader._sock is not second
+    assert reader._owner.sock is not second
     _send_until(pub, b"last", delivered)
 
 
@@ -157,7 +157,7 @@ def test_a_reader_of_large_messages_is_sized_for_the_largest_from_the_start(
     expected = hwm_for_bytes(settings.max_message_size, LIMIT, settings.rcvhwm)
     assert expected == 2
     _send_until(pub, b"small", delivered)
-    sock = reader._sock
+    sock = reader._owner.sock
     assert _rcvhwm(reader) == expected
     _send_until(pub, b"z" * 600_000, delivered)
-    assert reader._sock is sock  # the same socket: nothing to lower
+    assert reader._owner.sock is sock  # the same socket: nothing to lower

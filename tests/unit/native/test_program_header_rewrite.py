@@ -13,7 +13,8 @@ import pytest
 
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native.program import NotExpressibleError, compile_to_ros
+from ros_gz_bridge_py.native.program import compile_to_ros
+from ros_gz_bridge_py.native.words import NotExpressibleError
 from ros_gz_bridge_py.ros.cdr_writer import writer_for
 from tools.native_fuzz_programs import distinctive
 

@@ -1,0 +1,66 @@
+/* What the ROS -> Gazebo transcoder's files share (private: encode.h is its interface): the
+ * ops of an encoder (docs/native.md §6) and the slots the read ops fill. encode.c reads the CDR
+ * message into slots, encode_write.c writes the protobuf payload from them, encode_load.c
+ * checks an encoder's words once. */
+#ifndef RGB_ENCODE_OPS_H
+#define RGB_ENCODE_OPS_H
+
+#include "encode.h"
+#include "wire.h"
+
+enum {
+    R_END = 0,
+    R_NUM = 1,
+    R_STR = 2,
+    R_ARR = 3,
+    R_SEQ_NUM = 4,
+    R_SEQ_STR = 5,
+    R_SEQ_MSG = 6,
+};
+
+enum {
+    W_END = 0,
+    W_NUM = 1,
+    W_STR = 2,
+    W_STR_REP = 3,
+    W_CONST_STR = 4,
+    W_MSG = 5,
+    W_SEQ_MSG = 6,
+    W_PACKED = 7,
+    W_SEQ_STR = 8,
+};
+
+/* Slots of one message at most (40 bytes each): beyond, Python decides. */
+#define MAX_SLOTS ((size_t)1 << 22)
+#define MAX_DEPTH 32
+
+/* A field kept for the write ops: a number's raw bits, or where the data is. */
+struct slot {
+    uint64_t bits;
+    size_t offset; /* strings, arrays, sequences: where the data starts in the CDR */
+    size_t count;  /* strings: bytes (without the NUL); arrays, sequences: elements; message
+                      sequences: elements, whose frames start at `frame` */
+    size_t frame;
+};
+
+struct reader {
+    const uint8_t *p;
+    size_t n, pos;
+    struct slot *pool;
+    size_t used, cap;
+};
+
+/* The `size` bytes at `b` as a little-endian number. */
+static inline uint64_t load(const uint8_t *b, size_t size) {
+    uint64_t bits = 0;
+    for (size_t k = 0; k < size; k++) bits |= (uint64_t)b[k] << (8 * k);
+    return bits;
+}
+
+/* Reads a CDR string at r->pos into `s` (its bytes without the NUL; s may be NULL). */
+int enc_cdr_string(struct reader *r, struct slot *s);
+/* Runs write ops [op, end) for the frame at `frame` into `out`. */
+int enc_write_message(const struct reader *r, const int32_t *op, const int32_t *end,
+                      size_t frame, struct rgb_out *out, int depth);
+
+#endif

@@ -1,0 +1,309 @@
+/* The per-message work of a native Gazebo -> ROS channel (docs/native.md §5), run by its
+ * direction's Loop (loop.c) through the hooks at the end, with the GIL released.
+ *
+ * A turn reads each message's four frames from the topic's SUB socket, keeps the newest
+ * `capacity` payloads and at most `max_bytes` of them (dropping the oldest, before any work is
+ * spent on them), applies max_rate, transcodes each payload with the program of its wire type
+ * and publishes it through rcl on the channel's publisher. No Python runs per message. What it
+ * does not decide is handed back to Python, which stays the reference (pump.c take_handed):
+ * frames of a (sender, type) it has not been told about (Python judges them and tells it with
+ * `learn`), and payloads its program does not take (Python converts them, or says why not).
+ *
+ * ZMQ_FD is edge-like: readable while libzmq has commands to process, and a recv that returns
+ * EAGAIN has processed them all. So a socket is slept on only after a read found it empty;
+ * until then the pump is `readable` and its turns ask to come again (RGB_AGAIN). The socket's
+ * own ZMQ_EVENTS is never asked: a SUB socket answers it by prefetching a message. */
+#include "_native.h"
+
+#include <errno.h>
+#include <string.h>
+
+/* rcl_serialized_message_t (its allocator left zero: rcl only reads the buffer). */
+typedef struct {
+    uint8_t *buffer;
+    size_t buffer_length;
+    size_t buffer_capacity;
+    void *allocator[5];
+} rcl_serialized;
+
+enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_FD_ = 14, ZMQ_EVENTS_ = 15 };
+
+/* ---- publication windows (the loop guard, core/loop_guard.py) ----------------------------- */
+
+uint64_t pump_begin_publication(PumpObject *self) {
+    pthread_mutex_lock(&self->lock);
+    uint64_t sequence = ++self->sequence;
+    struct window *w = &self->windows[sequence % PUMP_HISTORY];
+    w->sequence = sequence;
+    w->start = rgb_now_ns(CLOCK_REALTIME);
+    w->end = INT64_MAX;
+    pthread_mutex_unlock(&self->lock);
+    return sequence;
+}
+
+void pump_end_publication(PumpObject *self, uint64_t sequence, int ok) {
+    pthread_mutex_lock(&self->lock);
+    struct window *w = &self->windows[sequence % PUMP_HISTORY];
+    if (!ok) {
+        w->sequence = 0;
+        if (self->sequence == sequence) self->sequence--;
+    } else if (w->sequence == sequence) {
+        w->end = rgb_now_ns(CLOCK_REALTIME);
+    }
+    pthread_mutex_unlock(&self->lock);
+}
+
+/* ---- the queue and the hand-over ------------------------------------------------------------ */
+
+int pump_find_route(PumpObject *self, const uint8_t *sender, size_t sender_len,
+                    const uint8_t *type, size_t type_len) {
+    for (int i = 0; i < self->nroutes; i++) {
+        struct route *r = &self->routes[i];
+        if (r->sender_len == sender_len && r->type_len == type_len &&
+            !memcmp(r->sender, sender, sender_len) && !memcmp(r->type, type, type_len))
+            return i;
+    }
+    return -1;
+}
+
+void pump_clear_ring(PumpObject *self) {
+    while (self->count) {
+        self->f.msg_close(&self->ring[self->head].payload);
+        self->head = (self->head + 1) % self->capacity;
+        self->count--;
+    }
+    self->queued_bytes = 0;
+}
+
+void pump_clear_handover(PumpObject *self) {
+    for (size_t i = 0; i < self->nhanded; i++)
+        for (int k = 0; k < self->handover[i].nframes; k++) free(self->handover[i].data[k]);
+    self->nhanded = 0;
+    self->handed_bytes = 0;
+}
+
+/* A new entry of the hand-over (NULL, counted as lost, when memory runs out). */
+static struct handed *hand(PumpObject *self, int kind, int route, int status) {
+    if (self->nhanded == self->handed_cap) {
+        size_t cap = self->handed_cap ? self->handed_cap * 2 : 16;
+        struct handed *grown = realloc(self->handover, cap * sizeof *grown);
+        if (grown == NULL) {
+            self->lost++;
+            return NULL;
+        }
+        self->handover = grown;
+        self->handed_cap = cap;
+    }
+    struct handed *h = &self->handover[self->nhanded++];
+    memset(h, 0, sizeof *h);
+    h->kind = kind;
+    h->route = route;
+    h->status = status;
+    return h;
+}
+
+/* Hands `n` frames to Python as copies. When memory runs out nothing is handed (an empty
+ * payload would parse as a valid all-default message) and the message is counted as lost. */
+static void hand_frames(PumpObject *self, int kind, int route, int status, zmq_msg *frames,
+                        int n) {
+    struct handed *h = hand(self, kind, route, status);
+    for (int i = 0; h != NULL && i < n; i++) {
+        h->size[i] = self->f.msg_size(&frames[i]);
+        h->data[i] = rgb_copy(self->f.msg_data(&frames[i]), h->size[i]);
+        h->nframes = i + 1;
+        if (h->data[i] == NULL) {
+            for (int k = 0; k < i; k++) free(h->data[k]);
+            self->nhanded--;
+            self->lost++;
+            return;
+        }
+    }
+    for (int i = 0; h != NULL && i < n; i++) self->handed_bytes += h->size[i];
+}
+
+static void drop_oldest(PumpObject *self) {
+    struct queued *oldest = &self->ring[self->head];
+    const struct route *r = &self->routes[oldest->route];
+    self->drop_sender_len = r->sender_len < PUMP_SENDER_MAX ? r->sender_len : PUMP_SENDER_MAX;
+    memcpy(self->drop_sender, r->sender, self->drop_sender_len);
+    self->queued_bytes -= self->f.msg_size(&oldest->payload);
+    self->f.msg_close(&oldest->payload);
+    self->head = (self->head + 1) % self->capacity;
+    self->count--;
+    self->dropped++;
+}
+
+/* Queues a payload; the oldest go first, before any work on them, while the ring is full or
+ * would hold more than max_bytes (one payload is always kept, as the Python path's queue). */
+static void keep(PumpObject *self, zmq_msg *payload, int route) {
+    size_t size = self->f.msg_size(payload);
+    while (self->count && (self->count == self->capacity ||
+                           self->queued_bytes + size > self->max_bytes))
+        drop_oldest(self);
+    struct queued *slot = &self->ring[(self->head + self->count) % self->capacity];
+    memcpy(&slot->payload, payload, sizeof *payload);
+    slot->route = route;
+    self->count++;
+    self->queued_bytes += size;
+}
+
+/* ---- reading ------------------------------------------------------------------------------- */
+
+/* Reads one message: 1 when one was read, 0 when none was waiting, -1 when the socket cannot
+ * be read (its context terminated, or it is closed). */
+static int read_message(PumpObject *self) {
+    zmq_msg frames[PUMP_FRAMES];
+    int n = 0, more = 1, extra = 0;
+    while (more) {
+        zmq_msg scratch, *frame = n < PUMP_FRAMES ? &frames[n] : &scratch;
+        self->f.msg_init(frame);
+        if (self->f.msg_recv(frame, self->sock, n ? 0 : ZMQ_DONTWAIT_) < 0) {
+            int error = errno;
+            self->f.msg_close(frame);
+            if (n == 0) return error == EAGAIN || error == EINTR ? 0 : -1;
+            break; /* a later frame cannot fail once the first is read (ZeroMQ is atomic) */
+        }
+        more = self->f.msg_more(frame);
+        if (frame == &scratch) {
+            self->f.msg_close(&scratch); /* beyond the frames kept: Python sees too many */
+            extra = 1;
+        } else {
+            n++;
+        }
+    }
+    self->taken++;
+    if (n > 2) {
+        size_t size = self->f.msg_size(&frames[2]);
+        self->bytes_read += size;
+        if (size > self->watch_above && size > self->grown) self->grown = size;
+    }
+    int route = -1;
+    if (n == 4 && !extra && self->f.msg_size(&frames[0]) == self->topic_len &&
+        !memcmp(self->f.msg_data(&frames[0]), self->topic, self->topic_len)) {
+        route = pump_find_route(self, self->f.msg_data(&frames[1]), self->f.msg_size(&frames[1]),
+                                self->f.msg_data(&frames[3]), self->f.msg_size(&frames[3]));
+        if (route >= 0) self->routes[route].used = self->taken;
+    }
+    if (route >= 0 && self->routes[route].program >= 0) {
+        keep(self, &frames[2], route);
+        self->f.msg_close(&frames[0]);
+        self->f.msg_close(&frames[1]);
+        self->f.msg_close(&frames[3]);
+        return 1;
+    }
+    if (route >= 0) /* a spelling already taken from this publisher: not ours */
+        self->skipped++;
+    else
+        hand_frames(self, HANDED_UNROUTED, -1, 0, frames, n);
+    for (int i = 0; i < n; i++) self->f.msg_close(&frames[i]);
+    return 1;
+}
+
+/* ---- delivering ---------------------------------------------------------------------------- */
+
+static void deliver(PumpObject *self, struct queued *q) {
+    self->received++;
+    if (!rgb_admit(&self->next_ns, self->period_ns)) {
+        self->rate_limited++;
+        return;
+    }
+    int program = self->routes[q->route].program;
+    const uint8_t *data = self->f.msg_data(&q->payload);
+    size_t size = self->f.msg_size(&q->payload);
+    enum rgb_status status = rgb_to_cdr(self->programs[program], data, size, &self->out);
+    if (status == RGB_OK) {
+        rcl_serialized message = {self->out.data, self->out.len, self->out.cap, {0}};
+        uint64_t sequence = pump_begin_publication(self);
+        int ret = self->f.publish(self->publisher, &message, NULL);
+        pump_end_publication(self, sequence, ret == 0);
+        rgb_out_trim(&self->out); /* a large message's buffer goes back at once */
+        if (ret == 0) {
+            self->published++;
+            return;
+        }
+        self->f.reset_error();
+        status = RGB_FALLBACK; /* Python publishes it, or says why it cannot */
+    }
+    if (status != RGB_TOO_LARGE) {
+        hand_frames(self, HANDED_REFUSED, q->route, (int)status, &q->payload, 1);
+        return;
+    }
+    struct handed *h = hand(self, HANDED_TOO_LARGE, q->route, status);
+    if (h != NULL) { /* the figures Python words the refusal with */
+        h->items = self->out.refused.items;
+        h->least = self->out.refused.least;
+        h->payload_size = size;
+    }
+}
+
+/* ---- the hooks (loop.c) -------------------------------------------------------------------- */
+
+static int zmq_fd(PumpObject *self, void *sock) {
+    int fd = -1;
+    size_t size = sizeof fd;
+    return self->f.getsockopt(sock, ZMQ_FD_, &fd, &size) == 0 ? fd : -1;
+}
+
+static int descriptors(struct rgb_member *m, int fds[RGB_MAX_FDS], const char **why) {
+    PumpObject *self = RGB_OWNER(PumpObject, m);
+    fds[0] = self->sock == NULL ? -1 : zmq_fd(self, self->sock);
+    fds[1] = self->monitor == NULL ? -1 : zmq_fd(self, self->monitor);
+    if (fds[0] < 0 || (self->monitor != NULL && fds[1] < 0)) {
+        *why = "the pump's socket (read_from) or its monitor has no descriptor to poll";
+        return -1;
+    }
+    return self->monitor == NULL ? 1 : 2;
+}
+
+static int attach(struct rgb_member *m, const char **why) {
+    (void)why;
+    RGB_OWNER(PumpObject, m)->readable = 0; /* the first turn reads it */
+    return 0;
+}
+
+static void detach(struct rgb_member *m) { (void)m; }
+
+/* Whether the monitor (a PAIR socket: asking ZMQ_EVENTS prefetches nothing) has an event. */
+static int monitor_ready(PumpObject *self) {
+    int events = 0;
+    size_t size = sizeof events;
+    return self->f.getsockopt(self->monitor, ZMQ_EVENTS_, &events, &size) == 0 &&
+           (events & ZMQ_POLLIN_);
+}
+
+/* Reads until the socket is empty or the budget is spent, then delivers. The read also ends
+ * early once a payload outgrew the watched size, so the socket's owner replaces the socket
+ * before a budget more of them arrive, and once the copies handed to Python hold max_bytes, so
+ * that Python learns their route before more are copied: either used to wait for a whole budget
+ * of 32 MB messages (2 GB, the loop's other members starved meanwhile). */
+static int turn(struct rgb_member *m, unsigned fired, const struct rgb_budget *budget) {
+    PumpObject *self = RGB_OWNER(PumpObject, m);
+    int events = 0;
+    if (fired & RGB_FIRED_ERROR) return RGB_EVENT_BROKEN;
+    if ((fired & 2) && monitor_ready(self)) events |= RGB_EVENT_MONITOR;
+    if (fired & 1) self->readable = 1;
+    for (int i = 0; self->readable && i < budget->messages; i++) {
+        int read = read_message(self);
+        if (read <= 0) self->readable = 0;
+        if (read < 0) events |= RGB_EVENT_BROKEN;
+        if (self->grown || self->handed_bytes >= self->max_bytes) break;
+    }
+    int64_t slice_end = rgb_now_ns(CLOCK_MONOTONIC) + budget->slice_ns;
+    for (int i = 0; i < budget->messages && self->count; i++) {
+        struct queued *q = &self->ring[self->head];
+        self->head = (self->head + 1) % self->capacity;
+        self->count--;
+        self->queued_bytes -= self->f.msg_size(&q->payload);
+        deliver(self, q);
+        self->f.msg_close(&q->payload);
+        if (rgb_now_ns(CLOCK_MONOTONIC) >= slice_end) break;
+    }
+    if (self->nhanded || self->grown) events |= RGB_EVENT_HANDED;
+    return events | (self->readable || self->count ? RGB_AGAIN : 0);
+}
+
+static unsigned long long progress(const struct rgb_member *m) {
+    return RGB_OWNER(PumpObject, m)->taken;
+}
+
+const struct rgb_hooks rgb_pump_hooks = {descriptors, attach, detach, turn, progress};

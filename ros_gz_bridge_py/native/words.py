@@ -1,0 +1,111 @@
+"""What the two compilers of native programs share (``program.py``: Gazebo -> ROS,
+``encoder.py``: ROS -> Gazebo): the error that keeps a pair on the Python path, paths of field
+names, the numbers of ROS basic types and of narrowing, the Value functions a program
+expresses, text as words, and the protobuf fields and ROS slots they read.
+"""
+
+from __future__ import annotations
+
+import sys
+from array import array
+from collections.abc import Callable, Mapping
+from typing import Any, TypeVar
+
+from ros_gz_bridge_py.converters._fields import same
+from ros_gz_bridge_py.converters.builtin_interfaces import to_int32, to_uint32
+from ros_gz_bridge_py.ros import cdr_types as cdr
+
+#: How a number changes type: exactly (out of range: Python decides), or narrowed as C++ (wire.h).
+CONV_EXACT, CONV_WRAP = 0, 1
+#: ROS basic types as the program numbers them, with their struct codes.
+ROS_KINDS: dict[str, tuple[int, str]] = {
+    "boolean": (1, "?"),
+    "uint8": (2, "B"),
+    "octet": (2, "B"),
+    "int8": (3, "b"),
+    "int16": (4, "h"),
+    "uint16": (5, "H"),
+    "int32": (6, "i"),
+    "uint32": (7, "I"),
+    "int64": (8, "q"),
+    "uint64": (9, "Q"),
+    "float": (10, "f"),
+    "double": (11, "d"),
+}
+
+
+class NotExpressibleError(Exception):
+    """The pair's conversion has a step a native program cannot express."""
+
+
+Path = tuple[str, ...]
+
+
+def split_path(path: str) -> Path:
+    return tuple(path.split(".")) if path else ()
+
+
+#: The Value functions programs express, and whether each narrows as C++ does.
+VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint32: True}
+
+
+_T = TypeVar("_T")
+
+
+def named(function: Callable[..., Any], table: Mapping[tuple[str, str], _T]) -> _T | None:
+    """``table``'s entry for ``function``, keyed by its module and name (the function itself,
+    not another of the same name)."""
+    key = (getattr(function, "__module__", ""), getattr(function, "__qualname__", ""))
+    module = sys.modules.get(key[0])
+    if key not in table or getattr(module, key[1], None) is not function:
+        return None
+    return table[key]
+
+
+def text_words(data: bytes) -> list[int]:
+    """A byte string as words: its length, then the bytes four to a word."""
+    padded = data + bytes(-len(data) % 4)
+    return [len(data), *array("i", padded)]
+
+
+def gz_field(descriptor: Any, name: str) -> Any:
+    """The field ``name`` of a protobuf message ``descriptor``."""
+    field = descriptor.fields_by_name.get(name)
+    if field is None:
+        msg = f"{descriptor.full_name} has no field {name!r}"
+        raise NotExpressibleError(msg)
+    return field
+
+
+def walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path`` (all but the last name), and the
+    descriptor of the field the last name names."""
+    steps = []
+    for name in path[:-1]:
+        field = gz_field(descriptor, name)
+        if field.message_type is None or field.is_repeated:
+            msg = f"{descriptor.full_name}.{name} is not a singular submessage"
+            raise NotExpressibleError(msg)
+        steps.append(field.number)
+        descriptor = field.message_type
+    return steps, gz_field(descriptor, path[-1])
+
+
+def descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path``, and the message it reaches."""
+    if not path:
+        return [], descriptor
+    steps, field = walk(descriptor, path)
+    if field.message_type is None or field.is_repeated:
+        msg = f"{descriptor.full_name}.{'.'.join(path)} is not a singular submessage"
+        raise NotExpressibleError(msg)
+    return [*steps, field.number], field.message_type
+
+
+def ros_kind(slot: Any) -> tuple[int, str]:
+    """The program's number and the struct code of a ROS basic type."""
+    basic = cdr.basic_of(slot)
+    if basic not in ROS_KINDS:
+        msg = f"ROS type {basic or type(slot).__name__} is not written natively"
+        raise NotExpressibleError(msg)
+    return ROS_KINDS[basic]
