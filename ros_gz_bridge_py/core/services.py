@@ -10,9 +10,12 @@ converted, or :data:`MAX_WAITING` calls, or ``max_queued_bytes`` of them, alread
 that came back but are not converted yet (:class:`HeldBytes`); a reply that would take them
 past the budget is not kept, and its call is answered ``success=False``. The server keeps
 :data:`REQUEST_DEPTH` requests, so a burst of clients is not overwritten before it is taken.
-The C++ bridge can answer twice, never answers when Gazebo is absent, and holds a thread per
-waiting call. Keeping calls off the main executor means a slow or absent Gazebo service never
-delays topic traffic (the EventsExecutor also cannot run coroutine callbacks).
+A response for a client the middleware has not finished discovering is sent again until it goes
+out (``ros/late_responses.py``); one given up is counted as dropped and told.
+The C++ bridge can answer twice, never answers when Gazebo is absent, loses the response of a
+client discovered late, and holds a thread per waiting call. Keeping calls off the main
+executor means a slow or absent Gazebo service never delays topic traffic (the EventsExecutor
+also cannot run coroutine callbacks).
 """
 
 from __future__ import annotations
@@ -136,6 +139,10 @@ class ServiceBridge:
         #: Calls answered at once because the waiting ones held the budget.
         self.refused_over_bytes = 0
         self._refusals = Throttle(DROP_WARN_PERIOD)
+        #: Responses sent again once their client was discovered, and responses given up.
+        self.late_answers = 0
+        self.unanswered = 0
+        self._late_notes = Throttle(DROP_WARN_PERIOD)
         self._service = host.node.create_service(
             pair.ros_class,
             spec.service,
@@ -147,6 +154,7 @@ class ServiceBridge:
             ),
             callback_group=host.reentrant,
         )
+        host.late_responses.serve(self._service, self)
         #: The name ROS resolved ``spec.service`` to (rclpy's ``srv_name`` is the given one).
         self.service_name: str = host.node.resolve_service_name(spec.service)
 
@@ -242,6 +250,23 @@ class ServiceBridge:
             return self.pair.reply_to_ros(self._reply_class.FromString(reply))
         except Exception as err:
             return self._fail(f"reply not converted: {err}")
+
+    def answered_late(self, waited: float) -> None:
+        """A held response went out once its client was discovered (late_responses.py)."""
+        self.late_answers += 1
+        if self._late_notes.ready():
+            self._logger.info(
+                f"{self.describe()}: a response went out {waited:.2f} s late, when the "
+                f"middleware had discovered its client; {self.late_answers} so far"
+            )
+
+    def not_answered(self, waited: float, why: str) -> None:
+        """A held response is given up after ``waited`` seconds (late_responses.py)."""
+        self.unanswered += 1
+        self._logger.warning(
+            f"{self.describe()}: a response is given up after {waited:.1f} s: {why}; "
+            f"{self.unanswered} given up so far"
+        )
 
     def _fail(self, why: str) -> Any:
         self.failures += 1

@@ -236,7 +236,8 @@ def channel_status(channel: Channel) -> ChannelStatus:
 
 
 def service_status(service: ServiceBridge) -> ChannelStatus:
-    """A service bridge: calls are "received", answered calls "published", failures errors."""
+    """A service bridge: calls are "received", answered calls "published", failures errors,
+    responses given up for a client never discovered "dropped"."""
     return ChannelStatus(
         direction="service",
         ros_name=service.service_name,
@@ -245,9 +246,9 @@ def service_status(service: ServiceBridge) -> ChannelStatus:
         gz_type=f"{service.gz_req_type}/{service.gz_rep_type}",
         state=ChannelState.ACTIVE.value,
         received=service.calls,
-        published=service.calls - service.failures,
+        published=service.calls - service.failures - service.unanswered,
         errors=service.failures,
-        dropped=0,
+        dropped=service.unanswered,
         rate=0.0,
         new_problems=0,
         conversion_errors=service.failures,

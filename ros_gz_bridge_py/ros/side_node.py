@@ -7,6 +7,7 @@ hosts:
 
 * service bridges, whose callbacks are coroutines awaiting the Gazebo reply (up to the service
   timeout) without holding a thread or delaying any topic, in a reentrant group;
+* the retries of service responses whose client is not discovered yet (``late_responses.py``);
 * ROS -> Gazebo subscriptions that need message info to recognise the bridge's own publications
   (bidirectional topics, see ``loop_guard.py``), in the node's default mutually exclusive group
   so each topic keeps its order.
@@ -24,6 +25,8 @@ from rclpy.node import Node as RosNode
 from rclpy.parameter import Parameter
 from rclpy.task import Future
 from rclpy.type_description_service import START_TYPE_DESCRIPTION_SERVICE_PARAM
+
+from ros_gz_bridge_py.ros.late_responses import LateResponses
 
 #: The bridge's helper nodes are named ``_<bridge node>_side`` and ``_<bridge node>_native``
 #: (the node no executor spins). The leading underscore makes them hidden nodes, which ROS
@@ -77,6 +80,7 @@ class SideNode:
     def __init__(self, owner: Any) -> None:
         self.node = _helper_node(side_node_name(owner), owner)
         self.reentrant = ReentrantCallbackGroup()
+        self.late_responses = LateResponses(self.node)
         self._executor = MultiThreadedExecutor(num_threads=self.THREADS, context=owner.context)
         self._executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name="ros-gz-side", daemon=True)

@@ -317,7 +317,8 @@ def test_a_first_call_made_the_moment_the_service_is_discoverable_is_answered(
     peer = start_replier(started, service, WORLD_CONTROL)
     client = ros_side.run(lambda: ros_side.node.create_client(ControlWorld, service))
     entry = f"{service}@ros_gz_interfaces/srv/ControlWorld@{WORLD_CONTROL}@{BOOLEAN}"
-    started.append(start_bridge(entry))
+    bridge = start_bridge(entry)
+    started.append(bridge)
     try:
         deadline = time.monotonic() + WAIT
         while not client.service_is_ready():
@@ -325,7 +326,10 @@ def test_a_first_call_made_the_moment_the_service_is_discoverable_is_answered(
             time.sleep(0.001)
         future = ros_side.run(lambda: client.call_async(control_request()))
         while not future.done():
-            assert time.monotonic() < deadline + WAIT, f"no response from {service}"
+            assert time.monotonic() < deadline + WAIT, (
+                f"no response from {service}; the bridge printed:\n{bridge.output()}\n"
+                f"the Fortress service printed:\n{peer.output()}"
+            )
             time.sleep(0.01)
     finally:
         ros_side.destroy(client)

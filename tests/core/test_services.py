@@ -13,6 +13,7 @@ from collections.abc import Callable
 from typing import Any
 
 import pytest
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from ros_gz_interfaces.srv import ControlWorld, SetEntityPose
 
 from ros_gz_bridge_py.config import ServiceBridgeSpec
@@ -240,3 +241,36 @@ def test_held_bytes_always_lets_one_call_through() -> None:
     held.release(500)
     held.release(500)
     assert (held.calls, held.held) == (0, 0)
+
+
+def test_a_response_whose_client_is_never_discovered_is_given_up_and_counted(
+    rig: Rig, world: RosWorld
+) -> None:
+    """A client whose response reader the service's writer cannot match (transient_local
+    durability) still gets its request through; rmw then times out sending the response, which
+    rclpy only warns about and drops. The bridge holds it, tries again until its patience runs
+    out, then counts it as dropped (status) and says why."""
+    service = unique("never_found")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    rig.gazebo().advertise_service(
+        service, "gz.msgs.WorldControl", "gz.msgs.Boolean", Provider(GzWorldControl, GzBoolean())
+    )
+    bridge = rig.bridge.services[0]
+    late = rig.bridge._side_node().late_responses
+    late.patience = 0.5
+    unmatched = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    client = world.run(
+        lambda: world.node.create_client(ControlWorld, service, qos_profile=unmatched)
+    )
+    try:
+        future = world.run(lambda: client.call_async(control_request()))
+        wait_until(lambda: bridge.calls == 1, "the request taken by the bridge")
+        wait_until(lambda: late.held == 1, "the response held")
+        wait_until(lambda: bridge.unanswered == 1, "the response given up", timeout=WAIT)
+        assert late.held == 0
+        assert not future.done()
+    finally:
+        world.destroy(client)
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert (status.received, status.published, status.dropped) == (1, 0, 1)
+    assert bridge.late_answers == 0
