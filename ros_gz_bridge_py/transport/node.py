@@ -92,6 +92,14 @@ class GzNode(ServiceEnds, GraphView):
         self._subscriptions: dict[str, tuple[Subscription, ...]] = {}
         self._subscriptions_lock = threading.Lock()
         self.closed = False
+        self._open()
+
+    def _open(self) -> None:
+        """The backend's sockets and threads, opened last in ``__init__`` (none here).
+
+        Raises:
+            TransportError: they cannot be opened.
+        """
 
     # --- names and counters ---------------------------------------------------------------
 

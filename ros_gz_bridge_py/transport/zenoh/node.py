@@ -89,6 +89,7 @@ class ZenohGzNode(ZenohServices):
             TransportError: the Zenoh session cannot be opened (e.g. no router in client mode).
         """
         super().__init__(partition, namespace, settings)
+        self._start_services()
         if not self.partition:
             msg = (
                 "the Zenoh backend needs a non-empty partition (an empty one gives invalid "

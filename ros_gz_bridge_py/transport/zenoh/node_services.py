@@ -25,7 +25,6 @@ from ros_gz_bridge_py.msgs.names import canonical_type, same_message
 from ros_gz_bridge_py.transport.api import ONE_WAY_TYPES, ServiceCall, ServiceHandler
 from ros_gz_bridge_py.transport.handles import ServiceOffer, offer_key
 from ros_gz_bridge_py.transport.node import GzNode
-from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zenoh.endpoints import ZenohServiceOffer, undeclare
 from ros_gz_bridge_py.transport.zenoh.graph import ZenohGraph
 from ros_gz_bridge_py.transport.zenoh.keys import EntityKind, GraphToken, service_token
@@ -61,13 +60,8 @@ class ZenohServices(GzNode):
     _graph: ZenohGraph
     _thread: threading.Thread
 
-    def __init__(
-        self,
-        partition: str | None = None,
-        namespace: str = "",
-        settings: TransportSettings | None = None,
-    ) -> None:
-        super().__init__(partition, namespace, settings)
+    def _start_services(self) -> None:
+        """The service half's state (the node calls it first thing after ``GzNode``'s set-up)."""
         # Graph, offers and calls; the condition also wakes the node thread.
         self._lock = threading.Lock()
         self._calls_changed = threading.Condition(self._lock)

@@ -34,7 +34,7 @@ from ros_gz_bridge_py.transport.api import Scope, ServiceHandler
 from ros_gz_bridge_py.transport.budget import TURN_MESSAGES
 from ros_gz_bridge_py.transport.delivery import Payload
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
-from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, TransportSettings
+from ros_gz_bridge_py.transport.settings import DEFAULT_HWM
 from ros_gz_bridge_py.transport.zmq.discovery import DiscoveryEngine
 from ros_gz_bridge_py.transport.zmq.discovery_events import (
     Event,
@@ -68,22 +68,19 @@ MAX_POLL = 0.25
 
 
 class ZmqGzNode(ZmqGraphView):
-    """A Gazebo Transport node speaking the ZeroMQ protocol (gz-transport wire version 10)."""
+    """A Gazebo Transport node speaking the ZeroMQ protocol (gz-transport wire version 10).
+
+    Made as every :class:`GzNode` is; raises :class:`LocalProtocolError` for an invalid
+    partition or namespace and :class:`TransportError` when the sockets cannot be opened.
+    """
 
     subscription_class = ZmqSubscription
     call_class = PendingCall
     runs_native_loops = True
 
-    def __init__(
-        self,
-        partition: str | None = None,
-        namespace: str = "",
-        settings: TransportSettings | None = None,
-    ) -> None:
-        """Raises:
-        LocalProtocolError: the partition or namespace is invalid.
-        TransportError: the sockets cannot be opened."""
-        super().__init__(partition, namespace, settings)
+    # --- sockets and the I/O thread -------------------------------------------------------
+
+    def _open(self) -> None:
         #: The node id of the announcements of our publishers under their other spelling
         #: (gz peers keep one record per node and address, so it must differ).
         self.respelled_node_uuid = str(uuid.uuid4())
@@ -96,11 +93,6 @@ class ZmqGzNode(ZmqGraphView):
         self._spellings_version = -1
         #: Publishers with a socket of their own (a native loop may send on it).
         self._own_socket_publishers: set[ZmqPublisher] = set()
-        self._open_resources()
-
-    # --- sockets and the I/O thread -------------------------------------------------------
-
-    def _open_resources(self) -> None:
         self._io = open_sockets(self.settings, self.host, self.count)
         # Connections to publishers, and the queued subscriptions' readers (intake.py).
         self._intake = DataIntake(
