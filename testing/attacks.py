@@ -179,6 +179,8 @@ class AttackRun:
         self.outcomes: list[Outcome] = []
         self.status_table = ""
         self.resting = 0.0
+        #: The real /clock publisher's message file (removed when the run ends).
+        self.clock_file = ROOT / ".build" / f"attack-clock-{uuid.uuid4().hex[:6]}.pb"
 
     def run(self, chosen: list[Attack]) -> list[Outcome]:
         saved = dict(os.environ)
@@ -193,12 +195,13 @@ class AttackRun:
             self._status()
         finally:
             self.group.stop()
+            self.clock_file.unlink(missing_ok=True)
             os.environ.clear()
             os.environ.update(saved)
         return self.outcomes
 
     def _start(self) -> None:
-        clock_file = ROOT / ".build" / f"attack-clock-{uuid.uuid4().hex[:6]}.pb"
+        clock_file = self.clock_file
         clock_file.parent.mkdir(exist_ok=True)
         clock_file.write_bytes(message_class("gz.msgs.Clock")().SerializeToString())
         lifetime = str(int(2 * START_LIMIT + 3 * (self.seconds + self.after + 30)))
