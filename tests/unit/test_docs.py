@@ -6,6 +6,8 @@
   heading of it (``## 2.``, ``### 2.8``, ``#### 2.8.1``).
 * A bare ``§N`` (a later citation in a file that has named its page once) resolves in one of
   the pages the file names; a docs page's bare ``§N`` in the page itself.
+* Every relative link of a Markdown page (``[text](path#anchor)``, images too) names a file or
+  folder of the repository, and its anchor a heading of the page it names.
 """
 
 from __future__ import annotations
@@ -39,6 +41,10 @@ CITATION = re.compile(
 )
 SECTION_NUMBER = re.compile(r"§(\d+(?:\.\d+)*)")
 HEADING = re.compile(r"^#{1,6}\s+(\d+(?:\.\d+)*)\.?\s", re.MULTILINE)
+#: ``[text](target)`` and ``![alt](target)``; the text may run over lines.
+LINK = re.compile(r"\[[^\]]*\]\(([^()\s]+)\)")
+FENCE = re.compile(r"^ {0,3}(```|~~~).*?^ {0,3}\1", re.MULTILINE | re.DOTALL)
+CODE_SPAN = re.compile(r"`[^`\n]*`")
 
 _SKIPPED_DIRS = {
     ".git", ".venv", ".build", "build", "install", "log", "__pycache__", "node_modules",
@@ -131,4 +137,69 @@ def test_problems_are_found() -> None:
 
 def test_every_citation_is_good() -> None:
     report = [f"{name}: {problem}" for name, text in _files() for problem in _problems(name, text)]
+    assert not report, "\n".join(report)
+
+
+def _anchor(heading: str) -> str:
+    """The anchor GitHub gives a heading: lower case, punctuation but ``-`` and ``_`` dropped,
+    spaces made ``-``."""
+    text = heading.strip().lower().replace("`", "")
+    return re.sub(r"[^\w\- ]", "", text).replace(" ", "-")
+
+
+@cache
+def _anchors(path: Path) -> frozenset[str]:
+    """The anchors of a Markdown page's headings (a repeated one also as ``-1``, ``-2``...)."""
+    text = FENCE.sub("", path.read_text(encoding="utf-8"))
+    seen: dict[str, int] = {}
+    anchors = set()
+    for line in text.splitlines():
+        match = re.match(r"#{1,6}\s+(.*?)\s*#*\s*$", line)
+        if not match:
+            continue
+        anchor = _anchor(match.group(1))
+        count = seen.get(anchor, 0)
+        seen[anchor] = count + 1
+        anchors.add(anchor if count == 0 else f"{anchor}-{count}")
+    return frozenset(anchors)
+
+
+def _link_problems(name: str, text: str) -> list[str]:
+    """What is wrong with the relative links of the Markdown page ``name`` (from the root)."""
+    problems = []
+    page = ROOT / name
+    for match in LINK.finditer(CODE_SPAN.sub("", FENCE.sub("", text))):
+        target = match.group(1)
+        if re.match(r"[a-z][a-z0-9+.-]*:", target):  # https:, mailto:
+            continue
+        path_part, _, anchor = target.partition("#")
+        path = (page.parent / path_part).resolve() if path_part else page
+        if not path.exists() or ROOT not in (path, *path.parents):
+            problems.append(f"links {target}, which does not exist")
+        elif anchor and path.suffix == ".md" and anchor not in _anchors(path):
+            problems.append(f"links {target}, which has no such heading")
+    return problems
+
+
+def test_link_problems_are_found() -> None:
+    page = "docs/protocol.md"
+    assert _link_problems(page, "[a](conversions.md) [b](../README.md#the-two-commands)") == []
+    assert _link_problems(page, "[a](nowhere.md) `[x](nowhere.md)`") == [
+        "links nowhere.md, which does not exist"
+    ]
+    assert _link_problems(page, "[a](../README.md#no-such-heading)") == [
+        "links ../README.md#no-such-heading, which has no such heading"
+    ]
+    assert _anchor("Node parameters (`parameter_bridge`, node name `ros_gz_bridge`)") == (
+        "node-parameters-parameter_bridge-node-name-ros_gz_bridge"
+    )
+
+
+def test_every_relative_link_resolves() -> None:
+    report = [
+        f"{name}: {problem}"
+        for name, text in _files()
+        if name.endswith(".md")
+        for problem in _link_problems(name, text)
+    ]
     assert not report, "\n".join(report)
