@@ -197,7 +197,8 @@ IMU_HARMONIC = GzSample(
         "linear_acceleration_covariance": [float(value) for value in range(21, 30)],
     },
     harmonic_fields=(
-        # Harmonic numbering (docs/protocol.md §9.4): 4, 6, 8 are covariances, 5 and 7 vectors.
+        # Harmonic numbering (docs/protocol-lines.md §9.4): 4, 6, 8 are covariances, 5 and 7
+        # vectors.
         HarmonicField(4, "orientation_covariance", "Float_V", _float_v(list(range(1, 10)))),
         HarmonicField(5, "angular_velocity", "Vector3d", "x: 0.5 y: -1.5 z: 2.5"),
         HarmonicField(6, "angular_velocity_covariance", "Float_V", _float_v(list(range(11, 20)))),

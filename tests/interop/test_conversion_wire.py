@@ -50,7 +50,7 @@ from tests.interop.wire_runs import DELIVERY_TIMEOUT, PARALLEL, run_limited
 pytestmark = pytest.mark.peer
 
 #: The CLI publishes once, 800 ms after advertising, and exits as it does: about one message
-#: in four never reaches the wire (docs/protocol.md §2.8.7; before our subscribers stayed
+#: in four never reaches the wire (docs/protocol-zmq-data.md §2.8.7; before our subscribers stayed
 #: connected a moment after a publisher's goodbye, two in three were lost): up to 6 one-shots
 #: per case, each a fresh publisher process.
 CLI_ATTEMPTS = 6

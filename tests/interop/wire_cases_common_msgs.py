@@ -142,7 +142,8 @@ def check_imu_fortress(ros: Any) -> None:
     assert isinstance(ros, Imu)
     assert_header(ros, "imu/link")
     assert xyzw(ros.orientation) == (0.5, -0.5, 0.5, -0.5)
-    # Fortress layout: 4 is angular_velocity and 5 linear_acceleration (docs/protocol.md §9.4).
+    # Fortress layout: 4 is angular_velocity and 5 linear_acceleration (docs/protocol-lines.md
+    # §9.4).
     assert xyz(ros.angular_velocity) == (0.25, -0.125, 3.5)
     assert xyz(ros.linear_acceleration) == (0.5, 0.75, -9.81)
     # No covariances exist in the Fortress layout: all stay zero (§3.5 Imu, §1.5).

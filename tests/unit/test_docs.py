@@ -119,16 +119,23 @@ def _problems(name: str, text: str) -> list[str]:
 
 
 def test_headings_are_found() -> None:
-    assert {"1.1", "2.8.1", "2.9.3", "4.5", "5", "9", "9.4"} <= (_sections("protocol") or set())
+    assert {"1.1", "1.4", "5"} <= (_sections("protocol") or set())
+    assert {"2", "2.3.1", "2.7"} <= (_sections("protocol-zmq-discovery") or set())
+    assert {"2.8.1", "2.9.3"} <= (_sections("protocol-zmq-data") or set())
+    assert {"4", "4.5"} <= (_sections("protocol-zenoh") or set())
+    assert {"3", "9", "9.4"} <= (_sections("protocol-lines") or set())
     assert {"1.2", "3.5", "3.14", "4", "5"} <= (_sections("conversions") or set())
 
 
 def test_problems_are_found() -> None:
-    text = "see gz-transport-protocol.md §2.1 and (docs/protocol.md §2.8.1, §77) and §88"
+    text = "see gz-transport-protocol.md §2.9 and (docs/protocol-zmq-data.md §2.8.1, §77) and §88"
     assert _problems("x.py", text) == [
         "names a note: 'gz-transport-protocol.md'",
-        "cites docs/protocol.md §77, which has no such heading",
-        "cites §88, which none of docs/protocol.md has",
+        "cites docs/protocol-zmq-data.md §77, which has no such heading",
+        "cites §88, which none of docs/protocol-zmq-data.md has",
+    ]
+    assert _problems("x.py", "(docs/protocol.md §2.8.1)") == [
+        "cites docs/protocol.md §2.8.1, which has no such heading"
     ]
     assert _problems("x.py", "(§2.1)") == ["cites §2.1 without naming a docs page"]
     assert _problems("x.py", "(docs/conversions.md §3.5) and docs/conversions.md") == []
