@@ -1,6 +1,6 @@
 """The Gazebo -> ROS wire cases of std_msgs, geometry_msgs, nav_msgs, tf2_msgs, sensor_msgs and
 rosgraph_msgs: a text a real publisher sends, and the checks of the ROS message it must become
-(docs/conversions.md's sections in the headings)."""
+(the sections of docs/conversions.md and docs/conversions-per-package.md in the headings)."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ from tf2_msgs.msg import TFMessage
 
 from tests.interop.wire_case import Case, assert_header, header, octal_bytes, xyz, xyzw
 
-# --- std (§3.2) -------------------------------------------------------------------------------
+# --- std (docs/conversions-per-package.md §3.2) ---------------------------------------------------
 
 STRING_TEXT = 'wire ✓ \\"quoted\\" a::b'
 

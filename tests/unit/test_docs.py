@@ -23,13 +23,14 @@ THIS = Path(__file__).resolve()
 
 
 #: How the notes outside the repository were named. A page of ours is always written with its
-#: folder (``docs/conversions.md``), so a bare ``conversions.md`` is a note.
+#: folder (``docs/conversions.md``), so a bare ``conversions.md`` is a note; a link's target
+#: (``[docs/conversions.md](conversions.md)``, from a page of ``docs/``) is checked as a link.
 NOTE_NAMES = re.compile(
     r"shared/spec"
     r"|gz-transport-protocol\.md"
     r"|ros-gz-bridge-behaviour"
     r"|gz-msgs-versions"
-    r"|(?<![\w/.-])(?:conversions|environment|style)\.md"
+    r"|(?<![\w/.-])(?<!\]\()(?:conversions|environment|style)\.md"
     r"|behaviour spec"
     r"|conversion spec"
 )
@@ -124,7 +125,8 @@ def test_headings_are_found() -> None:
     assert {"2.8.1", "2.9.3"} <= (_sections("protocol-zmq-data") or set())
     assert {"4", "4.5"} <= (_sections("protocol-zenoh") or set())
     assert {"3", "9", "9.4"} <= (_sections("protocol-lines") or set())
-    assert {"1.2", "3.5", "3.14", "4", "5"} <= (_sections("conversions") or set())
+    assert {"1.2", "4", "5"} <= (_sections("conversions") or set())
+    assert {"3", "3.5", "3.14"} <= (_sections("conversions-per-package") or set())
 
 
 def test_problems_are_found() -> None:
@@ -138,7 +140,10 @@ def test_problems_are_found() -> None:
         "cites docs/protocol.md §2.8.1, which has no such heading"
     ]
     assert _problems("x.py", "(§2.1)") == ["cites §2.1 without naming a docs page"]
-    assert _problems("x.py", "(docs/conversions.md §3.5) and docs/conversions.md") == []
+    assert _problems("x.py", "(docs/conversions-per-package.md §3.5) and docs/conversions.md") == []
+    assert _problems("x.md", "see conversions.md, [docs/conversions.md](conversions.md)") == [
+        "names a note: 'conversions.md'"
+    ]
     assert _problems("x.py", "docs/nowhere.md") == ["cites docs/nowhere.md, which does not exist"]
 
 

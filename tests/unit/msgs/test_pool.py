@@ -15,7 +15,7 @@ from ros_gz_bridge_py.errors import UnsupportedTypeError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, known_types, message_class, regen
 
 # The gz types of the bridged pairs (docs/conversions.md §2) and of the ControlWorld
-# service (docs/conversions.md §3.14), plus the types transport and services build on.
+# service (docs/conversions-per-package.md §3.14), plus the types transport and services build on.
 BRIDGED_TYPES = (
     "Actuators",
     "Altimeter",
