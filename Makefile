@@ -67,7 +67,7 @@ test: lint typecheck unit
 demo: setup-demo
 	$(WITH_LOOPBACK) $(PY) -m ros_gz_bridge_py.demo
 
-# The benchmarks also need the `bench` extra (matplotlib, for the plots of BENCHMARKS.md).
+# The benchmarks also need the `bench` extra (matplotlib, for the plots of BENCHMARKS.md and its reports).
 $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -r <($(PY) tools/requirements.py --extras-only bench)
 	@touch $(BENCH_STAMP)

@@ -1,6 +1,6 @@
-"""What the bridge costs and how it holds up, measured and written to BENCHMARKS.md (``make
-bench``: ``run.py``) and SOAK.md (``make soak``, ``make attacks``). A module per question, each
-writing its own section:
+"""What the bridge costs and how it holds up, measured and written to BENCHMARKS.md and the
+reports it lists, ``benchmarks/reports/`` (``make bench``: ``run.py``), and SOAK.md (``make soak``,
+``make attacks``). A module per question, each writing its own report:
 
 - ``conversion``: what converting one message costs, per pair and direction, in process;
 - ``transport``: our Gazebo Transport node's throughput and latency against C++ ign-transport;
@@ -28,6 +28,6 @@ writing its own section:
 What several share is named after what it is: ``harness`` (one flow through a bridge),
 ``bridged`` (flows on either backend), ``workers`` (the endpoint processes), ``payloads`` (the
 messages), ``reference`` (the goals and the C++ figures quoted), ``tables``, ``report`` (the
-sections), ``results`` (the stored figures), ``headline`` and ``plots``. Their own tests are in
+reports), ``results`` (the stored figures), ``headline`` and ``plots``. Their own tests are in
 ``benchmarks/tests``.
 """

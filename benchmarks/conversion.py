@@ -1,8 +1,9 @@
 """Per-message conversion cost (issue 4), in this process, with the bridge's allocator tuning.
 
-Usage: ``.venv/bin/python -m benchmarks.conversion [--seconds S]``; writes the ``conversion``
-section of BENCHMARKS.md. ROS->GZ is what a channel does per message: the registry's ``to_gz``
-plus ``SerializeToString``; GZ->ROS is ``FromString`` plus ``to_ros``. rclpy's own CDR
+Usage: ``.venv/bin/python -m benchmarks.conversion [--seconds S]``; writes the report
+``benchmarks/reports/conversion.md``. ROS->GZ is what a channel does per message: the
+registry's ``to_gz`` plus ``SerializeToString``; GZ->ROS is ``FromString`` plus ``to_ros``.
+rclpy's own CDR
 (de)serialization, which ``publish`` and the subscription do on top, is shown beside it. The
 ceiling is one copy of the serialized message (``bytes(bytearray(payload))``), measured here.
 """

@@ -1,8 +1,9 @@
 """Bridge CPU per delivered message, per message type and direction, at fixed rates (issue 15).
 
-Usage: ``.venv/bin/python -m benchmarks.costs [--seconds S]``; writes the ``costs`` section of
-BENCHMARKS.md and stores its flows for the headline. Every message must arrive: histories of
-1000 messages on the ROS ends and in the bridge's channels, as ``small_messages``' paced rows.
+Usage: ``.venv/bin/python -m benchmarks.costs [--seconds S]``; writes the report
+``benchmarks/reports/costs.md`` and stores its flows for the headline. Every message must
+arrive: histories of 1000 messages on the ROS ends and in the bridge's channels, as
+``small_messages``' paced rows.
 """
 
 from __future__ import annotations

@@ -55,7 +55,7 @@ from benchmarks.fleet_goals import (
 )
 from benchmarks.fleet_ros import parts
 from benchmarks.fleet_rounds import IDLE_SETTLE, idle_round, run, schedule
-from benchmarks.report import write_section
+from benchmarks.report import link, write_section
 from benchmarks.results import store
 
 
@@ -227,7 +227,7 @@ def report(
     context = rss_context(rows)
     if context:
         lines += ["", context]
-    lines += ["", f"![fleet]({plot})"]
+    lines += ["", f"![fleet]({link(plot)})"]
     return "\n".join(lines)
 
 

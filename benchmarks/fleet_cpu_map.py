@@ -21,8 +21,9 @@ beside what plain rclpy spends on it; which of the two goes first alternates fro
 the next. Everything is read from outside the process, by thread name, ``/proc`` and perf, so
 the module runs unchanged on any arrangement of the bridge's loops. A stage's µs per message is
 its share of its role's samples times that role's µs per message in the clean window (perf's
-own cost does not enter it). The section is written beside the single-topic breakdown
-(``costs``) in BENCHMARKS.md and the figures stored in ``benchmarks/results.json``.
+own cost does not enter it). The report, ``benchmarks/reports/fleet_cpu_map.md``, is
+written beside the single-topic breakdown (``costs``) and the figures stored in
+``benchmarks/results.json``.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
-"""The section of BENCHMARKS.md that ``benchmarks.fleet_cpu_map`` writes from what it found
-(``fleet_cpu_figures.CpuMap``): the bridge's CPU per delivered message by thread, by stage, by
-cross-cut, beside the same run's rclpy ceiling, and issue 36's candidates, with the biggest
-items named."""
+"""The report that ``benchmarks.fleet_cpu_map`` writes (``benchmarks/reports/fleet_cpu_map.md``)
+from what it found (``fleet_cpu_figures.CpuMap``): the bridge's CPU per delivered message by
+thread, by stage, by cross-cut, beside the same run's rclpy ceiling, and issue 36's candidates,
+with the biggest items named."""
 
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ and the plots.
 Usage: ``.venv/bin/python -m benchmarks.headline`` (``benchmarks.run`` calls it last). It
 reads what ``sustained``, ``costs``, ``starvation`` and ``fleet`` stored in
 ``benchmarks/results.json``,
-writes the ``headline`` section at the top of BENCHMARKS.md and draws the plots it links.
+writes the headline at the top of BENCHMARKS.md and draws the plots it links.
 Each figure is shown with the commit and date of the run it came from, and each verdict is
 computed from the figure beside it when the headline is written, never stored.
 """
@@ -388,7 +388,7 @@ verdict is computed from the figure in its row when this headline is written. Th
 ros_gz_bridge cannot be built here: its figures are quoted from issue 15, which measured it
 side by side with this bridge (on this machine type, on another day, at an older commit of
 this bridge); none of them is measured by these benchmarks. Details, and every other figure,
-in the sections below.
+in the reports listed below the headline.
 
 {provenance(present)}
 
@@ -408,7 +408,7 @@ Where /clock was lost under the flood{_from(clock)}:
 {chr(10).join(notes) if notes else "- not measured yet (`benchmarks.starvation`)"}
 {cpu_text}
 A fleet as users run it (issues 28, 36){_from(fleet_run)}: every figure against the rclpy ceiling
-of the same run (details in "A fleet as users run it" below):
+of the same run (details in [its report](benchmarks/reports/fleet.md)):
 {chr(10).join(fleet_lines(fleet_run))}
 
 Measured (2 cores shared with other work: every figure is noisy, the load averages say how

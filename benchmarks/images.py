@@ -1,7 +1,7 @@
 """Large messages through the bridge (issues 5 and 6), side by side with the rclpy ceiling.
 
 Usage: ``.venv/bin/python -m benchmarks.images [--seconds S] [--no-zenoh]``; writes the
-``images`` section of BENCHMARKS.md. The ceiling is an rclpy publisher -> rclpy subscriber with
+report ``benchmarks/reports/images.md``. The ceiling is an rclpy publisher -> rclpy subscriber with
 the same settings as the bridge (Fast DDS SHM profile, EventsExecutor, allocator tuning). The
 Gazebo ends are those of ``benchmarks.harness.worker`` (the C++ Ignition Transport peer on
 ZeroMQ, Python workers on Zenoh, on explicit loopback endpoints).

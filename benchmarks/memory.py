@@ -1,7 +1,7 @@
 """The bridge's memory under a long 1080p flood, and with a ROS subscriber slower than Gazebo.
 
 Usage: ``.venv/bin/python -m benchmarks.memory [--flood-seconds S] [--slow-seconds S]``;
-writes the ``memory`` section of BENCHMARKS.md. Goals: a full-rate 1080p Gazebo -> ROS flood
+writes the report ``benchmarks/reports/memory.md``. Goals: a full-rate 1080p Gazebo -> ROS flood
 grows the bridge's RSS by < 50 MB (from a warm-up to the end), and a subscriber that takes
 longer per image than the publisher makes nothing queue without bound (RSS flat, excess dropped).
 """

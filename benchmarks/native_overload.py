@@ -23,6 +23,7 @@ from benchmarks.native_paths import (
     path_backend,
     threads_cell,
 )
+from benchmarks.report import link
 from benchmarks.small_messages import PACED_DEPTH
 from benchmarks.tables import verdict
 
@@ -231,4 +232,4 @@ def plot(points: list[Point]) -> str:
         drawn = plots.native_overload_plot(series, OVERLOAD_PNG)
     except ImportError:
         return "Plot not drawn: matplotlib is missing (`make bench` installs `.[bench]`)."
-    return f"![Odometry Gazebo -> ROS: delivered against offered, native and Python]({drawn})"
+    return f"![Odometry Gazebo -> ROS: delivered against offered, native and Python]({link(drawn)})"

@@ -1,8 +1,9 @@
 """The native data plane against the Python path, each in a bridge process of its own (issue 22).
 
 Usage: ``.venv/bin/python -m benchmarks.native_plane [--seconds S] [--workload-seconds S]
-[--workload-rounds N] [--clock-seconds S] [--rates HZ ...]``; writes the ``native_plane``
-section of BENCHMARKS.md, stores its figures and draws ``benchmarks/plots/native_overload.png``.
+[--workload-rounds N] [--clock-seconds S] [--rates HZ ...]``; writes the report
+``benchmarks/reports/native_plane.md``, stores its figures and draws
+``benchmarks/plots/native_overload.png``.
 Each phase runs with the native data plane (the default where the extension is built) and with
 ``ROS_GZ_BRIDGE_NATIVE=off`` in the bridge's environment (the Python path), a fresh bridge
 each time; the status table (SIGUSR1) says which path each channel took and what it received,
@@ -137,8 +138,8 @@ Goal (issue 22):
 ### CPU per message against the rclpy ends (issue 22's proxy)
 
 Goal: bridge CPU per message <= {GOAL_PROXY:g} x (rclpy publisher + rclpy subscriber CPU per
-message at the same rate, the same run), judged on the Gazebo -> ROS rows of the `costs`
-section (its bridge ran with the native data plane on, the default).
+message at the same rate, the same run), judged on the Gazebo -> ROS rows of the
+[`costs` report](costs.md) (its bridge ran with the native data plane on, the default).
 {chr(10).join(proxy_lines())}
 """
 

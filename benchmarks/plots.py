@@ -1,4 +1,5 @@
-"""The PNG plots of BENCHMARKS.md, drawn from ``benchmarks/results.json`` (matplotlib, Agg).
+"""The PNG plots of BENCHMARKS.md and its reports, drawn from ``benchmarks/results.json``
+(matplotlib, Agg).
 
 matplotlib comes with the ``bench`` extra (``pip install '.[bench]'``, which ``make bench``
 does); it is imported only inside the functions that draw, so nothing else needs it.

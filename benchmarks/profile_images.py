@@ -1,7 +1,7 @@
 """Where the bridge's time goes on the 1080p GZ->ROS image path (issue 5's "with a profile").
 
 Usage: ``.venv/bin/python -m benchmarks.profile_images [--seconds S] [--sample S]``; writes the
-``profile`` section of BENCHMARKS.md. It runs the images benchmark's flow "Gazebo publisher ->
+report ``benchmarks/reports/profile.md``. It runs the images benchmark's flow "Gazebo publisher ->
 parameter_bridge Image channel (ZeroMQ) -> rclpy subscriber", 1920x1080 rgb8 flat out, with the
 same helpers (``benchmarks.bridged``), and while it publishes samples the bridge process with
 ``py-spy record --nonblocking --threads`` twice at once: every busy sample, and (``--gil``) only

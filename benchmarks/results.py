@@ -20,7 +20,8 @@ from typing import Any
 from benchmarks.harness import FlowResult
 
 RESULTS = Path(__file__).resolve().parent / "results.json"
-#: The plots drawn from them, relative to the repository root (BENCHMARKS.md links them so).
+#: The plots drawn from them, relative to the repository root (BENCHMARKS.md links them so; a report
+#: in ``benchmarks/reports/`` through ``report.link``).
 SUSTAINED_PNG = "benchmarks/plots/sustained_1080p.png"
 COSTS_PNG = "benchmarks/plots/cpu_per_message.png"
 FLEET_PNG = "benchmarks/plots/fleet.png"

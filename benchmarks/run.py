@@ -1,8 +1,8 @@
-"""``make bench``: every benchmark in one go, each bounded, rewriting BENCHMARKS.md.
+"""``make bench``: every benchmark in one go, each bounded, each rewriting its report.
 
 Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
 about 30 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
-Each module writes its own section; a module that fails is reported and the others still run.
+Each module writes its own report; a module that fails is reported and the others still run.
 Last, the headline is rewritten from the figures stored by ``sustained``, ``costs`` and
 ``starvation`` (this run's, or their last run's when they were not run), and its plots drawn.
 The Gazebo ends of ZeroMQ flows are the C++ peer on the real ign-transport 11 (built on first
@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
             outcome = "done"
         except Exception:
             traceback.print_exc()
-            outcome = "**failed** (see the console output); its section is from an earlier run"
+            outcome = "**failed** (see the console output); its report is from an earlier run"
         finally:
             stop_all()
         lines.append(f"- `{name}`: {outcome} in {time.monotonic() - began:.0f} s")

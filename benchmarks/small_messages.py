@@ -1,7 +1,7 @@
 """Small messages through one channel each, both directions, beside the ceiling.
 
 Usage: ``.venv/bin/python -m benchmarks.small_messages [--seconds S] [--no-zenoh]``; writes
-the ``small_messages`` section of BENCHMARKS.md. Goal: >= 5,000 msg/s through one channel.
+the report ``benchmarks/reports/small_messages.md``. Goal: >= 5,000 msg/s through one channel.
 """
 
 from __future__ import annotations

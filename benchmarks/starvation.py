@@ -1,10 +1,10 @@
 """``/clock`` at 1 kHz while 1080p frames flood the same Gazebo process flat out (issues 3, 15).
 
-Usage: ``.venv/bin/python -m benchmarks.starvation [--seconds S]``; writes the ``starvation``
-section of BENCHMARKS.md and stores its flows for the headline. One Gazebo publisher process
-sends ``gz.msgs.Clock`` at 1 kHz and, from another thread of the same process, 1920x1080 images
-back to back (``kind-pub --flood``), as a simulator sends its clock beside a camera. Goal
-(issue 15): >= 99% of the clock messages reach the default subscriber.
+Usage: ``.venv/bin/python -m benchmarks.starvation [--seconds S]``; writes the report
+``benchmarks/reports/starvation.md`` and stores its flows for the headline. One Gazebo
+publisher process sends ``gz.msgs.Clock`` at 1 kHz and, from another thread of the same
+process, 1920x1080 images back to back (``kind-pub --flood``), as a simulator sends its clock
+beside a camera. Goal (issue 15): >= 99% of the clock messages reach the default subscriber.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 sustainable rate, beside rclpy -> rclpy at the same rates (issue 15).
 
 Usage: ``.venv/bin/python -m benchmarks.sustained [--seconds S] [--rates HZ ...]``; writes the
-``sustained`` section of BENCHMARKS.md and stores its flows for the headline and the plots.
+report ``benchmarks/reports/sustained.md`` and stores its flows for the headline and the plots.
 A rate is sustainable when >= 99% of the frames arrive with a p99 latency under 100 ms.
 """
 
@@ -26,7 +26,7 @@ from benchmarks.reference import (
     SUSTAINED_P99_MS,
     SUSTAINED_SHARE,
 )
-from benchmarks.report import write_section
+from benchmarks.report import link, write_section
 from benchmarks.results import SUSTAINED_PNG, Stored, store
 from benchmarks.tables import verdict
 
@@ -176,7 +176,7 @@ the same run, with the bridge's speed settings. A rate is **sustainable** when >
 the highest sustainable rate is the highest offered rate up to which every offered rate was.
 Bridge CPU per frame = the bridge process's CPU time over the window / the frames delivered.
 {warm_up_text(warm.hz, seconds, warm.result)}
-{GZ_ENDS} Plot: [delivered rate and p99 latency against the offered rate]({SUSTAINED_PNG}).
+{GZ_ENDS} Plot: [delivered rate and p99 latency against the offered rate]({link(SUSTAINED_PNG)}).
 
 {HEADER}
 {table}

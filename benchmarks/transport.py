@@ -1,7 +1,7 @@
 """Gazebo Transport throughput and latency: our Python node against the real C++ ign-transport 11.
 
 Usage, from the repository root: ``.venv/bin/python -m benchmarks.transport [--seconds S]``;
-it writes the ``transport`` section of BENCHMARKS.md. Every case is one publisher process and
+it writes the report ``benchmarks/reports/transport.md``. Every case is one publisher process and
 one subscriber process exchanging ``ignition.msgs.Bytes`` whose data starts with the
 CLOCK_MONOTONIC send time (ns, int64 little-endian). C++ ends are the test peer
 (``testing/peer``, modes bench-pub/bench-sub); Python ends are this module run as

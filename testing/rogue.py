@@ -126,7 +126,8 @@ class RoguePublisher:
         return False
 
     def send(self, payload: bytes | memoryview, msg_type: str | None = None) -> None:
-        """One data message of four frames (docs/protocol.md §2.8.2), payload not copied."""
+        """One data message of four frames (docs/protocol-zmq-data.md §2.8.2), payload not
+        copied."""
         self.xpub.send(self.fqn.encode(), zmq.SNDMORE)
         self.xpub.send(self.address.encode(), zmq.SNDMORE)
         self.xpub.send(payload, zmq.SNDMORE, copy=False)

@@ -1,4 +1,4 @@
-"""How BENCHMARKS.md is put together: the headline first, the other sections where they were,
+"""How the reports are put together: the headline atop BENCHMARKS.md, each other on its own page,
 what counts as a sustainable 1080p rate, and the bridge's CPU split by thread."""
 
 from __future__ import annotations
@@ -18,33 +18,48 @@ from benchmarks.sustained import highest
 
 
 @pytest.fixture
-def report_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    path = tmp_path / "BENCHMARKS.md"
-    monkeypatch.setattr(report, "REPORT", path)
+def report_files(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """A repository of its own: BENCHMARKS.md and ``benchmarks/reports/`` under ``tmp_path``."""
+    monkeypatch.setattr(report, "ROOT", tmp_path)
+    monkeypatch.setattr(report, "INDEX", tmp_path / "BENCHMARKS.md")
+    monkeypatch.setattr(report, "REPORTS", tmp_path / "benchmarks" / "reports")
     monkeypatch.setattr(report, "machine_line", lambda: "test machine")
-    return path
+    return tmp_path
 
 
-def _sections(text: str) -> list[str]:
-    return [
-        line.split()[1].split(":")[0] for line in text.splitlines() if line.endswith("begin -->")
-    ]
-
-
-def test_the_headline_goes_first_and_the_others_keep_their_places(report_file: Path) -> None:
+def test_each_report_has_its_own_page_rewritten_whole(report_files: Path) -> None:
     report.write_section("transport", "## T\n")
     report.write_section("images", "## I\n")
-    report.write_section("headline", "## H one\n", first=True)
     report.write_section("transport", "## T again\n")
-    report.write_section("headline", "## H two\n", first=True)
-    report.write_section("memory", "## M\n")
 
-    text = report_file.read_text(encoding="utf-8")
+    pages = report_files / "benchmarks" / "reports"
+    assert sorted(path.name for path in pages.iterdir()) == ["images.md", "transport.md"]
+    assert (pages / "transport.md").read_text(encoding="utf-8") == (
+        "## T again\n\n_Machine: test machine._\n"
+    )
+    assert not (report_files / "BENCHMARKS.md").exists()
+
+
+def test_the_headline_goes_first_and_the_index_below_it_is_kept(report_files: Path) -> None:
+    index = report_files / "BENCHMARKS.md"
+    index.write_text(report.TITLE + "\n## Index\n\n- [T](benchmarks/reports/transport.md)\n")
+    report.write_section("headline", "## H one\n", first=True)
+    report.write_section("headline", "## H two\n", first=True)
+
+    text = index.read_text(encoding="utf-8")
     assert text.startswith(report.TITLE + "\n<!-- headline:begin -->\n## H two\n")
-    assert _sections(text) == ["headline", "transport", "images", "memory"]
+    assert text.endswith(
+        "<!-- headline:end -->\n\n## Index\n\n- [T](benchmarks/reports/transport.md)\n"
+    )
     assert "H one" not in text
-    assert "## T again" in text
     assert "\n\n\n" not in text
+
+
+def test_a_report_links_a_plot_from_its_own_folder() -> None:
+    assert report.link("benchmarks/plots/fleet.png") == "../plots/fleet.png"
+    assert (report.REPORTS / report.link(results.FLEET_PNG)).resolve() == (
+        report.ROOT / results.FLEET_PNG
+    )
 
 
 def _flow(share: float, p99_ms: float, error: str = "") -> FlowResult:

@@ -31,7 +31,7 @@ Bridge ROS 2 and Gazebo Transport topics and services listed in node parameters
 
   {PROGRAM} --ros-args -p config_file:=<bridge.yaml> [-r __node:=<name>] [-r __ns:=<namespace>]
 
-Its parameters are parameter_bridge's (README.md, Node parameters); its node is named
+Its parameters are parameter_bridge's (docs/configuration.md, Node parameters); its node is named
 ros_gz_bridge unless renamed. Topics given as arguments are not read: list them in config_file
 (or in bridge_names / bridges.<name>.* parameters), or run parameter_bridge instead."""
 

@@ -21,7 +21,7 @@ from ros_gz_bridge_py.core.discovery_plan import BY_ROS_PUBLISHER
 from ros_gz_bridge_py.msgs.names import canonical_type
 
 #: Seconds ``--discover`` listens by default: every peer re-announces within a second, and
-#: discovery counts as complete after two (docs/protocol.md §2.5).
+#: discovery counts as complete after two (docs/protocol-zmq-discovery.md §2.5).
 DEFAULT_SECONDS = 5.0
 
 #: Comments on the QoS of some ROS types and names, written above their entries.

@@ -18,7 +18,7 @@ _ROS_INSTALL = re.compile(r"/opt/ros/([^/]+)/")
 HOW = (
     "Install the ros-jazzy-* wheels into this Python 3.11+ environment (`pip install '.[ros]'`) "
     "in a shell where no other ROS distribution is sourced, or source a ROS 2 Jazzy install "
-    "(README.md, Install, Which ROS)."
+    "(docs/which-ros.md)."
 )
 
 

@@ -5,7 +5,7 @@
 ``gz_version`` parameter. Their node parameters are declared here too, the ones they share
 (:class:`SharedParameters`) with one name, type and default. The executables then hand the
 library :class:`~ros_gz_bridge_py.core.bridge.Bridge` its :class:`BridgeOptions` and the runtime
-helpers plain arguments (README: "Node parameters", "Speed settings and switches").
+helpers plain arguments (docs/configuration.md: "Node parameters", "Speed settings and switches").
 
 One rule per kind of value: a switch is off when set to ``off``, ``0``, ``false`` or ``no``; a
 choice compares its value case-blind; an integer that is not one is reported (variable, value,
@@ -205,7 +205,7 @@ class ParameterBridgeParameters:
     #: Ours: seconds between two /diagnostics status messages (0 = none). Any type may be
     #: given; ``start_diagnostics`` takes an int or a float and reports anything else.
     status_period: object = 0.0
-    #: Ours: bridge every Gazebo topic discovery shows (README, "Discovered bridging").
+    #: Ours: bridge every Gazebo topic discovery shows (docs/many-topics.md, "Discovered bridging").
     auto_bridge: bool = False
     #: Ours: regular expressions on Gazebo names: only matching topics are auto-bridged
     #: (empty: all), and none that ``auto_bridge_deny`` matches (string arrays).

@@ -1,6 +1,6 @@
 """The ``gz_version`` setting: which Gazebo line the simulator is, when the user says so.
 
-The bridge meets every line on its own terms without being told (docs/protocol.md §9), with
+The bridge meets every line on its own terms without being told (docs/protocol-lines.md §9), with
 one exception it cannot detect: Garden sends ``gz.msgs.IMU`` in the Fortress layout and, like
 Fortress, announces no record in its heartbeats. ``gz_version:=garden`` (or ``GZ_VERSION=garden``,
 the variable ros_gz builds with) says so. The other names are accepted and change nothing.

@@ -49,9 +49,9 @@ _NOT_IN_ROS_NAMES = re.compile(r"[^A-Za-z0-9_]")
 
 
 def ros_name_for_gz(gz_topic: str) -> str:
-    """The ROS topic name discovered bridging gives a Gazebo topic (README, "Discovered
-    bridging"): ``::`` (Gazebo's scope separator) becomes ``/``; every other character that
-    ROS names do not allow (``-``, ``.``, ``:``, ...) becomes ``_``; a token that starts with
+    """The ROS topic name discovered bridging gives a Gazebo topic (docs/many-topics.md,
+    "Discovered bridging"): ``::`` (Gazebo's scope separator) becomes ``/``; every other character
+    that ROS names do not allow (``-``, ``.``, ``:``, ...) becomes ``_``; a token that starts with
     a digit gets a leading ``_``; empty tokens go. A leading ``/`` is kept; "" when nothing
     is left.
 

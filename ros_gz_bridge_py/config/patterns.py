@@ -3,7 +3,7 @@
 A YAML entry whose Gazebo name holds a wildcard, or that leaves out a type, is a
 :class:`TopicPattern` instead of a :class:`~ros_gz_bridge_py.config.model.TopicBridgeSpec`:
 the running bridge makes one bridge per Gazebo topic of the partition that matches it, as
-such topics appear, with the type discovery shows (README, "Templates and wildcards").
+such topics appear, with the type discovery shows (docs/many-topics.md, "Templates and wildcards").
 
 Wildcards: ``*`` stands for one or more characters within one name token (no ``/``), ``**``
 for one or more whole tokens. A ROS name may repeat the wildcards of the Gazebo name, in the

@@ -1,4 +1,4 @@
-"""actuator_msgs/msg/Actuators <-> gz.msgs.Actuators (docs/conversions.md §3.10).
+"""actuator_msgs/msg/Actuators <-> gz.msgs.Actuators (docs/conversions-per-package.md §3.10).
 
 The three float64 lists are copied whole, in order, with their lengths.
 """

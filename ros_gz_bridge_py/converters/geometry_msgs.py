@@ -1,4 +1,5 @@
-"""geometry_msgs pairs (docs/conversions.md §1.4, §1.5, §3.3) and the fill helpers they share.
+"""geometry_msgs pairs (docs/conversions.md §1.4, §1.5; docs/conversions-per-package.md §3.3)
+and the fill helpers they share.
 
 The :class:`~ros_gz_bridge_py.converters._fields.Fill` constants (``VECTOR3``, ``POSE``,
 ``TWIST``, ...) write a source message into an existing target, both ways, so composite

@@ -1,4 +1,4 @@
-"""gps_msgs/msg/GPSFix <-> gz.msgs.NavSat (docs/conversions.md §3.6).
+"""gps_msgs/msg/GPSFix <-> gz.msgs.NavSat (docs/conversions-per-package.md §3.6).
 
 ``track`` is read and written as radians counter-clockwise from East, as the reference does,
 although the ``.msg`` documents degrees from North. Only position, speed, track and climb

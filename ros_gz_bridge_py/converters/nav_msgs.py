@@ -1,5 +1,5 @@
 """nav_msgs/msg/Odometry <-> gz.msgs.Odometry (default) and gz.msgs.OdometryWithCovariance
-(docs/conversions.md §3.4).
+(docs/conversions-per-package.md §3.4).
 
 With gz.msgs.Odometry both ROS covariances are dropped (R→G) and left zero (G→R).
 """

@@ -1,4 +1,4 @@
-"""rcl_interfaces/msg/ParameterValue <-> gz.msgs.Any (docs/conversions.md §3.12).
+"""rcl_interfaces/msg/ParameterValue <-> gz.msgs.Any (docs/conversions-per-package.md §3.12).
 
 Only the scalar kinds cross: bool, integer (clamped to int32 on the way to Gazebo), double and
 string. The oneof member is always set explicitly, so ``false``/``0``/``""`` still serialize.

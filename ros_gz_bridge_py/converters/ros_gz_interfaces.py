@@ -1,4 +1,5 @@
-"""ros_gz_interfaces: the message pairs (docs/conversions.md §3.13) and the four bridged services.
+"""ros_gz_interfaces: the message pairs (docs/conversions-per-package.md §3.13) and the four bridged
+services.
 
 The message conversions are in ``ros_gz_interfaces_messages``, AirSpeed and LogicalCameraImage
 in ``ros_gz_interfaces_sensors``. The services (§3.14, plus the

@@ -1,4 +1,4 @@
-"""Converters for the ros_gz_interfaces messages (docs/conversions.md §3.13).
+"""Converters for the ros_gz_interfaces messages (docs/conversions-per-package.md §3.13).
 
 The pair table and the services live in ``ros_gz_interfaces``; this module holds the
 conversions, each declared once for both directions where it is a list of fields, and the
@@ -13,8 +13,8 @@ Differences from ros_gz_bridge:
   reference, but without printing an error; so does an unparsable Dataframe ``rssi`` entry,
   which keeps the previous value.
 - WorldStatistics and LogPlaybackStatistics are converted field by field by name (times
-  copied as in §1.2), as ros_gz PR #841 describes them; its converter code was not available
-  to compare with. R→G always sends every Time submessage, even a zero one.
+  copied as in docs/conversions.md §1.2), as ros_gz PR #841 describes them; its converter code was
+  not available to compare with. R→G always sends every Time submessage, even a zero one.
 """
 
 from __future__ import annotations

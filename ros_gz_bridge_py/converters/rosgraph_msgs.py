@@ -1,4 +1,5 @@
-"""rosgraph_msgs/msg/Clock <-> gz.msgs.Clock (docs/conversions.md §3.8). Only ``sim`` is used.
+"""rosgraph_msgs/msg/Clock <-> gz.msgs.Clock (docs/conversions-per-package.md §3.8). Only ``sim`` is
+used.
 
 G→R normalises like ``rclcpp::Time``: nanoseconds of 10^9 or more carry into seconds.
 

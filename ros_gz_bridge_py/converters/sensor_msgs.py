@@ -1,8 +1,8 @@
-"""sensor_msgs pairs (docs/conversions.md §3.5); Image/CameraInfo and LaserScan/Range/PointCloud2
-live in sensor_msgs_image.py and sensor_msgs_scan.py, NavSatFix <-> NavSatWithCovariance (Jetty,
-not in the C++ bridge) in sensor_msgs_navsat.py.
+"""sensor_msgs pairs (docs/conversions-per-package.md §3.5); Image/CameraInfo and
+LaserScan/Range/PointCloud2 live in sensor_msgs_image.py and sensor_msgs_scan.py, NavSatFix <->
+NavSatWithCovariance (Jetty, not in the C++ bridge) in sensor_msgs_navsat.py.
 
-``sensor_msgs/msg/Imu`` has two Gazebo layouts (docs/protocol.md §9.4): ``gz.msgs.IMU`` is the
+``sensor_msgs/msg/Imu`` has two Gazebo layouts (docs/protocol-lines.md §9.4): ``gz.msgs.IMU`` is the
 Harmonic layout with covariances; ``ignition.msgs.IMU`` is the Fortress layout, whose field
 numbers differ and which has no covariances (G→R leaves them zero).
 

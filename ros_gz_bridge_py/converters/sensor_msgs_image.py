@@ -1,4 +1,5 @@
-"""sensor_msgs Image and CameraInfo converters (docs/conversions.md §3.5); paired in sensor_msgs.py.
+"""sensor_msgs Image and CameraInfo converters (docs/conversions-per-package.md §3.5); paired in
+sensor_msgs.py.
 
 Image data is copied once, as ``bytes``; on the bulk path (``IMAGE_BULK``) the channel converts
 only the other fields with the ``*_meta_*`` halves and copies the data once into the output.

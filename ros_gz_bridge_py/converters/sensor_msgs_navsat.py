@@ -1,7 +1,8 @@
 """sensor_msgs/msg/NavSatFix <-> gz.msgs.NavSatWithCovariance (Jetty, gz-msgs 12).
 
-ros_gz_bridge has no such pair; this one extends its NavSat conversion (docs/conversions.md §3.5,
-``sensor_msgs.py``) with the position covariance that NavSatFix can carry:
+ros_gz_bridge has no such pair; this one extends its NavSat conversion
+(docs/conversions-per-package.md §3.5, ``sensor_msgs.py``) with the position covariance that
+NavSatFix can carry:
 
 - Position, header and frame_id as for ``gz.msgs.NavSat``: G→R takes ``header.frame_id`` from
   gz ``frame_id`` (``::`` -> ``/``) and sets ``status.status`` to STATUS_FIX; R→G sends the ROS

@@ -1,4 +1,4 @@
-"""sensor_msgs LaserScan, Range and PointCloud2 converters (docs/conversions.md §3.5).
+"""sensor_msgs LaserScan, Range and PointCloud2 converters (docs/conversions-per-package.md §3.5).
 
 Paired in sensor_msgs.py. ``sensor_msgs/msg/Range`` <-> ``gz.msgs.LaserScan`` follows
 ros_gz PR #736 in spirit (a narrow Gazebo lidar used as a range finder); its upstream source

@@ -1,4 +1,5 @@
-"""std_msgs pairs (docs/conversions.md §3.2) and the Header rules every stamped type shares (§1.3).
+"""std_msgs pairs (docs/conversions-per-package.md §3.2) and the Header rules every stamped type
+shares (docs/conversions.md §1.3).
 
 The header helpers here are the only place that knows how a ROS header maps onto the gz
 ``Header.data`` key/value list; other modules call them instead of touching ``data``.

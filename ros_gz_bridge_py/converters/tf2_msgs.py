@@ -1,4 +1,4 @@
-"""tf2_msgs/msg/TFMessage <-> gz.msgs.Pose_V (docs/conversions.md §3.7).
+"""tf2_msgs/msg/TFMessage <-> gz.msgs.Pose_V (docs/conversions-per-package.md §3.7).
 
 Each transform is one gz Pose carrying its own header (``frame_id`` and ``child_frame_id``).
 R→G also writes the first transform's header (stamp and ``frame_id``) as the Pose_V header;

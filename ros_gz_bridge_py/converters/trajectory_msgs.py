@@ -1,4 +1,5 @@
-"""trajectory_msgs/msg/JointTrajectory <-> gz.msgs.JointTrajectory (docs/conversions.md §3.9).
+"""trajectory_msgs/msg/JointTrajectory <-> gz.msgs.JointTrajectory (docs/conversions-per-package.md
+§3.9).
 
 The point lists are copied whole (no per-element Python loop). ``time_from_start`` is copied
 verbatim in R→G and normalised like ``rclcpp::Duration`` in G→R, saturating at the int32 ends.

@@ -1,7 +1,8 @@
 """vision_msgs Detection2D/3D(Array) <-> gz.msgs.AnnotatedAxisAligned2DBox/Oriented3DBox(_V).
 
-docs/conversions.md §3.11, vision_msgs 4.x layout. Only ``results[0].hypothesis.class_id`` survives,
-parsed as an integer label like C++ ``std::stoi``; G→R reports one hypothesis with score 1.0.
+docs/conversions-per-package.md §3.11, vision_msgs 4.x layout. Only
+``results[0].hypothesis.class_id`` survives, parsed as an integer label like C++ ``std::stoi``; G→R
+reports one hypothesis with score 1.0.
 
 Differences from ros_gz_bridge:
 - A class_id that ``std::stoi`` rejects (empty, non-numeric, outside int32) raises

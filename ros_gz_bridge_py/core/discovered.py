@@ -171,8 +171,8 @@ class DiscoveredBridges:
         if spec.ros_topic.lstrip("/") != topic.lstrip("/"):
             self._say_once(
                 topic,
-                f"Gazebo {topic} is bridged as ROS {spec.ros_topic} (a valid ROS name; README: "
-                "Discovered bridging)",
+                f"Gazebo {topic} is bridged as ROS {spec.ros_topic} (a valid ROS name; "
+                "docs/many-topics.md: Discovered bridging)",
             )
 
     def _explicit_topics(self) -> frozenset[str]:

@@ -17,7 +17,7 @@ The types, by the first rule that applies (each spec's ``discovered_by`` names i
   subscribers tell no type (gz-transport 11/12 with ZeroMQ) takes the type of the ROS
   publishers (not the bridge's) on its ROS name, and that type's default Gazebo type
   (``bridge_types --get-ros-to-gz``), spelled as the subscribers' Gazebo line spells it when
-  discovery tells the line (docs/protocol.md §9.2).
+  discovery tells the line (docs/protocol-lines.md §9.2).
 
 A topic whose endpoints disagree, or that no rule types, is skipped with a reason. The ROS type
 is the entry's, else the ROS publishers' type where it pairs with the Gazebo type, else the
@@ -142,7 +142,7 @@ class Plan:
 def same_bridge(a: TopicBridgeSpec, b: BridgeSpec) -> bool:
     """True if ``a`` and ``b`` bridge alike: the rule that chose the types and the spelling
     of the Gazebo type aside (a Fortress subscriber inferred from ROS shows its type once it
-    took our publisher, and both spellings are announced anyway, docs/protocol.md §9.2)."""
+    took our publisher, and both spellings are announced anyway, docs/protocol-lines.md §9.2)."""
 
     def key(spec: TopicBridgeSpec) -> TopicBridgeSpec:
         return dataclasses.replace(spec, gz_type=canonical_type(spec.gz_type), discovered_by="")

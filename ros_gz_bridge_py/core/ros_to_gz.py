@@ -3,7 +3,7 @@
 Messages arrive on the executor as serialized CDR (read with the light reader, or through the
 bulk path for images and point clouds) or as rclpy's message objects; where the Gazebo lines
 lay a message out differently (the IMU), each spelling a subscriber needs is converted on its
-own (docs/protocol.md §9.4).
+own (docs/protocol-lines.md §9.4).
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ class RosToGzChannel(Channel):
 
     def _open_output(self) -> None:
         """The Gazebo publisher; for a pair of large messages (a bulk pair: images, point
-        clouds) with a send queue per subscriber of ``max_queued_bytes`` (docs/protocol.md
+        clouds) with a send queue per subscriber of ``max_queued_bytes`` (docs/protocol-zmq-data.md
         §2.8.8), so a Gazebo subscriber that stops reading costs the bridge that much."""
         large = self.pair.bulk is not None
         self._gz_publisher = self.ctx.gz_node.advertise(

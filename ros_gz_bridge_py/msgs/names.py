@@ -1,4 +1,4 @@
-"""Gazebo message type names and the two spellings of every message (docs/protocol.md §9).
+"""Gazebo message type names and the two spellings of every message (docs/protocol-lines.md §9).
 
 Fortress (and Citadel) name their messages ``ignition.msgs.X``; Garden and later ``gz.msgs.X``.
 The bytes of a message are the same under both names (except the IMU layout, which the

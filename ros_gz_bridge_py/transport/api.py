@@ -31,7 +31,8 @@ class Rejection(enum.StrEnum):
 
 
 class Scope(enum.IntEnum):
-    """How far an advertisement travels (Discovery.Publisher.Scope, docs/protocol.md §2.6)."""
+    """How far an advertisement travels (Discovery.Publisher.Scope, docs/protocol-zmq-discovery.md
+    §2.6)."""
 
     PROCESS = 0
     HOST = 1
@@ -211,8 +212,8 @@ class NativeLoop(Protocol):
 ServiceHandler = Callable[[bytes], tuple[bool, bytes]]
 #: Async service callback: ``(True/False, reply)`` on a reply, ``(None, b"")`` on timeout.
 ReplyCallback = Callable[[bool | None, bytes], None]
-#: Response types that make a service call one-way (docs/protocol.md §2.9.3, §4.6): there is no
-#: reply, the call is done once the request is sent.
+#: Response types that make a service call one-way (docs/protocol-zmq-data.md §2.9.3,
+#: docs/protocol-zenoh.md §4.6): there is no reply, the call is done once the request is sent.
 ONE_WAY_TYPES = frozenset({"gz.msgs.Empty", "ignition.msgs.Empty"})
 
 

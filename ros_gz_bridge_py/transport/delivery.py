@@ -37,7 +37,7 @@ Delivery = tuple[Payload, "MessageInfo"]
 #: Bytes a delivery queue holds by default (at least one item is always kept): ten 1080p RGB
 #: frames or two 4K RGBA ones, so a camera stream whose consumer pauses for a frame or two
 #: loses nothing, while a flood of large messages costs one channel at most this much
-#: (the bridge's ``max_queued_bytes`` parameter sets it; README, "Node parameters").
+#: (the bridge's ``max_queued_bytes`` parameter sets it; docs/configuration.md, "Node parameters").
 MAX_QUEUED_BYTES = 64 * 1024 * 1024
 #: Seconds between two warnings of one queue's drops.
 DROP_WARN_PERIOD = 10.0

@@ -41,7 +41,7 @@ class Publisher:
     """An advertised topic; ``publish`` may be called from any thread.
 
     It is announced under every name in ``names`` (both spellings of its type, the configured
-    one first, docs/protocol.md §9) and sends each message once per spelling a remote
+    one first, docs/protocol-lines.md §9) and sends each message once per spelling a remote
     subscriber needs.
     """
 

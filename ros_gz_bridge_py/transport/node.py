@@ -3,8 +3,8 @@ python-can's ``BusABC``).
 
 :class:`GzNode` is named so it cannot be mistaken for rclpy's ``Node``. It owns what is the same
 in every backend: the counters, the fully qualified names, the table of local subscriptions,
-local (intra-process) delivery, the choice of wire spellings per message (docs/protocol.md §9),
-``has_connections`` and an idempotent ``close``; its service half (blocking calls, handlers,
+local (intra-process) delivery, the choice of wire spellings per message (docs/protocol-lines.md
+§9), ``has_connections`` and an idempotent ``close``; its service half (blocking calls, handlers,
 ``node_services.py``) and its discovery half (the graph's queries, waiting for publishers,
 ``node_graph.py``) are mixed in from modules of their own. A backend implements narrow hooks:
 open and close its publishers, subscriptions and service offers, send one message in one
@@ -140,7 +140,7 @@ class GzNode(ServiceEnds, GraphView):
         ``queue_bytes`` (above 0), for a publisher of large messages: where the backend queues
         messages for each remote subscriber by count (ZeroMQ), the publisher sends from a
         socket of its own whose queue holds only as many of the largest messages the transport
-        carries as fit in ``queue_bytes`` (``zmq/hwm.py``; docs/protocol.md §2.8.8).
+        carries as fit in ``queue_bytes`` (``zmq/hwm.py``; docs/protocol-zmq-data.md §2.8.8).
 
         Raises:
             LocalProtocolError: the name is not a valid Gazebo topic.
@@ -158,7 +158,7 @@ class GzNode(ServiceEnds, GraphView):
 
     def publish(self, publisher: Publisher, payload: Payload, as_type: str | None = None) -> None:
         """Local subscriptions first, then one message per spelling a remote subscriber needs
-        (docs/protocol.md §9); ``as_type`` limits both to that spelling."""
+        (docs/protocol-lines.md §9); ``as_type`` limits both to that spelling."""
         if as_type is None or as_type == publisher.msg_type:
             local = self._local_receivers(publisher)
             if local:

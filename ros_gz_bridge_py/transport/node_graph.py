@@ -84,7 +84,7 @@ class GraphView(abc.ABC):
 
     def peer_spelling(self, process_uuid: str) -> Spelling | None:
         """How peer ``process_uuid``'s Gazebo line spells message types, when discovery tells
-        it (docs/protocol.md §9.2)."""
+        it (docs/protocol-lines.md §9.2)."""
         return self.subscriber_book.spelling(process_uuid)
 
     @abc.abstractmethod

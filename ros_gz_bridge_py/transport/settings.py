@@ -116,12 +116,12 @@ class TransportSettings:
     #: GZ_TRANSPORT_MAX_MESSAGE_SIZE: larger messages are refused before they are buffered.
     max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE
     #: GZ_TRANSPORT_USERNAME and GZ_TRANSPORT_PASSWORD, when both are set and not empty:
-    #: ZeroMQ PLAIN authentication (docs/protocol.md §2.8.6); None otherwise.
+    #: ZeroMQ PLAIN authentication (docs/protocol-zmq-data.md §2.8.6); None otherwise.
     credentials: tuple[str, str] | None = field(default=None, repr=False)
     #: GZ_TRANSPORT_IMPLEMENTATION, lower-cased: "zeromq" (default) or "zenoh".
     implementation: str = "zeromq"
     #: What ZeroMQ peers of gz-transport 11/12 (Fortress, Garden: no record in their
-    #: heartbeats) call their types, when nothing else tells (docs/protocol.md §9).
+    #: heartbeats) call their types, when nothing else tells (docs/protocol-lines.md §9).
     legacy_spelling: Spelling = Spelling.IGNITION
 
     @classmethod

@@ -1,4 +1,4 @@
-"""Which spelling of a message type a publisher puts on the wire (docs/protocol.md §9).
+"""Which spelling of a message type a publisher puts on the wire (docs/protocol-lines.md §9).
 
 A publisher of ``gz.msgs.Twist`` is announced under both spellings, so a typed Fortress
 subscriber (``ignition.msgs.Twist``) and a typed Harmonic one (``gz.msgs.Twist``) both take it.

@@ -100,7 +100,7 @@ _ZEROS_9 = [0.0] * 9
 CLOCK = GzSample(
     "Clock",
     "system { sec: 7 nsec: 8 } real { sec: 9 nsec: 10 } sim { sec: 1234 nsec: 1500000123 }",
-    # nsec >= 1e9 is carried into the seconds (docs/conversions.md §3.8).
+    # nsec >= 1e9 is carried into the seconds (docs/conversions-per-package.md §3.8).
     {"clock": {"sec": 1235, "nanosec": 500000123}},
 )
 
@@ -148,7 +148,7 @@ ODOMETRY = GzSample(
 
 TF = GzSample(
     "Pose_V",
-    # The Pose_V header and the pose names are ignored (docs/conversions.md §3.7).
+    # The Pose_V header and the pose names are ignored (docs/conversions-per-package.md §3.7).
     gz_header(1, 2, ("frame_id", "ignored_top_frame"))
     + " pose { "
     + gz_header(31, 62, ("frame_id", "odom"), ("child_frame_id", "waffle::base_footprint"))
@@ -197,7 +197,8 @@ IMU_HARMONIC = GzSample(
         "linear_acceleration_covariance": [float(value) for value in range(21, 30)],
     },
     harmonic_fields=(
-        # Harmonic numbering (docs/protocol.md §9.4): 4, 6, 8 are covariances, 5 and 7 vectors.
+        # Harmonic numbering (docs/protocol-lines.md §9.4): 4, 6, 8 are covariances, 5 and 7
+        # vectors.
         HarmonicField(4, "orientation_covariance", "Float_V", _float_v(list(range(1, 10)))),
         HarmonicField(5, "angular_velocity", "Vector3d", "x: 0.5 y: -1.5 z: 2.5"),
         HarmonicField(6, "angular_velocity_covariance", "Float_V", _float_v(list(range(11, 20)))),
@@ -228,8 +229,8 @@ IMU_FORTRESS = GzSample(
 _SCAN_RANGES = [0.25 * index for index in range(1, 16)]
 SCAN = GzSample(
     "LaserScan",
-    # Three rows of five samples: the bridge takes the middle row (docs/conversions.md §3.5), and
-    # the header frame is overwritten with `frame`.
+    # Three rows of five samples: the bridge takes the middle row (docs/conversions-per-package.md
+    # §3.5), and the header frame is overwritten with `frame`.
     gz_header(51, 102, ("frame_id", "header_frame"))
     + ' frame: "waffle::base_scan" angle_min: -1.5 angle_max: 1.5 angle_step: 0.75'
     + " range_min: 0.125 range_max: 3.5 count: 5 vertical_count: 3"
@@ -375,7 +376,7 @@ SCAN_TO_GZ = RosSample(
     },
     "LaserScan",
     # count = trunc((max - min) / increment) = 4: the fifth sample is dropped
-    # (docs/conversions.md §3.5).
+    # (docs/conversions-per-package.md §3.5).
     gz_header(91, 182, ("frame_id", "lidar::frame"))
     + ' frame: "lidar::frame" angle_min: -1.5 angle_max: 1.5 angle_step: 0.75'
     + " range_min: 0.125 range_max: 8 count: 4"

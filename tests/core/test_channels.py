@@ -2,7 +2,7 @@
 
 The bridge runs on a memory Gazebo node; other memory nodes on its network play Gazebo
 processes (``native=Spelling.IGNITION``: a Fortress one, which announces and takes only
-``ignition.msgs.*``, docs/protocol.md §9). The ROS side is an rclpy node of the same process.
+``ignition.msgs.*``, docs/protocol-lines.md §9). The ROS side is an rclpy node of the same process.
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import pytest
 
-#: Discovery groups of the two hosts (docs/protocol.md §2.2, §2.7).
+#: Discovery groups of the two hosts (docs/protocol-zmq-discovery.md §2.2, §2.7).
 SIM_GROUP = "239.255.0.71"
 ROS_GROUP = "239.255.0.72"
 

@@ -4,7 +4,7 @@ goes down for 10 s and comes back: bridging resumes by itself and nothing is dup
 * ZeroMQ: the simulator host is the real Fortress C++ peer (a Clock publisher stamping every
   message with its send time, a typed Twist subscriber); the ROS host runs the bridge with
   ``GZ_RELAY`` pointing at the simulator host. The hosts use different discovery groups, so
-  discovery crosses only as relayed unicast (docs/protocol.md §2.7).
+  discovery crosses only as relayed unicast (docs/protocol-zmq-discovery.md §2.7).
 * Zenoh: a Zenoh router on the simulator host, our ZenohGzNode there as the Gazebo side (no
   Jetty binary exists here), the bridge on the ROS host as a client of the router.
 

@@ -5,7 +5,8 @@ peer's ``pub`` mode, and for two cases also the Debian CLI one-shot ``ign-transp
 sends a message built from a text protobuf with distinctive values. Our ZmqGzNode subscribes raw
 with the exact Fortress type string ``ignition.msgs.X``; the bytes are decoded with
 ``message_class("ignition.msgs.X")``, converted with the registry's pair, and the ROS fields are
-checked against ``docs/conversions.md`` (its section numbers are in the checks). The peer
+checked against ``docs/conversions.md`` and ``docs/conversions-per-package.md`` (their section
+numbers are in the checks). The peer
 prints the SHA-256 of what it serialized, so each case also proves that the bytes we converted
 are exactly the C++ ones.
 
@@ -50,7 +51,7 @@ from tests.interop.wire_runs import DELIVERY_TIMEOUT, PARALLEL, run_limited
 pytestmark = pytest.mark.peer
 
 #: The CLI publishes once, 800 ms after advertising, and exits as it does: about one message
-#: in four never reaches the wire (docs/protocol.md §2.8.7; before our subscribers stayed
+#: in four never reaches the wire (docs/protocol-zmq-data.md §2.8.7; before our subscribers stayed
 #: connected a moment after a publisher's goodbye, two in three were lost): up to 6 one-shots
 #: per case, each a fresh publisher process.
 CLI_ATTEMPTS = 6

@@ -2,7 +2,8 @@
 published by our ZmqGzNode under ``ignition.msgs.X`` and printed by the C++ peer's ``echo`` mode
 (decoded with the Fortress schema compiled into ign-msgs 8); the printed text is checked for the
 expected fields and parsed back into the message we sent (the other direction:
-``test_conversion_wire.py``). The sections cited are those of docs/conversions.md.
+``test_conversion_wire.py``). The sections cited are those of docs/conversions.md and
+docs/conversions-per-package.md.
 
 All deliveries happen once per module, in a module-scoped fixture that runs a few echoes at a
 time and stops every process it started before the first test runs.
@@ -148,7 +149,8 @@ REVERSES = (
     Reverse("laser_scan", "sensor_msgs/msg/LaserScan", "ignition.msgs.LaserScan", ros_scan, (
         'frame: "laser"',
         "angle_min: -1 angle_max: 1 angle_step: 0.5 range_min: 0.25 range_max: 12",
-        # count = trunc((max - min) / increment) = 4: the last sample is dropped (§3.5).
+        # count = trunc((max - min) / increment) = 4: the last sample is dropped
+        # (docs/conversions-per-package.md §3.5).
         "count: 4",
         "ranges: 1 ranges: 2 ranges: 3 ranges: 4 intensities: 10",
         "intensities: 40",

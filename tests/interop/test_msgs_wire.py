@@ -3,7 +3,7 @@
 The Fortress files are compiled with protoc and compared with our committed descriptor set
 (whose freshness tests/unit/msgs/test_pool.py checks): for every message we define that also exists
 in ign-msgs 8, each field both define must have the same number, name and wire type, and each
-enum value both define the same name. Additive fields (docs/protocol.md §9.5) are only on one
+enum value both define the same name. Additive fields (docs/protocol-lines.md §9.5) are only on one
 side, so they are not compared. ``gz.msgs.IMU`` is the one known renumbering: it is skipped, and our
 ``ignition.msgs.IMU`` is compared with the Fortress IMU instead.
 """
@@ -97,8 +97,8 @@ def _ours() -> dict[str, tuple[Any, str]]:
 OURS = _ours()
 # gz.msgs.IMU is renumbered since Fortress; ignition.msgs.IMU stands for the Fortress layout.
 SKIPPED = {"gz.msgs.IMU"}
-# Top-level types added after Fortress (docs/protocol.md §9.5); their nested types go with them.
-# NavSatWithCovariance is newer still (Jetty).
+# Top-level types added after Fortress (docs/protocol-lines.md §9.5); their nested types go with
+# them. NavSatWithCovariance is newer still (Jetty).
 HARMONIC_ONLY = {
     "gz.msgs.Dataframe", "gz.msgs.EntityWrench", "gz.msgs.MaterialColor",
     "gz.msgs.OdometryWithCovariance", "gz.msgs.PoseWithCovariance",

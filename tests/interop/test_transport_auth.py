@@ -1,4 +1,4 @@
-"""PLAIN authentication against the real Fortress peer (docs/protocol.md §2.8.6).
+"""PLAIN authentication against the real Fortress peer (docs/protocol-zmq-data.md §2.8.6).
 
 ign-transport 11 reads ``IGN_TRANSPORT_USERNAME``/``IGN_TRANSPORT_PASSWORD``; our node here
 gets its credentials in its settings (the environment's ``GZ_``/``IGN_`` names give the same,

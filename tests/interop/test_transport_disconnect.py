@@ -3,14 +3,14 @@
 A one-shot publisher (``ign topic -p``, here the C++ peer's ``pub`` with a count of 1, the
 same ign-transport 11 code) advertises, publishes one message and exits (UNADVERTISE, BYE).
 A SUB socket that polled (libzmq then holds the message's first frame) and disconnects on that
-goodbye before reading aborts in fq.cpp (docs/protocol.md §2.8.7): that is why the node never
-disconnected. Our node now disconnects from publishers that are gone, reading whole messages
+goodbye before reading aborts in fq.cpp (docs/protocol-zmq-data.md §2.8.7): that is why the node
+never disconnected. Our node now disconnects from publishers that are gone, reading whole messages
 first. Each case runs in a child process (``one_shot_child.py``), since the abort kills it.
 
 The peer rather than ``ign topic -p``: the CLI publishes 800 ms after advertising whether or
 not anyone is connected, and it exits as it publishes, so that about one message in four
-never reaches the wire (docs/protocol.md §2.8.7); the peer publishes once its subscribers are
-connected, then settles 1 s so that the child's plain SUB socket, connected just after the
+never reaches the wire (docs/protocol-zmq-data.md §2.8.7); the peer publishes once its subscribers
+are connected, then settles 1 s so that the child's plain SUB socket, connected just after the
 node's, is up too.
 """
 
@@ -70,7 +70,7 @@ def test_a_plain_disconnect_after_a_poll_aborts_in_libzmq(ign_peer: Path) -> Non
 def test_our_node_disconnects_from_a_one_shot_publisher_and_lives(ign_peer: Path) -> None:
     """Both subscriptions (a queued one's own socket, and the shared socket) disconnect when
     the publisher says goodbye. Each usually gets the message; a socket whose connection came up
-    after the one message was sent misses it (the slow joiner, docs/protocol.md §2.8.1)."""
+    after the one message was sent misses it (the slow joiner, docs/protocol-zmq-data.md §2.8.1)."""
     child, output = one_shot("ours")
     assert child.returncode == 0, output
     assert re.search(r"^RECEIVED [12]$", output, re.MULTILINE), output

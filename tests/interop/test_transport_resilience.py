@@ -52,7 +52,8 @@ def test_subscriber_recovers_when_the_publisher_is_killed_and_restarted(
 
 
 def framed(body: bytes) -> bytes:
-    """A discovery datagram: little-endian uint16 length, then the body (docs/protocol.md §2.3)."""
+    """A discovery datagram: little-endian uint16 length, then the body
+    (docs/protocol-zmq-discovery.md §2.3)."""
     return struct.pack("<H", len(body)) + body
 
 

@@ -137,7 +137,7 @@ def test_cli_lists_our_publisher_with_type_and_address(ign_peer: Path, gz_node: 
     info = ign_topic("-i", "-t", topic, timeout=10)
 
     assert topic in listing.stdout.split()
-    # Announced under both spellings of its type (docs/protocol.md §9), from one address.
+    # Announced under both spellings of its type (docs/protocol-lines.md §9), from one address.
     rows = re.findall(rf"^\s+({LOOPBACK_ADDRESS}), (\S+)$", info.stdout, re.MULTILINE)
     assert sorted(msg_type for _, msg_type in rows) == sorted(spellings(STRING)), info.stdout
     (address,) = {address for address, _ in rows}

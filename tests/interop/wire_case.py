@@ -1,6 +1,6 @@
 """A Gazebo -> ROS wire case (what a real publisher sends, what ROS must get) and the helpers
 their texts and checks share (``wire_cases_*.py``, ``test_conversion_wire.py``); the sections
-cited are those of docs/conversions.md."""
+cited are those of docs/conversions.md and docs/conversions-per-package.md."""
 
 from __future__ import annotations
 

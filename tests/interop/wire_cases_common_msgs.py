@@ -1,6 +1,6 @@
 """The Gazebo -> ROS wire cases of std_msgs, geometry_msgs, nav_msgs, tf2_msgs, sensor_msgs and
 rosgraph_msgs: a text a real publisher sends, and the checks of the ROS message it must become
-(docs/conversions.md's sections in the headings)."""
+(the sections of docs/conversions.md and docs/conversions-per-package.md in the headings)."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ from tf2_msgs.msg import TFMessage
 
 from tests.interop.wire_case import Case, assert_header, header, octal_bytes, xyz, xyzw
 
-# --- std (§3.2) -------------------------------------------------------------------------------
+# --- std (docs/conversions-per-package.md §3.2) ---------------------------------------------------
 
 STRING_TEXT = 'wire ✓ \\"quoted\\" a::b'
 
@@ -142,7 +142,8 @@ def check_imu_fortress(ros: Any) -> None:
     assert isinstance(ros, Imu)
     assert_header(ros, "imu/link")
     assert xyzw(ros.orientation) == (0.5, -0.5, 0.5, -0.5)
-    # Fortress layout: 4 is angular_velocity and 5 linear_acceleration (docs/protocol.md §9.4).
+    # Fortress layout: 4 is angular_velocity and 5 linear_acceleration (docs/protocol-lines.md
+    # §9.4).
     assert xyz(ros.angular_velocity) == (0.25, -0.125, 3.5)
     assert xyz(ros.linear_acceleration) == (0.5, 0.75, -9.81)
     # No covariances exist in the Fortress layout: all stay zero (§3.5 Imu, §1.5).

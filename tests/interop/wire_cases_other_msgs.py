@@ -1,6 +1,7 @@
 """The Gazebo -> ROS wire cases of ros_gz_interfaces, vision_msgs, gps_msgs, actuator_msgs,
 trajectory_msgs and rcl_interfaces: a text a real publisher sends, and the checks of the ROS
-message it must become (docs/conversions.md's sections in the headings)."""
+message it must become (the sections of docs/conversions.md and
+docs/conversions-per-package.md in the headings)."""
 
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ from vision_msgs.msg import Detection2D
 
 from tests.interop.wire_case import Case, assert_header, f32, header, xyz, xyzw
 
-# --- ros_gz_interfaces (§3.13) ------------------------------------------------------------------
+# --- ros_gz_interfaces (docs/conversions-per-package.md §3.13) ------------------------------------
 
 
 def check_entity(ros: Any) -> None:

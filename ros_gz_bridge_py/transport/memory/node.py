@@ -1,11 +1,11 @@
 """An in-memory Gazebo Transport: nodes of one process meet on a :class:`MemoryNetwork`.
 
 For tests of the bridge's core without sockets or second processes, and a third backend
-under the one contract. It keeps the rules that matter on the wire (docs/protocol.md §2.8,
-§9): a publisher is announced under each spelling its node uses; a subscriber registers with
-an announcement only if it takes that type (NEW_CONNECTION), and takes one spelling per
-publisher; a publisher sends nothing while nobody registered, then each message once per
-spelling its subscribers need; service calls reach a provider of either spelling of their
+under the one contract. It keeps the rules that matter on the wire (docs/protocol-zmq-data.md
+§2.8, docs/protocol-lines.md §9): a publisher is announced under each spelling its node uses; a
+subscriber registers with an announcement only if it takes that type (NEW_CONNECTION), and takes one
+spelling per publisher; a publisher sends nothing while nobody registered, then each message once
+per spelling its subscribers need; service calls reach a provider of either spelling of their
 types, after it is known, and time out otherwise.
 
 ``native`` makes a node stand for a gz process of one Gazebo line: it announces and takes

@@ -1,1 +1,1 @@
-"""The Zenoh backend of gz-transport 15 (docs/protocol.md §4)."""
+"""The Zenoh backend of gz-transport 15 (docs/protocol-zenoh.md §4)."""

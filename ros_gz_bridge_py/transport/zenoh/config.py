@@ -1,4 +1,5 @@
-"""The Zenoh session configuration, chosen as gz-transport 15 chooses it (docs/protocol.md §4.2).
+"""The Zenoh session configuration, chosen as gz-transport 15 chooses it (docs/protocol-zenoh.md
+§4.2).
 
 1. ``ZENOH_CONFIG`` names a config file; if it is set but is not a readable regular file that
    parses, an error is logged and Zenoh's default configuration is used.
@@ -107,7 +108,7 @@ def limit_message_size(config: zenoh.Config, limit: int) -> zenoh.Config:
     """Give Zenoh our maximum message size (GZ_TRANSPORT_MAX_MESSAGE_SIZE) as its receive
     limit, unless the configuration chose one: Zenoh then drops a larger message before
     reassembling it (without telling; messages that still arrive larger are counted by the
-    node). gz sets nothing (docs/protocol.md §4.2); the limit applies to what we receive."""
+    node). gz sets nothing (docs/protocol-zenoh.md §4.2); the limit applies to what we receive."""
     if json.loads(config.get_json(RX_LIMIT_KEY)) == ZENOH_RX_LIMIT_DEFAULT:
         config.insert_json5(RX_LIMIT_KEY, str(limit))
     return config

@@ -31,7 +31,7 @@ class ZenohPublisher(Publisher):
     def __init__(self, node: ZenohGzNode, topic: str, fqn: str, msg_type: str) -> None:
         super().__init__(node, topic, fqn, msg_type)
         #: The attachment of a put in each spelling: the type name as raw bytes
-        #: (docs/protocol.md §4.5).
+        #: (docs/protocol-zenoh.md §4.5).
         self.attachments = {name: name.encode() for name in self.names}
         #: The Zenoh publisher and the MP token, in declaration order.
         self.entities: list[Any] = []
@@ -63,7 +63,7 @@ class ZenohServiceOffer(ServiceOffer):
 def take_sample(
     sub: Subscription, sample: zenoh.Sample, partition: str, limit: int
 ) -> tuple[bytes, MessageInfo] | None:
-    """A remote sample's payload and info as gz checks it (docs/protocol.md §4.5), or None
+    """A remote sample's payload and info as gz checks it (docs/protocol-zenoh.md §4.5), or None
     once ``sub`` was told why not: no or an unreadable type attachment, another type, or a
     payload over ``limit`` bytes (Zenoh itself drops larger fragmented messages unseen,
     ``config.limit_message_size``)."""

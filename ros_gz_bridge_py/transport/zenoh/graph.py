@@ -1,5 +1,5 @@
 """The Zenoh graph: the ``@gz/…`` liveliness tokens a node has seen, and what they tell
-(docs/protocol.md §4.4): listings, remote subscribers per topic, and the publishers and
+(docs/protocol-zenoh.md §4.4): listings, remote subscribers per topic, and the publishers and
 subscribers of a topic in every partition. Thread-safe; no Zenoh calls here.
 """
 

@@ -1,4 +1,4 @@
-"""Zenoh liveliness tokens of gz-transport 15 (docs/protocol.md §4.3, §4.4).
+"""Zenoh liveliness tokens of gz-transport 15 (docs/protocol-zenoh.md §4.3, §4.4).
 
 Pure functions: build a token for one of our entities, and parse a token seen on
 ``@gz/**`` back into who declares what. The format follows rmw_zenoh's graph cache::

@@ -1,4 +1,4 @@
-"""The Zenoh Gazebo Transport node of gz-transport 15 (Jetty), docs/protocol.md §4.
+"""The Zenoh Gazebo Transport node of gz-transport 15 (Jetty), docs/protocol-zenoh.md §4.
 
 Each :class:`ZenohGzNode` opens its own Zenoh session and looks like one gz process (own
 process and node UUIDs). Topics and services are Zenoh keys equal to their fully qualified
@@ -12,7 +12,7 @@ that completes without a reply is reported as a failure (a timeout if the deadli
 first). Local subscriptions get our own messages from the shared publish; Zenoh's own
 session-local loop-back is switched off (publishers put to remote sessions only, subscribers
 take remote samples only), so nothing is delivered twice (gz-transport #961). Every Zenoh
-peer is Jetty or later, so our tokens say ``gz.msgs`` (docs/protocol.md §9.3). Offers and
+peer is Jetty or later, so our tokens say ``gz.msgs`` (docs/protocol-lines.md §9.3). Offers and
 calls are the node's service half, :class:`~.node_services.ZenohServices`.
 
 Threads: Zenoh runs callbacks on threads of its own (one per subscription, queryable, the
@@ -125,7 +125,7 @@ class ZenohGzNode(ZenohServices):
     ) -> Publisher:
         """A Zenoh publisher on the FQN (remote destinations only) and its MP token;
         ``own_socket`` and ``queue_bytes`` change nothing here (ZeroMQ notions; Zenoh's
-        publishers drop what the network cannot take, docs/protocol.md §4.2)."""
+        publishers drop what the network cannot take, docs/protocol-zenoh.md §4.2)."""
         publisher = ZenohPublisher(self, topic, fqn, msg_type)
         token = message_token(
             fqn, self.process_uuid, self.node_uuid, EntityKind.PUBLISHER, canonical_type(msg_type)

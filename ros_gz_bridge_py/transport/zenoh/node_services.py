@@ -1,4 +1,5 @@
-"""Services over Zenoh (docs/protocol.md §4.6): the service half of :class:`~.node.ZenohGzNode`.
+"""Services over Zenoh (docs/protocol-zenoh.md §4.6): the service half of
+:class:`~.node.ZenohGzNode`.
 
 :class:`ZenohServices` offers services (a queryable and its SS token each) and calls them: a
 call waits for a provider's token, is sent as a ``get`` and finished exactly once, by its reply,

@@ -1,1 +1,1 @@
-"""The ZeroMQ backend of every Gazebo line (docs/protocol.md §2)."""
+"""The ZeroMQ backend of every Gazebo line (docs/protocol-zmq-discovery.md §2)."""

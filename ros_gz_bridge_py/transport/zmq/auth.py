@@ -1,4 +1,4 @@
-"""ZeroMQ PLAIN authentication of the data plane, as gz-transport does it (docs/protocol.md
+"""ZeroMQ PLAIN authentication of the data plane, as gz-transport does it (docs/protocol-zmq-data.md
 §2.8.6).
 
 With ``GZ_TRANSPORT_USERNAME`` and ``GZ_TRANSPORT_PASSWORD`` set, the PUB socket is a PLAIN

@@ -1,6 +1,6 @@
 """The publisher addresses one SUB socket is connected to, and what libzmq tells about them.
 
-Three things libzmq does on its own that a SUB socket's owner must follow (docs/protocol.md
+Three things libzmq does on its own that a SUB socket's owner must follow (docs/protocol-zmq-data.md
 §2.8.7):
 
 * ``ZMQ_MAXMSGSIZE``: a frame larger than the limit is refused while its size is read, before

@@ -1,4 +1,4 @@
-"""The UDP discovery protocol as a sans-IO state machine (docs/protocol.md §2.3-§2.7).
+"""The UDP discovery protocol as a sans-IO state machine (docs/protocol-zmq-discovery.md §2.3-§2.7).
 
 One :class:`DiscoveryEngine` serves one discovery port (a node runs one for topics on the
 msg port and one for services on the srv port, §2.1). It owns no socket and no clock: the
@@ -88,7 +88,7 @@ class DiscoveryEngine:
         self._subscribe_seen: dict[str, dict[str, str]] = {}
         # topic -> (process, node) -> the record of a SUBSCRIBERS_REP (gz-transport 13+)
         self._listed: dict[str, dict[tuple[str, str], PublisherRecord]] = {}
-        #: What each peer process calls its message types (docs/protocol.md §9).
+        #: What each peer process calls its message types (docs/protocol-lines.md §9).
         self.spellings = PeerSpellings(legacy_spelling)
         self._next_heartbeat = now
         self._next_activity = math.inf  # no peer yet
@@ -172,7 +172,8 @@ class DiscoveryEngine:
             self._local_subscribers.remove(record)
 
     def connect(self, publisher: PublisherRecord, node_uuid: str) -> list[Outgoing]:
-        """NEW_CONNECTION: our ``node_uuid`` subscribes to ``publisher`` (§2.8.1 step 5)."""
+        """NEW_CONNECTION: our ``node_uuid`` subscribes to ``publisher`` (docs/protocol-zmq-data.md
+        §2.8.1 step 5)."""
         record = replace(
             publisher,
             process_uuid=self.process_uuid,

@@ -1,5 +1,5 @@
 """What a discovery engine (:mod:`~.discovery`) hands its runner: the datagrams to send, and
-events about remote publishers and subscribers (docs/protocol.md §2.4)."""
+events about remote publishers and subscribers (docs/protocol-zmq-discovery.md §2.4)."""
 
 from __future__ import annotations
 

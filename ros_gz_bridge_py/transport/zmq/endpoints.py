@@ -20,8 +20,8 @@ if TYPE_CHECKING:
 
 class ZmqPublisher(Publisher):
     """Announced once per spelling of its type (``records``, the configured one first), from
-    the node's PUB address (docs/protocol.md §9), or from the address of a PUB socket of its own
-    (``sock``)."""
+    the node's PUB address (docs/protocol-lines.md §9), or from the address of a PUB socket of its
+    own (``sock``)."""
 
     def __init__(
         self,
@@ -50,13 +50,14 @@ class ZmqPublisher(Publisher):
         }
 
     def send_queue(self) -> int:
-        """The SNDHWM of its socket, set when the socket was made (docs/protocol.md §2.8.8)."""
+        """The SNDHWM of its socket, set when the socket was made (docs/protocol-zmq-data.md
+        §2.8.8)."""
         return self._send_queue
 
 
 class ZmqSubscription(Subscription):
-    """A subscription with its record (announced in SUBSCRIBERS_REP answers, §2.4), set when
-    the node opens it."""
+    """A subscription with its record (announced in SUBSCRIBERS_REP answers,
+    docs/protocol-zmq-discovery.md §2.4), set when the node opens it."""
 
     record: PublisherRecord | None = None
 

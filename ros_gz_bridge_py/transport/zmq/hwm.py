@@ -4,7 +4,7 @@ libzmq bounds each pipe's queue by a count of messages (SNDHWM, RCVHWM), whateve
 size: 1000 images of 6 MB are 6 GB. A socket whose mark is the number of its largest messages
 that fit in the bridge's ``max_queued_bytes`` keeps each queue under that budget instead.
 
-The mark must be set before the socket is bound or connected, never after (docs/protocol.md
+The mark must be set before the socket is bound or connected, never after (docs/protocol-zmq-data.md
 §2.8.8): a pipe takes the socket's mark when it is made; libzmq 4.3.5 applies a changed mark to
 the pipes already made, but a lowered one can leave a live pipe stalled for good (the writer's
 count of what was read lags by up to the old low-water mark), and changing it while a peer

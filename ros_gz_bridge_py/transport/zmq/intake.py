@@ -3,11 +3,12 @@ readers, connected to publishers as discovery learns them and disconnected when 
 
 §2.8.1 step 4 connects a SUB socket once per publisher address. We also disconnect: when
 the last remote record at an address goes away for a topic (UNADVERTISE, BYE, a process
-silent for 3 s, §2.5), the readers of that topic disconnect from it, and the shared socket
-does once no record at all is left there, each a moment later (``connections.LEAVE_AFTER``),
-so that what the publisher sent last still arrives. gz never disconnects; without it,
-addresses of a peer that is gone are retried for ever (docs/protocol.md §2.8.7). Everything
-here runs on the I/O thread; readers do their part on their own threads.
+silent for 3 s, docs/protocol-zmq-discovery.md §2.5), the readers of that topic disconnect from it,
+and the shared socket does once no record at all is left there, each a moment later
+(``connections.LEAVE_AFTER``), so that what the publisher sent last still arrives. gz never
+disconnects; without it, addresses of a peer that is gone are retried for ever
+(docs/protocol-zmq-data.md §2.8.7). Everything here runs on the I/O thread; readers do their part on
+their own threads.
 """
 
 from __future__ import annotations

@@ -2,9 +2,9 @@
 
 Each :class:`ZmqGzNode` is a full gz participant with its own process UUID (two nodes in one
 Python process look like two processes on the wire), with two discovery engines (topics and
-services, :mod:`~.discovery`) and the sockets of docs/protocol.md §2.1 (:mod:`~.sockets`).
-The service side is :class:`~.services.ServiceRouter`, received data is routed by
-:mod:`~.routes`, and what discovery knows is answered by :class:`~.node_graph.ZmqGraphView`.
+services, :mod:`~.discovery`) and the sockets of docs/protocol-zmq-discovery.md §2.1
+(:mod:`~.sockets`). The service side is :class:`~.services.ServiceRouter`, received data is routed
+by :mod:`~.routes`, and what discovery knows is answered by :class:`~.node_graph.ZmqGraphView`.
 
 Threading model: one I/O thread (``gz-io``) owns the discovery engines and every socket
 except PUB and the queued subscriptions' own SUB sockets; other threads post commands to it
@@ -186,8 +186,9 @@ class ZmqGzNode(ZmqGraphView):
     ) -> Publisher:
         """Announce ``topic`` under each spelling; re-announced every second (§2.5). With
         ``own_socket``, from a PUB socket of the publisher's own, at its own address (a record
-        names the address subscribers connect to, §2.8.1); with ``queue_bytes`` too, and that
-        socket's SNDHWM set for it before the socket is bound (§2.8.8)."""
+        names the address subscribers connect to, docs/protocol-zmq-data.md §2.8.1); with
+        ``queue_bytes`` too, and that socket's SNDHWM set for it before the socket is bound
+        (§2.8.8)."""
         sock = None
         sndhwm = self.settings.sndhwm
         if queue_bytes > 0:
@@ -303,7 +304,7 @@ class ZmqGzNode(ZmqGraphView):
 
     def _connect_publisher(self, record: PublisherRecord, subs: Sequence[Subscription]) -> None:
         """§2.8.1 steps 4-5: connect once per address, NEW_CONNECTION if a subscription takes
-        the record (docs/protocol.md §9). Queued subscriptions connect their own sockets."""
+        the record (docs/protocol-lines.md §9). Queued subscriptions connect their own sockets."""
         if not self._intake.connect(record, subs):
             return
         taking = [sub for sub in subs if sub.take(record.address, record.msg_type)]

@@ -3,7 +3,7 @@
 :class:`ZmqGraphView` answers the listings (topics, services, their publishers and providers,
 the graph, the peer processes) from the node's two discovery engines on its I/O thread, with
 :mod:`~.graph`, and adds the engines' counters to the node's. The node owns the engines, the
-sockets and the thread. Sections cited: docs/protocol.md.
+sockets and the thread. Sections cited: docs/protocol-zmq-discovery.md.
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ from ros_gz_bridge_py.transport.zmq.udp import DiscoverySocket
 
 T = TypeVar("T")
 
-#: Our counters for the discovery engines' counts of bad or foreign datagrams (§2.3).
+#: Our counters for the discovery engines' counts of bad or foreign datagrams
+#: (docs/protocol-zmq-discovery.md §2.3).
 _ENGINE_COUNTS = {
     "datagrams_received": "received",
     "datagrams_malformed": "malformed",

@@ -1,10 +1,10 @@
 """Received data messages to the local subscriptions that take them (I/O thread only).
 
-§2.8.1 step 8: the exact fully qualified name (ZeroMQ filters by prefix), and a spelling
-the subscription takes from that sender (docs/protocol.md §9). A (topic, sender, type) seen
-before takes its cached route: no decoding, no matching; the node empties the cache whenever
-a subscription starts or ends (on the same thread). Subscriptions of the exact topic that
-do not take the message's type, or that get malformed frames, are told (``reject``).
+docs/protocol-zmq-data.md §2.8.1 step 8: the exact fully qualified name (ZeroMQ filters by prefix),
+and a spelling the subscription takes from that sender (docs/protocol-lines.md §9). A (topic,
+sender, type) seen before takes its cached route: no decoding, no matching; the node empties the
+cache whenever a subscription starts or ends (on the same thread). Subscriptions of the exact topic
+that do not take the message's type, or that get malformed frames, are told (``reject``).
 """
 
 from __future__ import annotations

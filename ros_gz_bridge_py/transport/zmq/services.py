@@ -1,6 +1,6 @@
 """The service side of a :class:`~ros_gz_bridge_py.transport.zmq.node.ZmqGzNode`.
 
-The protocol: docs/protocol.md §2.9.
+The protocol: docs/protocol-zmq-data.md §2.9.
 
 :class:`ServiceRouter` keeps the node's service offers, its calls waiting for a provider, a
 route or a response, and the ROUTER sends retried until their peer is routable. It runs on the
@@ -122,7 +122,7 @@ class ServiceRouter:
             return
         one_way = request.response_type in ONE_WAY_TYPES
         if not one_way and not is_tcp_endpoint(request.response_address):
-            self._count("addresses_refused")  # docs/protocol.md §2.3.1: tcp:// only
+            self._count("addresses_refused")  # docs/protocol-zmq-discovery.md §2.3.1: tcp:// only
             _LOG.debug("service request with response address %r", request.response_address)
             return
         ok, payload = self._run_handler(offer, bytes(request.payload))

@@ -164,8 +164,8 @@ class SocketOwner:
         whose messages grow by small steps changes socket once per doubling, not at each step)
         on a new socket, connected where the old one was, which replaces it: libzmq applies
         an HWM set on a socket to its open connections too, which then stall for good, or
-        crash it while a connection closes (docs/protocol.md, "The receive queue in bytes").
-        What the old socket holds is read first (one batch more); what is still on its way
+        crash it while a connection closes (docs/protocol-zmq-data.md §2.8.7, "The receive queue in
+        bytes"). What the old socket holds is read first (one batch more); what is still on its way
         in its connections is lost, once per lowering."""
         hwm = hwm_for_bytes(GROWTH_ROOM * size, self._max_bytes, self._configured_hwm)
         if 0 < self._hwm <= hwm:
@@ -244,7 +244,8 @@ class SocketOwner:
             return None
         if not self._accepts(message.sender, message.msg_type):
             if self._takes(message.msg_type):
-                return None  # the other spelling of a message already taken (docs/protocol.md §9)
+                # the other spelling of a message already taken (docs/protocol-lines.md §9)
+                return None
             return (
                 Rejection.WRONG_TYPE,
                 f"the publisher at {message.sender} sends {message.msg_type}",

@@ -1,4 +1,5 @@
-"""The sockets of one ZeroMQ node (docs/protocol.md §2.1), opened and released together."""
+"""The sockets of one ZeroMQ node (docs/protocol-zmq-discovery.md §2.1), opened and released
+together."""
 
 from __future__ import annotations
 
@@ -116,8 +117,9 @@ def open_sockets(
 
 
 def limit_input(sock: Any, settings: TransportSettings) -> None:
-    """Refuse frames over the maximum message size before they are buffered (§2.8.7), and
-    retry an address that failed with a growing delay, up to MAX_BACKOFF."""
+    """Refuse frames over the maximum message size before they are buffered
+    (docs/protocol-zmq-data.md §2.8.7), and retry an address that failed with a growing delay, up to
+    MAX_BACKOFF."""
     sock.setsockopt(zmq.MAXMSGSIZE, settings.max_message_size)
     sock.setsockopt(zmq.RECONNECT_IVL_MAX, int(MAX_BACKOFF * 1000))
 

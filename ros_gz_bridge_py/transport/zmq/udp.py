@@ -1,4 +1,4 @@
-"""UDP sockets for multicast discovery (docs/protocol.md §2.2).
+"""UDP sockets for multicast discovery (docs/protocol-zmq-discovery.md §2.2).
 
 One socket per discovery port serves as receiver and sender. Like gz-transport it sets
 SO_REUSEADDR and SO_REUSEPORT (several gz processes share the port), binds INADDR_ANY:port,

@@ -1,4 +1,5 @@
-"""Byte layouts of the ZeroMQ backend, pure functions (docs/protocol.md §2.3, §2.8.2, §2.9).
+"""Byte layouts of the ZeroMQ backend, pure functions (docs/protocol-zmq-discovery.md §2.3,
+docs/protocol-zmq-data.md §2.8.2, §2.9).
 
 * Discovery datagram: little-endian uint16 body length + protobuf ``Discovery`` (§2.3).
 * Data message: 4 ZMQ frames [FQN, sender PUB endpoint, payload, type name] (§2.8.2).
@@ -22,7 +23,8 @@ from ros_gz_bridge_py.errors import LocalProtocolError, RemoteProtocolError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport.api import Scope
 
-#: Discovery wire version of every line from ign-transport8 to gz-transport15 (§3).
+#: Discovery wire version of every line from ign-transport8 to gz-transport15
+#: (docs/protocol-lines.md §3).
 WIRE_VERSION = 10
 #: Largest datagram gz-transport receives or sends (kMaxRcvStr, §2.3).
 MAX_DATAGRAM = 65535
@@ -42,8 +44,8 @@ _MAX_PORT = 65535
 
 def is_tcp_endpoint(address: str) -> bool:
     """True for ``tcp://host:port`` (port 1-65535), the only addresses gz advertises and the
-    only ones we connect to when the network names them (docs/protocol.md §2.3.1): never
-    ``ipc://``, ``inproc://`` or an interface-qualified form."""
+    only ones we connect to when the network names them (docs/protocol-zmq-discovery.md §2.3.1):
+    never ``ipc://``, ``inproc://`` or an interface-qualified form."""
     match = _TCP_ENDPOINT.fullmatch(address)
     return match is not None and 0 < int(match[1]) <= _MAX_PORT
 

@@ -93,8 +93,8 @@ def test_invalid_sets(yaml_text: str, message: str) -> None:
 
 def test_a_left_out_type_is_completed_by_discovery() -> None:
     """C++'s InvalidSetTypes case ("both ros_type_name and gz_type_name must be set"): ours
-    takes the missing type from discovery when the bridge runs (README, "Templates and
-    wildcards"), so the entry is a pattern, not an error."""
+    takes the missing type from discovery when the bridge runs (docs/many-topics.md, "Templates
+    and wildcards"), so the entry is a pattern, not an error."""
     result = parse_yaml("\n- topic_name: foo\n  ros_type_name: bar")
     assert (result.specs, result.errors) == ((), ())
     (pattern,) = result.patterns

@@ -1,4 +1,4 @@
-"""geometry_msgs pairs (docs/conversions.md §1.4, §1.5, §3.3)."""
+"""geometry_msgs pairs (docs/conversions.md §1.4, §1.5; docs/conversions-per-package.md §3.3)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""gps_msgs/msg/GPSFix <-> gz.msgs.NavSat (docs/conversions.md §3.6)."""
+"""gps_msgs/msg/GPSFix <-> gz.msgs.NavSat (docs/conversions-per-package.md §3.6)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """nav_msgs/msg/Odometry with gz.msgs.Odometry and gz.msgs.OdometryWithCovariance.
 
-The rules: docs/conversions.md §3.4.
+The rules: docs/conversions-per-package.md §3.4.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""rcl_interfaces/msg/ParameterValue <-> gz.msgs.Any (docs/conversions.md §3.12)."""
+"""rcl_interfaces/msg/ParameterValue <-> gz.msgs.Any (docs/conversions-per-package.md §3.12)."""
 
 from __future__ import annotations
 

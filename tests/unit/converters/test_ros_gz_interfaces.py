@@ -1,5 +1,5 @@
-"""ros_gz_interfaces' pairs and its four services (docs/conversions.md §3.13, §3.14); the
-messages' conversions are in test_ros_gz_interfaces_messages*.py."""
+"""ros_gz_interfaces' pairs and its four services (docs/conversions-per-package.md §3.13, §3.14);
+the messages' conversions are in test_ros_gz_interfaces_messages*.py."""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
-"""ros_gz_interfaces' messages (converters/ros_gz_interfaces_messages.py, docs/conversions.md
-§3.13): entities, wrenches, contacts, the altimeter, data frames, arrays, sensor noise, video
-recording and the statistics; the scene's messages and the parameters have files of their own."""
+"""ros_gz_interfaces' messages (converters/ros_gz_interfaces_messages.py,
+docs/conversions-per-package.md §3.13): entities, wrenches, contacts, the altimeter, data frames,
+arrays, sensor noise, video recording and the statistics; the scene's messages and the parameters
+have files of their own."""
 
 from __future__ import annotations
 

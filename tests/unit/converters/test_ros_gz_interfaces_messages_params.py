@@ -1,5 +1,6 @@
 """ros_gz_interfaces' ParamVec as gz.msgs.Param and Param_V (converters/
-ros_gz_interfaces_messages.py, docs/conversions.md §3.13): names, types, children, order."""
+ros_gz_interfaces_messages.py, docs/conversions-per-package.md §3.13): names, types, children,
+order."""
 
 from __future__ import annotations
 

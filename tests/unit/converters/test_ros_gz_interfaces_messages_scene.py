@@ -1,5 +1,6 @@
 """ros_gz_interfaces' messages of the scene (converters/ros_gz_interfaces_messages.py,
-docs/conversions.md §3.13): the tracked visual, the GUI camera, lights and material colours."""
+docs/conversions-per-package.md §3.13): the tracked visual, the GUI camera, lights and material
+colours."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """rosgraph_msgs/msg/Clock <-> gz.msgs.Clock: only ``sim``, normalised in G→R.
 
-The rules: docs/conversions.md §3.8.
+The rules: docs/conversions-per-package.md §3.8.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """sensor_msgs pairs except Image/CameraInfo and LaserScan/Range/PointCloud2.
 
-The rules: docs/conversions.md §3.5.
+The rules: docs/conversions-per-package.md §3.5.
 """
 
 from __future__ import annotations

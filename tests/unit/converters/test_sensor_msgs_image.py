@@ -1,4 +1,4 @@
-"""sensor_msgs Image and CameraInfo (docs/conversions.md §3.5)."""
+"""sensor_msgs Image and CameraInfo (docs/conversions-per-package.md §3.5)."""
 
 from __future__ import annotations
 

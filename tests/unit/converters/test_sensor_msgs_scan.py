@@ -1,4 +1,4 @@
-"""sensor_msgs LaserScan, Range and PointCloud2 (docs/conversions.md §3.5)."""
+"""sensor_msgs LaserScan, Range and PointCloud2 (docs/conversions-per-package.md §3.5)."""
 
 from __future__ import annotations
 

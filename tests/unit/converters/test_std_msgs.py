@@ -1,4 +1,5 @@
-"""std_msgs pairs and the shared Header rules (docs/conversions.md §1.3, §3.2)."""
+"""std_msgs pairs and the shared Header rules (docs/conversions.md §1.3,
+docs/conversions-per-package.md §3.2)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""tf2_msgs/msg/TFMessage <-> gz.msgs.Pose_V (docs/conversions.md §3.7)."""
+"""tf2_msgs/msg/TFMessage <-> gz.msgs.Pose_V (docs/conversions-per-package.md §3.7)."""
 
 from __future__ import annotations
 

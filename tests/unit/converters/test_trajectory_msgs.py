@@ -1,4 +1,5 @@
-"""trajectory_msgs/msg/JointTrajectory <-> gz.msgs.JointTrajectory (docs/conversions.md §3.9)."""
+"""trajectory_msgs/msg/JointTrajectory <-> gz.msgs.JointTrajectory (docs/conversions-per-package.md
+§3.9)."""
 
 from __future__ import annotations
 

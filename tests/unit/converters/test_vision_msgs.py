@@ -1,4 +1,5 @@
-"""vision_msgs Detection2D/3D(Array) <-> gz annotated boxes (docs/conversions.md §3.11)."""
+"""vision_msgs Detection2D/3D(Array) <-> gz annotated boxes (docs/conversions-per-package.md
+§3.11)."""
 
 from __future__ import annotations
 

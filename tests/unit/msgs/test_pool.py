@@ -15,7 +15,7 @@ from ros_gz_bridge_py.errors import UnsupportedTypeError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, known_types, message_class, regen
 
 # The gz types of the bridged pairs (docs/conversions.md §2) and of the ControlWorld
-# service (docs/conversions.md §3.14), plus the types transport and services build on.
+# service (docs/conversions-per-package.md §3.14), plus the types transport and services build on.
 BRIDGED_TYPES = (
     "Actuators",
     "Altimeter",
@@ -89,7 +89,7 @@ BRIDGED_TYPES = (
 )
 
 # Whole UDP datagrams sent by ign-transport 11.0.0 (frames 1, 3, 5 and 6 of a capture,
-# docs/protocol.md §2.3.2): uint16 little-endian body length, then the Discovery body.
+# docs/protocol-zmq-discovery.md §2.3.2): uint16 little-endian body length, then the Discovery body.
 PROCESS_UUID = "8fac3557-a1af-460e-92b0-1c45be37ee4e"
 PUBLISHER_UUID = "ce706bf2-4115-4b4c-9992-067a4b7ce765"
 HEARTBEAT = bytes.fromhex(

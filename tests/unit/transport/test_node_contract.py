@@ -37,7 +37,7 @@ LIMIT = 10.0
 
 def publish_until(publish: Callable[[], None], condition: Callable[[], bool]) -> bool:
     """Publish until ``condition``: the first messages after a match may be lost (the ZeroMQ
-    slow joiner, docs/protocol.md §2.8.1), as with gz."""
+    slow joiner, docs/protocol-zmq-data.md §2.8.1), as with gz."""
     deadline = time.monotonic() + LIMIT
     while not condition():
         if time.monotonic() > deadline:
@@ -139,7 +139,7 @@ def test_remote_messages_reach_typed_and_raw_subscriptions(pair: tuple[GzNode, G
 def test_either_spelling_reaches_every_subscriber_once(
     pair: tuple[GzNode, GzNode], published: str, subscribed: str
 ) -> None:
-    """docs/protocol.md §9: a subscriber of either spelling and a generic one each get every
+    """docs/protocol-lines.md §9: a subscriber of either spelling and a generic one each get every
     message exactly once."""
     a, b = pair
     topic = unique("spelled")
@@ -196,7 +196,7 @@ def test_messages_over_the_size_limit_are_refused(
 ) -> None:
     """issue 14: a message over ``max_message_size`` never reaches the callback, later ones
     do. ZeroMQ and memory count it and tell ``on_reject``; Zenoh is given the limit and drops
-    such a message inside Zenoh, which reports nothing (docs/protocol.md §4.2)."""
+    such a message inside Zenoh, which reports nothing (docs/protocol-zenoh.md §4.2)."""
     backend, a, b = limited_pair
     topic = unique("big")
     inbox = Inbox()

@@ -1,4 +1,4 @@
-"""Which spelling each message is sent in (docs/protocol.md §9), without sockets."""
+"""Which spelling each message is sent in (docs/protocol-lines.md §9), without sockets."""
 
 from __future__ import annotations
 

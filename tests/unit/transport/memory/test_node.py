@@ -1,6 +1,6 @@
 """The in-memory backend's nodes that stand for one Gazebo line (``native``).
 
-A native node keeps the rules of a gz process of its line (docs/protocol.md §9.1): it
+A native node keeps the rules of a gz process of its line (docs/protocol-lines.md §9.1): it
 announces and asks for its own spelling only; a generic subscriber (``ign topic -e``, a log
 recorder) registers with every publisher of the topic and decodes only the names its line
 knows. Against such nodes our publisher (announced under both spellings) must send each

@@ -1,4 +1,5 @@
-"""The sans-IO discovery engine with an injected clock (docs/protocol.md §2.4-§2.7)."""
+"""The sans-IO discovery engine with an injected clock (docs/protocol-zmq-discovery.md
+§2.4-§2.7)."""
 
 from __future__ import annotations
 
@@ -169,7 +170,8 @@ def test_received_scope_filter() -> None:
 
 
 def test_new_connection_contents() -> None:
-    """§2.4, §2.8.1 step 5: the publisher's record, our uuids, ctrl = publisher's process uuid."""
+    """§2.4, docs/protocol-zmq-data.md §2.8.1 step 5: the publisher's record, our uuids, ctrl =
+    publisher's process uuid."""
     engine = DiscoveryEngine(ME, 0.0)
     (message,) = sent(engine.connect(record(), MY_NODE))
     assert message.type == DiscoveryType.NEW_CONNECTION
@@ -308,7 +310,7 @@ def test_only_tcp_addresses_are_taken_from_advertisements() -> None:
 
 def test_a_publisher_that_readvertises_rarely_stays_known() -> None:
     """gz-transport after 15 re-ADVERTISEs only on a change, for a new peer, or every tenth
-    heartbeat: heartbeats alone must keep its records (docs/protocol.md §2.5)."""
+    heartbeat: heartbeats alone must keep its records (docs/protocol-zmq-discovery.md §2.5)."""
     engine = DiscoveryEngine(ME, 0.0)
     engine.datagram_received(datagram(DiscoveryType.ADVERTISE, pub=record()), "127.0.0.1", 0.0)
     for second in range(1, 25):

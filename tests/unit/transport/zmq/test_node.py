@@ -22,7 +22,8 @@ StringMsg = message_class("gz.msgs.StringMsg")
 
 def publish_until(publish: Callable[[], None], condition: Callable[[], bool]) -> bool:
     """Publish until ``condition``: a NEW_CONNECTION can overtake the SUB's TCP handshake
-    (the ZMQ slow joiner, docs/protocol.md §2.8.1), so the first message may be lost, as with gz."""
+    (the ZMQ slow joiner, docs/protocol-zmq-data.md §2.8.1), so the first message may be lost, as
+    with gz."""
     deadline = time.monotonic() + 10.0
     while not condition():
         if time.monotonic() > deadline:
@@ -371,8 +372,8 @@ def test_a_publisher_of_large_messages_has_a_send_queue_sized_in_bytes(
     nodes: tuple[ZmqGzNode, ZmqGzNode],
 ) -> None:
     """``queue_bytes``: the publisher sends from a socket of its own, at its own address, whose
-    SNDHWM (set before the bind, docs/protocol.md §2.8.8) holds ``queue_bytes`` of the largest
-    messages the transport carries; messages reach a subscriber as from any publisher."""
+    SNDHWM (set before the bind, docs/protocol-zmq-data.md §2.8.8) holds ``queue_bytes`` of the
+    largest messages the transport carries; messages reach a subscriber as from any publisher."""
     from ros_gz_bridge_py.transport.zmq.hwm import hwm_for_bytes  # noqa: PLC0415
 
     a, b = nodes

@@ -194,7 +194,7 @@ def _settings(credentials: tuple[str, str] | None) -> TransportSettings:
 def test_plain_authentication(
     publisher: tuple[str, str], subscriber: tuple[str, str] | None, flows: bool
 ) -> None:
-    """docs/protocol.md §2.8.6: the PUB socket a PLAIN server, SUB sockets PLAIN clients.
+    """docs/protocol-zmq-data.md §2.8.6: the PUB socket a PLAIN server, SUB sockets PLAIN clients.
     Without credentials the mechanisms differ and the handshake fails before ZAP is asked."""
     with (
         ZmqGzNode(settings=_settings(publisher)) as a,

@@ -1,6 +1,7 @@
 """Datagram and ZMQ frame codecs against golden bytes captured from ign-transport 11.0.0.
 
-The layouts: docs/protocol.md §2.3, §2.8.2, §2.9; the captures: §2.3.2.
+The layouts: docs/protocol-zmq-discovery.md §2.3, docs/protocol-zmq-data.md §2.8.2, §2.9; the
+captures: §2.3.2.
 """
 
 from __future__ import annotations
