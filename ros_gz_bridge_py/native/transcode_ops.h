@@ -27,8 +27,6 @@ enum {
 
 /* Deepest nesting validated natively; deeper payloads are left to Python. */
 #define MAX_DEPTH 64
-/* Longest path of field numbers in an op. */
-#define MAX_STEPS 16
 
 struct view {
     const uint8_t *p;
