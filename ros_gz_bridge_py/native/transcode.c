@@ -26,10 +26,7 @@ static int align(struct rgb_out *out, size_t size) {
 
 static int put_u32(struct rgb_out *out, uint32_t value) {
     int status = align(out, 4);
-    if (status) return status;
-    uint8_t b[4] = {(uint8_t)value, (uint8_t)(value >> 8), (uint8_t)(value >> 16),
-                    (uint8_t)(value >> 24)};
-    return rgb_put(out, b, 4);
+    return status ? status : rgb_put_le(out, value, 4);
 }
 
 /* Writes `val` as ROS `kind` the way the Python path would, or RGB_FALLBACK where Python
@@ -52,10 +49,7 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
     }
     if (val.is_float) return RGB_FALLBACK;
     uint64_t bits = val.is_unsigned ? val.u : (uint64_t)val.i;
-    if (kind == ROS_BOOL) {
-        b[0] = val.i != 0;
-        return rgb_put(out, b, 1);
-    }
+    if (kind == ROS_BOOL) return rgb_put_le(out, val.i != 0, 1);
     if (conv == CONV_EXACT) {
         int ok;
         int64_t i = val.i;
@@ -72,8 +66,7 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
         }
         if (!ok) return RGB_FALLBACK;
     }
-    for (size_t k = 0; k < size; k++) b[k] = (uint8_t)(bits >> (8 * k));
-    return rgb_put(out, b, size);
+    return rgb_put_le(out, bits, size);
 }
 
 /* A CDR string: length with the NUL, the bytes, the NUL. A NUL inside is left to Python. */
@@ -143,20 +136,12 @@ static int scalar_element(void *ctx, const struct field *f) {
         size_t pos = 0;
         while (pos < f->payload.n) {
             struct field one = {f->number, wire, 0, {NULL, 0}};
-            if (wire == WIRE_VARINT) {
-                int status = read_varint(f->payload, &pos, &one.varint);
-                if (status) return status;
-            } else {
-                size_t size = wire == WIRE_I64 ? 8 : 4;
-                if (f->payload.n - pos < size) return RGB_UNDECODABLE;
-                one.payload.p = f->payload.p + pos;
-                one.payload.n = size;
-                pos += size;
-            }
+            int status = read_value(f->payload, &pos, wire, &one);
+            if (status) return status;
             s->count++;
             if (s->kind) {
-                int status = put_value(s->out, s->kind, CONV_EXACT,
-                                       pb_decode_scalar(s->type, &one, pb_raw_of(&one)));
+                status = put_value(s->out, s->kind, CONV_EXACT,
+                                   pb_decode_scalar(s->type, pb_raw_of(&one)));
                 if (status) return status;
             }
         }
@@ -165,7 +150,7 @@ static int scalar_element(void *ctx, const struct field *f) {
     if (f->wire != wire) return RGB_FALLBACK;
     s->count++;
     if (!s->kind) return 0;
-    return put_value(s->out, s->kind, CONV_EXACT, pb_decode_scalar(s->type, f, pb_raw_of(f)));
+    return put_value(s->out, s->kind, CONV_EXACT, pb_decode_scalar(s->type, pb_raw_of(f)));
 }
 /* The elements of a repeated submessage field, each indexed (when its type is known) and run
  * through a body of ops; the element's index is popped after. */
@@ -263,8 +248,6 @@ static int header_entry(void *ctx, const struct field *f) {
     return 0;
 }
 
-/* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
-
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v) {
     struct rgb_out *out = c->out;
     while (op < end && *op != OP_END) {
@@ -285,10 +268,8 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         case OP_CONST: {
             uint64_t bits = (uint32_t)op[1] | (uint64_t)(uint32_t)op[2] << 32;
             size_t size = rgb_ros_size(op[0]);
-            uint8_t b[8];
-            for (size_t k = 0; k < size; k++) b[k] = (uint8_t)(bits >> (8 * k));
             status = align(out, size);
-            if (!status) status = rgb_put(out, b, size);
+            if (!status) status = rgb_put_le(out, bits, size);
             op += 3;
             break;
         }

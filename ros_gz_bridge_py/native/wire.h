@@ -210,6 +210,13 @@ static inline int rgb_put(struct rgb_out *out, const void *bytes, size_t n) {
     return 0;
 }
 
+/* Appends the `size` low bytes of `bits`, little-endian. */
+static inline int rgb_put_le(struct rgb_out *out, uint64_t bits, size_t size) {
+    uint8_t b[8];
+    for (size_t k = 0; k < size && k < 8; k++) b[k] = (uint8_t)(bits >> (8 * k));
+    return rgb_put(out, b, size < 8 ? size : 8);
+}
+
 /* The words a string takes in a program (its length, then the bytes four to a word); counted
  * in size_t, so a damaged length near INT32_MAX cannot overflow. */
 static inline size_t rgb_text_span(int32_t nbytes) { return 1 + ((size_t)nbytes + 3) / 4; }
