@@ -37,6 +37,10 @@ int rgb_addresses(PyObject *functions, void **out, Py_ssize_t count);
 /* A copy of `n` bytes (malloc; NULL only when memory runs out). */
 uint8_t *rgb_copy(const void *p, size_t n);
 int64_t rgb_now_ns(clockid_t clock);
+/* `n` as a Py_ssize_t, PY_SSIZE_T_MAX where it is larger. */
+static inline Py_ssize_t rgb_clamp(size_t n) {
+    return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n;
+}
 /* The loaded program or encoder `object` is, or NULL when it is not one (transcoders.c). */
 struct rgb_program *rgb_program_of(PyObject *object);
 struct rgb_encoder *rgb_encoder_of(PyObject *object);
