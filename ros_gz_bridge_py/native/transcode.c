@@ -113,14 +113,6 @@ static int put_frame(struct rgb_out *out, struct view s) {
 
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v);
 
-/* Reads the path at *op (count, then field numbers) and returns the message it reaches. */
-static int path(struct ctx *c, const int32_t **op, struct at v, struct at *out) {
-    int32_t nsteps = (*op)[0];
-    int status = pb_descend(c, v, *op + 1, nsteps, out);
-    *op += 1 + nsteps;
-    return status;
-}
-
 /* Counting, and then reading, the elements of a repeated scalar (packed or not). */
 struct scalars {
     int32_t type;
@@ -254,10 +246,14 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         int32_t code = *op++;
         struct at at;
         int status;
+        const char *layout = rgb_layout(rgb_op_layouts, OP_COUNT, code);
+        if (layout != NULL && layout[0] == 'P') { /* the message its path (count, steps) reaches */
+            status = pb_descend(c, v, op + 1, op[0], &at);
+            if (status) return status;
+            op += 1 + op[0];
+        }
         switch (code) {
         case OP_NUM: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             struct rgb_number val;
             status = pb_scalar(c, at, (uint32_t)op[0], op[1], &val);
             if (status) return status;
@@ -274,8 +270,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             break;
         }
         case OP_STR: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             struct field f;
             int found;
             status = pb_last_of(c, at, (uint32_t)op[0], &f, &found);
@@ -290,8 +284,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += rgb_text_span(op[0]);
             break;
         case OP_HEADER_STR: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             struct header_lookup h = {c, word_bytes(op + 1), (size_t)op[1], op[0], 0, {NULL, 0}};
             op += 1 + rgb_text_span(op[1]);
             status = pb_for_each(c, at, 2, header_entry, &h);
@@ -302,8 +294,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             break;
         }
         case OP_FIXED_LIST: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t type = op[1], kind = op[2], count = op[3];
             op += 4;
@@ -323,8 +313,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             break;
         }
         case OP_SEQ_MSG: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t body_len = op[1];
             const int32_t *body = op + 2;
@@ -349,8 +337,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         }
         case OP_COLUMN:
         case OP_COLUMN_STR: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t nsub = op[1];
             struct column col = {c, op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0, out};
@@ -369,8 +355,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             break;
         }
         case OP_CLOCK: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             int32_t part = op[0];
             op += 1;
             struct rgb_number sec, nsec;

@@ -3,14 +3,13 @@
  * body write at the least, which bounds a sequence before it is written. */
 #include "transcode_ops.h"
 
-/* Each op's operands (wire.h rgb_operands), by op code. */
-static const char *const LAYOUTS[] = {
+const char *const rgb_op_layouts[OP_COUNT] = {
     [OP_NUM] = "Pfskc",      [OP_CONST] = "kww",        [OP_STR] = "Pf",
     [OP_CONST_STR] = "T",    [OP_HEADER_STR] = "PcTT",  [OP_FIXED_LIST] = "Pfskn",
     [OP_SEQ_MSG] = "PfB",    [OP_COLUMN] = "PfPfsk",    [OP_COLUMN_STR] = "PfPf",
     [OP_CLOCK] = "Pc",       [OP_WALL_STAMP] = "",      [OP_CONST_BLOCK] = "aT",
 };
-#define LAYOUT(code) rgb_layout(LAYOUTS, sizeof LAYOUTS / sizeof *LAYOUTS, code)
+#define LAYOUT(code) rgb_layout(rgb_op_layouts, OP_COUNT, code)
 
 /* The fewest bytes the ops of a body (checked by check_ops) write for one element, whatever
  * its values: a CDR string or sequence writes at least its 4-byte length, a number or a fixed

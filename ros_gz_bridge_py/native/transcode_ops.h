@@ -23,6 +23,7 @@ enum {
     OP_CLOCK = 10,
     OP_CONST_BLOCK = 11,
     OP_WALL_STAMP = 12,
+    OP_COUNT
 };
 
 /* Deepest nesting validated natively; deeper payloads are left to Python. */
@@ -183,6 +184,8 @@ int32_t pb_element_type(struct ctx *c, struct at v, uint32_t number);
 
 /* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
 static inline const uint8_t *word_bytes(const int32_t *words) { return (const uint8_t *)(words + 1); }
+/* Each op's operands (wire.h rgb_operands), by op code (transcode_load.c). */
+extern const char *const rgb_op_layouts[OP_COUNT];
 /* The fewest bytes the ops of a body write for one element (see transcode_load.c). */
 size_t rgb_least_bytes(const int32_t *op, const int32_t *end);
 
