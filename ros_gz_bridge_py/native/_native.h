@@ -19,6 +19,7 @@
 
 #include "encode.h"
 #include "transcode.h"
+#include "wire.h"
 
 /* ---- the module (_native.c) --------------------------------------------------------------- */
 
@@ -97,9 +98,10 @@ typedef struct {
 
 /* The member `object` is (an initialised Pump or RosPump), or NULL. */
 struct rgb_member *rgb_member_of(PyObject *object);
-/* 0, or -1 with a RuntimeError while the loop that holds `m` runs it: Python may not change a
- * member then. */
-int rgb_member_idle(const struct rgb_member *m, const char *what);
+/* 0, or -1 with a RuntimeError (`unset`) where the member, a `what`, was never initialised
+ * (__new__ alone: no functions to call), or (`idle`) while the loop that holds it runs it:
+ * Python may not change a member then. */
+int rgb_member_usable(const struct rgb_member *m, int idle, const char *what, const char *unset);
 
 /* ---- a Gazebo -> ROS channel (pump.c, pump_loop.c) ------------------------------------------ */
 
@@ -278,8 +280,10 @@ typedef struct {
     unsigned long long received, own_skipped, rate_limited, published, take_errors,
         send_failures, bytes_read;
     unsigned long long lost; /* messages for Python that could not be copied (no memory) */
-    uint8_t **refused;
-    size_t *refused_len;
+    struct refused {
+        uint8_t *cdr;
+        size_t len;
+    } *refused; /* the messages for Python, copied */
     size_t nrefused, refused_cap;
     /* Set when the channel's socket or eventfd failed (an errno): it takes nothing more. */
     int failure;

@@ -87,14 +87,7 @@ static struct slot *frame_slot(struct reader *r, size_t frame, int32_t index) {
 static int new_frames(struct reader *r, size_t count, int32_t nslots, size_t *first) {
     if (nslots && count > (MAX_SLOTS - r->used) / (size_t)nslots) return RGB_FALLBACK;
     size_t need = r->used + count * (size_t)nslots;
-    if (need > r->cap) {
-        size_t cap = r->cap ? r->cap : 64;
-        while (cap < need) cap *= 2;
-        struct slot *pool = realloc(r->pool, cap * sizeof *pool);
-        if (pool == NULL) return RGB_FALLBACK;
-        r->pool = pool;
-        r->cap = cap;
-    }
+    if (rgb_reserve(&r->pool, &r->cap, need, sizeof *r->pool, 64)) return RGB_FALLBACK;
     /* nothing to clear for frames without slots (the pool may still be NULL then) */
     if (need > r->used) memset(r->pool + r->used, 0, (need - r->used) * sizeof *r->pool);
     *first = r->used;

@@ -110,14 +110,7 @@ static int push_node(struct ctx *c, int32_t msg, size_t *offset) {
     size_t size = sizeof(struct node) + (size_t)m[0] * sizeof(struct slot);
     if (size > MAX_SCRATCH - c->top) return RGB_FALLBACK;
     size_t need = c->top + size;
-    if (need > c->out->scratch_cap) {
-        size_t cap = c->out->scratch_cap ? c->out->scratch_cap : 4096;
-        while (cap < need) cap *= 2;
-        void *data = realloc(c->out->scratch, cap);
-        if (data == NULL) return RGB_FALLBACK;
-        c->out->scratch = data;
-        c->out->scratch_cap = cap;
-    }
+    if (rgb_reserve(&c->out->scratch, &c->out->scratch_cap, need, 1, 4096)) return RGB_FALLBACK;
     *offset = c->top;
     c->top = need;
     struct node *n = node_at(c, *offset);

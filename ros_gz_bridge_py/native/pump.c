@@ -17,14 +17,8 @@ _Static_assert(sizeof(struct zmq_foreign) == 9 * sizeof(void *), "the functions,
 /* Routes a full table keeps: the most recently used (and those a waiting message names). */
 #define KEEP_ROUTES (MAX_ROUTES / 2)
 
-/* 0, or -1 with a Python error when the pump was never initialised (Pump.__new__ alone) or
- * (`idle`) while the loop runs it. */
 static int usable(PumpObject *self, int idle) {
-    if (self->member.hooks == NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "the Pump is not initialised");
-        return -1;
-    }
-    return idle ? rgb_member_idle(&self->member, "Pump") : 0;
+    return rgb_member_usable(&self->member, idle, "Pump", "the Pump is not initialised");
 }
 
 static int out_of_loop(PumpObject *self, const char *what) {

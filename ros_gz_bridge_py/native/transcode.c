@@ -419,8 +419,6 @@ static size_t refusal_limit(size_t n) {
     return RGB_OUTPUT_FLOOR + 2 * RGB_OUTPUT_RATIO * n;
 }
 
-void rgb_out_trim(struct rgb_out *out) { rgb_trim(out); }
-
 enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
                                    size_t payload_len, struct rgb_out *out, size_t *steps) {
     static const uint8_t header[4] = {0, 1, 0, 0};

@@ -90,7 +90,7 @@ static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
                                rgb_clamp(self->out.refused.least));
     else
         result = outcome(status, &self->out);
-    rgb_out_trim(&self->out);
+    rgb_trim(&self->out);
     return result;
 }
 

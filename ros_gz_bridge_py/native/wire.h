@@ -183,6 +183,22 @@ static inline int rgb_grow(struct rgb_out *out, size_t extra) {
     return 0;
 }
 
+/* Makes room for `need` items of `size` bytes in the array at `array` (a pointer to it, NULL
+ * before its first item) of `*cap` items, the capacity doubled from `first`: 0, or -1 without
+ * memory (the array left as it was). */
+static inline int rgb_reserve(void *array, size_t *cap, size_t need, size_t size, size_t first) {
+    if (need <= *cap) return 0;
+    void *items;
+    memcpy(&items, array, sizeof items);
+    size_t grown = *cap ? *cap : first;
+    while (grown < need) grown *= 2;
+    items = realloc(items, grown * size);
+    if (items == NULL) return -1;
+    memcpy(array, &items, sizeof items);
+    *cap = grown;
+    return 0;
+}
+
 /* Buffers above this size are freed once used instead of kept for the next message. */
 #define RGB_KEEP_BYTES ((size_t)1 << 20)
 
