@@ -61,35 +61,23 @@ static int check_read(const int32_t *ops, size_t n, int32_t nslots, int depth) {
     return -1;
 }
 
-/* Checks write ops [0, n) against the read ops of their frame: each slot they use must be
- * one the read ops fill, with the right kind of content. `kinds[s]` is the read op code that
- * fills slot s (0: none), `frames[s]` the body of a message sequence. */
+/* What the read ops of a frame put in each of its slots, which its write ops are checked
+ * against: each slot they use must be one the read ops fill, with the right kind of content. */
 struct frame_info {
     int32_t nslots;
-    int32_t *codes;       /* per slot: the R_* op that fills it, 0 none */
-    int32_t *kinds;       /* per slot: its ROS kind (numbers) */
-    const int32_t **body; /* per slot: read body of a message sequence */
-    size_t *body_len;
-    int32_t *body_slots;
+    struct filled {
+        int32_t code;         /* the R_* op that fills it, 0 none */
+        int32_t kind;         /* its ROS kind (numbers) */
+        const int32_t *body;  /* a message sequence's read body, its length and slots */
+        size_t body_len;
+        int32_t body_slots;
+    } *slots;                 /* calloc'd: the caller frees it */
 };
 
-static void frame_free(struct frame_info *f) {
-    free(f->codes);
-    free(f->kinds);
-    free(f->body);
-    free(f->body_len);
-    free(f->body_slots);
-}
-
 static int frame_of(const int32_t *ops, size_t n, int32_t nslots, struct frame_info *f) {
-    size_t count = nslots > 0 ? (size_t)nslots : 1;
     f->nslots = nslots;
-    f->codes = calloc(count, sizeof *f->codes);
-    f->kinds = calloc(count, sizeof *f->kinds);
-    f->body = calloc(count, sizeof *f->body);
-    f->body_len = calloc(count, sizeof *f->body_len);
-    f->body_slots = calloc(count, sizeof *f->body_slots);
-    if (!f->codes || !f->kinds || !f->body || !f->body_len || !f->body_slots) return -1;
+    f->slots = calloc(nslots > 0 ? (size_t)nslots : 1, sizeof *f->slots);
+    if (f->slots == NULL) return -1;
     size_t at = 0, w[RGB_MAX_OPERANDS];
     while (at < n && ops[at] != R_END) {
         int32_t code = ops[at++];
@@ -97,13 +85,14 @@ static int frame_of(const int32_t *ops, size_t n, int32_t nslots, struct frame_i
         if (layout == NULL || rgb_operands(ops, n, &at, layout, nslots, w)) return -1;
         int32_t s = ops[w[strchr(layout, 'S') - layout]];
         if (s < 0) continue;
-        if (f->codes[s]) return -1; /* one op per slot */
-        f->codes[s] = code;
-        if (layout[0] == 'k') f->kinds[s] = ops[w[0]];
+        struct filled *slot = &f->slots[s];
+        if (slot->code) return -1; /* one op per slot */
+        slot->code = code;
+        if (layout[0] == 'k') slot->kind = ops[w[0]];
         if (code == R_SEQ_MSG) {
-            f->body[s] = ops + w[2] + 1;
-            f->body_len[s] = (size_t)ops[w[2]];
-            f->body_slots[s] = ops[w[1]];
+            slot->body = ops + w[2] + 1;
+            slot->body_len = (size_t)ops[w[2]];
+            slot->body_slots = ops[w[1]];
         }
     }
     return 0;
@@ -112,7 +101,7 @@ static int frame_of(const int32_t *ops, size_t n, int32_t nslots, struct frame_i
 static int check_write(const int32_t *ops, size_t n, const struct frame_info *f, int depth) {
     size_t at = 0, w[RGB_MAX_OPERANDS];
     if (depth > MAX_DEPTH) return -1;
-#define FILLED(s, code) ((s) >= 0 && (s) < f->nslots && f->codes[s] == (code))
+#define FILLED(s, c) ((s) >= 0 && (s) < f->nslots && f->slots[s].code == (c))
     while (at < n) {
         int32_t code = ops[at++];
         if (code == W_END) return at == n ? 0 : -1;
@@ -122,7 +111,7 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
         int ok = 1;
         switch (code) {
         case W_NUM: /* field, pb type, ros kind, conv, slot */
-            ok = FILLED(ops[w[4]], R_NUM) && f->kinds[ops[w[4]]] == ops[w[2]];
+            ok = FILLED(ops[w[4]], R_NUM) && f->slots[ops[w[4]]].kind == ops[w[2]];
             break;
         case W_STR:
         case W_STR_REP:
@@ -132,16 +121,17 @@ static int check_write(const int32_t *ops, size_t n, const struct frame_info *f,
             ok = !check_write(ops + w[1] + 1, (size_t)ops[w[1]], f, depth + 1);
             break;
         case W_SEQ_MSG: { /* field, slot, nslots, body */
-            if (!FILLED(s, R_SEQ_MSG) || ops[w[2]] != f->body_slots[s]) return -1;
+            if (!FILLED(s, R_SEQ_MSG) || ops[w[2]] != f->slots[s].body_slots) return -1;
+            const struct filled *sequence = &f->slots[s];
             struct frame_info element = {0};
-            ok = !frame_of(f->body[s], f->body_len[s], f->body_slots[s], &element) &&
+            ok = !frame_of(sequence->body, sequence->body_len, sequence->body_slots, &element) &&
                  !check_write(ops + w[3] + 1, (size_t)ops[w[3]], &element, depth + 1);
-            frame_free(&element);
+            free(element.slots);
             break;
         }
         case W_PACKED: /* field, pb type, ros kind, slot */
             ok = (FILLED(ops[w[3]], R_ARR) || FILLED(ops[w[3]], R_SEQ_NUM)) &&
-                 f->kinds[ops[w[3]]] == ops[w[2]];
+                 f->slots[ops[w[3]]].kind == ops[w[2]];
             break;
         case W_SEQ_STR:
             ok = FILLED(s, R_SEQ_STR);
@@ -171,7 +161,7 @@ int rgb_encoder_load(struct rgb_encoder *encoder, const int32_t *words, size_t l
     }
     struct frame_info top = {0};
     int bad = frame_of(read, read_len, words[0], &top) || check_write(write, write_len, &top, 0);
-    frame_free(&top);
+    free(top.slots);
     if (bad) {
         *why = "encoder: a write op is not well-formed";
         return -1;

@@ -247,13 +247,15 @@ static inline int rgb_room(size_t n, size_t at, size_t k) { return at <= n && k 
 
 /* The operands of one op, as both transcoders' ops are laid out (docs/native.md §3, §6): one
  * letter an operand in the op's layout, each letter one word unless said otherwise:
- *   w any word            f a field number (> 0)      F a protobuf field number (1 to 2^29 - 1:
- *   k a ROS kind          s a protobuf scalar type      the tag keeps 3 bits for the wire type)
- *   c 0 or 1 (a conversion, a flag)                   a an alignment (1, 2, 4 or 8)
- *   S a slot of a frame of `nslots` (-1: none)        n, N, m a count of 0 to 2^20, 2^24, 4096
- *   P a path: a count up to MAX_STEPS, then as many field numbers
- *   T a text: its length, then its bytes four to a word (rgb_text_span)
- *   B a body: its length (at least 1), then as many words, which the caller checks.
+ *   w  any word                          k  a ROS kind
+ *   f  a field number (> 0)              s  a protobuf scalar type (a number, not bytes)
+ *   F  a protobuf field number (1 to 2^29 - 1: the tag keeps 3 bits for the wire type)
+ *   c  0 or 1 (a conversion, a flag)     a  an alignment (1, 2, 4 or 8)
+ *   S  a slot of a frame of `nslots` (-1: none)
+ *   n, N, m  a count of 0 to 2^20, 2^24 or 4096
+ *   P  a path: a count up to MAX_STEPS, then as many field numbers
+ *   T  a text: its length, then its bytes four to a word (rgb_text_span)
+ *   B  a body: its length (at least 1), then as many words, which the caller checks.
  * Checks the operands at *at of ops[0..n) and advances past them; where[i] is the index of
  * operand i's (first) word. 0, or -1 when one is not well-formed or past the words. The loaders
  * check every op with it once; what walks loaded ops again uses it to find their operands. */
@@ -269,7 +271,7 @@ static inline int rgb_operands(const int32_t *ops, size_t n, size_t *at, const c
         case 'f': ok = w > 0; break;
         case 'F': ok = w >= 1 && w <= (1 << 29) - 1; break;
         case 'k': ok = w >= ROS_BOOL && w <= ROS_DOUBLE; break;
-        case 's': /* a number: not a string, group, message or bytes */
+        case 's': /* not a string, group, message or bytes */
             ok = (w >= PB_DOUBLE && w <= PB_BOOL) || (w >= PB_UINT32 && w <= PB_SINT64);
             break;
         case 'c': ok = w == 0 || w == 1; break;
