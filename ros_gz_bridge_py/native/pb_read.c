@@ -82,13 +82,13 @@ int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth) {
 
 /* ---- finding values (in a validated message) --------------------------------------------- */
 
-/* The last occurrence of field `number` (a singular field: the one Python keeps), found by
- * scanning `v`; found 0 when absent. */
-int pb_find_last(struct ctx *c, struct view v, uint32_t number, struct field *out,
-                     int *found) {
+/* The last occurrence of field `number` (a singular field: the one Python keeps), or the first
+ * (`first`: a repeated field's first element), found by scanning `v`; found 0 when absent. */
+int pb_find(struct ctx *c, struct view v, uint32_t number, int first, struct field *out,
+            int *found) {
     size_t pos = 0;
     *found = 0;
-    while (pos < v.n) {
+    while (pos < v.n && !(first && *found)) {
         struct field f;
         int status = read_field(c, v, &pos, &f);
         if (status) return status;
@@ -152,7 +152,7 @@ static int slot_of(struct ctx *c, struct at a, uint32_t number, const int32_t **
 
 int pb_last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, int *found) {
     int k = slot_of(c, a, number, NULL);
-    if (k < 0) return pb_find_last(c, a.v, number, out, found);
+    if (k < 0) return pb_find(c, a.v, number, 0, out, found);
     const struct slot *s = &node_at(c, a.node)->slots[k];
     *found = s->count > 0;
     if (*found) *out = s->last;

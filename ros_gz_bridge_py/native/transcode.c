@@ -183,7 +183,7 @@ static int column_element(void *ctx, const struct field *f) {
     if (c->kind == 0) {
         struct field s;
         int found;
-        status = pb_find_last(c->c, element.v, c->number, &s, &found);
+        status = pb_find(c->c, element.v, c->number, 0, &s, &found);
         if (status) return status;
         if (found && s.wire != WIRE_LEN) return RGB_FALLBACK;
         return found ? put_string(c->out, s.payload.p, s.payload.n) : put_string(c->out, NULL, 0);
@@ -219,24 +219,18 @@ static int header_entry(void *ctx, const struct field *f) {
     if (h->found && !h->last) return 0;
     if (f->wire != WIRE_LEN) return RGB_FALLBACK; /* f->payload is only set for WIRE_LEN */
     struct field key, value;
-    int found_key, status = pb_find_last(h->c, f->payload, 1, &key, &found_key);
+    int found_key, found_value, status = pb_find(h->c, f->payload, 1, 0, &key, &found_key);
     if (status) return status;
     if (found_key && key.wire != WIRE_LEN) return RGB_FALLBACK;
     struct view key_bytes = found_key ? key.payload : (struct view){NULL, 0};
     if (key_bytes.n != h->key_len || (h->key_len && memcmp(key_bytes.p, h->key, h->key_len)))
         return 0;
     /* value[0]: the first occurrence of field 2 */
-    size_t pos = 0;
-    while (pos < f->payload.n) {
-        status = read_field(h->c, f->payload, &pos, &value);
-        if (status) return status;
-        if (value.number == 2) {
-            if (value.wire != WIRE_LEN) return RGB_FALLBACK;
-            h->found = 1;
-            h->value = value.payload;
-            return 0;
-        }
-    }
+    status = pb_find(h->c, f->payload, 2, 1, &value, &found_value);
+    if (status || !found_value) return status;
+    if (value.wire != WIRE_LEN) return RGB_FALLBACK;
+    h->found = 1;
+    h->value = value.payload;
     return 0;
 }
 

@@ -160,8 +160,9 @@ struct at {
 int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth);
 /* Indexes `v`, a validated message of schema type `msg`, in one scan. */
 int pb_index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset);
-/* The last occurrence of field `number` in `v`, scanned (found 0 when absent). */
-int pb_find_last(struct ctx *c, struct view v, uint32_t number, struct field *out, int *found);
+/* The last (or `first`) occurrence of field `number` in `v`, scanned (found 0 when absent). */
+int pb_find(struct ctx *c, struct view v, uint32_t number, int first, struct field *out,
+            int *found);
 /* The same in `a`, from its index where it has one. */
 int pb_last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, int *found);
 /* The submessage reached through `steps` (an empty view where one is absent). */
