@@ -85,8 +85,12 @@ struct rgb_member *rgb_member_of(PyObject *object) {
     return m->hooks != NULL ? m : NULL;
 }
 
-int rgb_member_idle(const struct rgb_member *m, const char *what) {
-    if (m->running != NULL && atomic_load(m->running)) {
+int rgb_member_usable(const struct rgb_member *m, int idle, const char *what, const char *unset) {
+    if (m->hooks == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, unset);
+        return -1;
+    }
+    if (idle && m->running != NULL && atomic_load(m->running)) {
         PyErr_Format(PyExc_RuntimeError, "the %s's loop is running it", what);
         return -1;
     }

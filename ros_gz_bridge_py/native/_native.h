@@ -19,6 +19,7 @@
 
 #include "encode.h"
 #include "transcode.h"
+#include "wire.h"
 
 /* ---- the module (_native.c) --------------------------------------------------------------- */
 
@@ -37,6 +38,10 @@ int rgb_addresses(PyObject *functions, void **out, Py_ssize_t count);
 /* A copy of `n` bytes (malloc; NULL only when memory runs out). */
 uint8_t *rgb_copy(const void *p, size_t n);
 int64_t rgb_now_ns(clockid_t clock);
+/* `n` as a Py_ssize_t, PY_SSIZE_T_MAX where it is larger. */
+static inline Py_ssize_t rgb_clamp(size_t n) {
+    return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n;
+}
 /* The loaded program or encoder `object` is, or NULL when it is not one (transcoders.c). */
 struct rgb_program *rgb_program_of(PyObject *object);
 struct rgb_encoder *rgb_encoder_of(PyObject *object);
@@ -93,9 +98,10 @@ typedef struct {
 
 /* The member `object` is (an initialised Pump or RosPump), or NULL. */
 struct rgb_member *rgb_member_of(PyObject *object);
-/* 0, or -1 with a RuntimeError while the loop that holds `m` runs it: Python may not change a
- * member then. */
-int rgb_member_idle(const struct rgb_member *m, const char *what);
+/* 0, or -1 with a RuntimeError (`unset`) where the member, a `what`, was never initialised
+ * (__new__ alone: no functions to call), or (`idle`) while the loop that holds it runs it:
+ * Python may not change a member then. */
+int rgb_member_usable(const struct rgb_member *m, int idle, const char *what, const char *unset);
 
 /* ---- a Gazebo -> ROS channel (pump.c, pump_loop.c) ------------------------------------------ */
 
@@ -274,8 +280,10 @@ typedef struct {
     unsigned long long received, own_skipped, rate_limited, published, take_errors,
         send_failures, bytes_read;
     unsigned long long lost; /* messages for Python that could not be copied (no memory) */
-    uint8_t **refused;
-    size_t *refused_len;
+    struct refused {
+        uint8_t *cdr;
+        size_t len;
+    } *refused; /* the messages for Python, copied */
     size_t nrefused, refused_cap;
     /* Set when the channel's socket or eventfd failed (an errno): it takes nothing more. */
     int failure;

@@ -87,56 +87,12 @@ static struct slot *frame_slot(struct reader *r, size_t frame, int32_t index) {
 static int new_frames(struct reader *r, size_t count, int32_t nslots, size_t *first) {
     if (nslots && count > (MAX_SLOTS - r->used) / (size_t)nslots) return RGB_FALLBACK;
     size_t need = r->used + count * (size_t)nslots;
-    if (need > r->cap) {
-        size_t cap = r->cap ? r->cap : 64;
-        while (cap < need) cap *= 2;
-        struct slot *pool = realloc(r->pool, cap * sizeof *pool);
-        if (pool == NULL) return RGB_FALLBACK;
-        r->pool = pool;
-        r->cap = cap;
-    }
+    if (rgb_reserve(&r->pool, &r->cap, need, sizeof *r->pool, 64)) return RGB_FALLBACK;
     /* nothing to clear for frames without slots (the pool may still be NULL then) */
     if (need > r->used) memset(r->pool + r->used, 0, (need - r->used) * sizeof *r->pool);
     *first = r->used;
     r->used = need;
     return 0;
-}
-
-/* The fewest bytes a message read by ops [op, end) takes on the wire (alignment aside): a
- * lower bound that keeps a count from sizing more slots than the bytes can hold. */
-static size_t min_size(const int32_t *op, const int32_t *end) {
-    size_t size = 0;
-    while (op < end && *op != R_END) {
-        switch (*op++) {
-        case R_NUM:
-            size += rgb_ros_size(op[0]);
-            op += 2;
-            break;
-        case R_STR:
-            size += 5; /* the length and the NUL */
-            op += 1;
-            break;
-        case R_ARR:
-            size += rgb_ros_size(op[0]) * (size_t)op[1];
-            op += 3;
-            break;
-        case R_SEQ_NUM:
-            size += 4;
-            op += 2;
-            break;
-        case R_SEQ_STR:
-            size += 4;
-            op += 1;
-            break;
-        case R_SEQ_MSG:
-            size += 4;
-            op += 3 + op[2];
-            break;
-        default:
-            return 1;
-        }
-    }
-    return size ? size : 1;
 }
 
 /* Runs read ops [op, end) for the frame at `frame`. */
@@ -188,7 +144,7 @@ static int read_message(struct reader *r, const int32_t *op, const int32_t *end,
             status = cdr_u32(r, &count);
             if (status) return status;
             /* the elements must fit the bytes left before any slot is made for them */
-            if (count > (r->n - r->pos) / min_size(body, body + body_len)) return RGB_UNDECODABLE;
+            if (count > (r->n - r->pos) / enc_min_size(body, body + body_len)) return RGB_UNDECODABLE;
             size_t first;
             status = new_frames(r, count, nslots, &first);
             if (status) return status;

@@ -4,192 +4,142 @@
 #include "encode_ops.h"
 
 #include <stdlib.h>
+#include <string.h>
 
-static int kind_ok(int32_t kind) { return kind >= ROS_BOOL && kind <= ROS_DOUBLE; }
+/* Each read op's operands (wire.h rgb_operands; S: its slot), by op code. */
+static const char *const READ_LAYOUTS[] = {
+    [R_NUM] = "kS",     [R_STR] = "S",     [R_ARR] = "kNS",
+    [R_SEQ_NUM] = "kS", [R_SEQ_STR] = "S", [R_SEQ_MSG] = "SmB",
+};
+/* Each write op's operands; their slots (w) are checked against the frame's read ops. */
+static const char *const WRITE_LAYOUTS[] = {
+    [W_NUM] = "Fskcw", [W_STR] = "Fw",       [W_STR_REP] = "Fw",  [W_CONST_STR] = "FT",
+    [W_MSG] = "FB",    [W_SEQ_MSG] = "FwwB", [W_PACKED] = "Fskw", [W_SEQ_STR] = "Fw",
+};
+#define READ_LAYOUT(code) rgb_layout(READ_LAYOUTS, sizeof READ_LAYOUTS / sizeof *READ_LAYOUTS, code)
+#define WRITE_LAYOUT(code) \
+    rgb_layout(WRITE_LAYOUTS, sizeof WRITE_LAYOUTS / sizeof *WRITE_LAYOUTS, code)
 
-static int pb_ok(int32_t type) {
-    return (type >= PB_DOUBLE && type <= PB_BOOL) || (type >= PB_UINT32 && type <= PB_SINT64);
+/* The fewest bytes a message read by ops [op, end) takes on the wire (alignment aside): a
+ * lower bound that keeps a count from sizing more slots than the bytes can hold. */
+size_t enc_min_size(const int32_t *op, const int32_t *end) {
+    size_t size = 0, n = (size_t)(end - op), at = 0, w[RGB_MAX_OPERANDS];
+    while (at < n && op[at] != R_END) {
+        int32_t code = op[at++];
+        const char *layout = READ_LAYOUT(code);
+        if (layout == NULL || rgb_operands(op, n, &at, layout, INT32_MAX, w)) return 1;
+        switch (code) {
+        case R_NUM:
+            size += rgb_ros_size(op[w[0]]);
+            break;
+        case R_STR:
+            size += 5; /* the length and the NUL */
+            break;
+        case R_ARR:
+            size += rgb_ros_size(op[w[0]]) * (size_t)op[w[1]];
+            break;
+        default: /* a sequence's length */
+            size += 4;
+        }
+    }
+    return size ? size : 1;
 }
-
-/* A protobuf field number (1 to 2^29 - 1: the tag keeps 3 bits for the wire type). */
-static int field_ok(int32_t field) { return field >= 1 && field <= (1 << 29) - 1; }
-
 
 /* Checks read ops [0, n) of a frame of `nslots` slots. */
 static int check_read(const int32_t *ops, size_t n, int32_t nslots, int depth) {
-    size_t at = 0;
+    size_t at = 0, w[RGB_MAX_OPERANDS];
     if (depth > MAX_DEPTH) return -1;
-#define SLOT_OK(s) ((s) >= -1 && (s) < nslots)
     while (at < n) {
         int32_t code = ops[at++];
-        switch (code) {
-        case R_END:
-            return at == n ? 0 : -1;
-        case R_NUM:
-        case R_SEQ_NUM:
-            if (rgb_room(n, at, 2) || !kind_ok(ops[at]) || !SLOT_OK(ops[at + 1])) return -1;
-            at += 2;
-            break;
-        case R_STR:
-        case R_SEQ_STR:
-            if (rgb_room(n, at, 1) || !SLOT_OK(ops[at])) return -1;
-            at += 1;
-            break;
-        case R_ARR:
-            if (rgb_room(n, at, 3) || !kind_ok(ops[at]) || ops[at + 1] < 0 || ops[at + 1] > (1 << 24) ||
-                !SLOT_OK(ops[at + 2]))
-                return -1;
-            at += 3;
-            break;
-        case R_SEQ_MSG:
-            if (rgb_room(n, at, 3) || !SLOT_OK(ops[at]) || ops[at + 1] < 0 || ops[at + 1] > 4096 ||
-                ops[at + 2] < 1 || rgb_room(n, at + 3, (size_t)ops[at + 2]) ||
-                check_read(ops + at + 3, (size_t)ops[at + 2], ops[at + 1], depth + 1))
-                return -1;
-            at += 3 + (size_t)ops[at + 2];
-            break;
-        default:
+        if (code == R_END) return at == n ? 0 : -1;
+        const char *layout = READ_LAYOUT(code);
+        if (layout == NULL || rgb_operands(ops, n, &at, layout, nslots, w)) return -1;
+        if (code == R_SEQ_MSG &&
+            check_read(ops + w[2] + 1, (size_t)ops[w[2]], ops[w[1]], depth + 1))
             return -1;
-        }
     }
-#undef SLOT_OK
     return -1;
 }
 
-/* Checks write ops [0, n) against the read ops of their frame: each slot they use must be
- * one the read ops fill, with the right kind of content. `kinds[s]` is the read op code that
- * fills slot s (0: none), `frames[s]` the body of a message sequence. */
+/* What the read ops of a frame put in each of its slots, which its write ops are checked
+ * against: each slot they use must be one the read ops fill, with the right kind of content. */
 struct frame_info {
     int32_t nslots;
-    int32_t *codes;       /* per slot: the R_* op that fills it, 0 none */
-    int32_t *kinds;       /* per slot: its ROS kind (numbers) */
-    const int32_t **body; /* per slot: read body of a message sequence */
-    size_t *body_len;
-    int32_t *body_slots;
+    struct filled {
+        int32_t code;         /* the R_* op that fills it, 0 none */
+        int32_t kind;         /* its ROS kind (numbers) */
+        const int32_t *body;  /* a message sequence's read body, its length and slots */
+        size_t body_len;
+        int32_t body_slots;
+    } *slots;                 /* calloc'd: the caller frees it */
 };
 
-static void frame_free(struct frame_info *f) {
-    free(f->codes);
-    free(f->kinds);
-    free(f->body);
-    free(f->body_len);
-    free(f->body_slots);
-}
-
 static int frame_of(const int32_t *ops, size_t n, int32_t nslots, struct frame_info *f) {
-    size_t count = nslots > 0 ? (size_t)nslots : 1;
     f->nslots = nslots;
-    f->codes = calloc(count, sizeof *f->codes);
-    f->kinds = calloc(count, sizeof *f->kinds);
-    f->body = calloc(count, sizeof *f->body);
-    f->body_len = calloc(count, sizeof *f->body_len);
-    f->body_slots = calloc(count, sizeof *f->body_slots);
-    if (!f->codes || !f->kinds || !f->body || !f->body_len || !f->body_slots) return -1;
-    size_t at = 0;
+    f->slots = calloc(nslots > 0 ? (size_t)nslots : 1, sizeof *f->slots);
+    if (f->slots == NULL) return -1;
+    size_t at = 0, w[RGB_MAX_OPERANDS];
     while (at < n && ops[at] != R_END) {
         int32_t code = ops[at++];
-        int32_t s = -1;
-        switch (code) {
-        case R_NUM:
-        case R_SEQ_NUM:
-            s = ops[at + 1];
-            if (s >= 0) f->kinds[s] = ops[at];
-            at += 2;
-            break;
-        case R_STR:
-        case R_SEQ_STR:
-            s = ops[at];
-            at += 1;
-            break;
-        case R_ARR:
-            s = ops[at + 2];
-            if (s >= 0) f->kinds[s] = ops[at];
-            at += 3;
-            break;
-        case R_SEQ_MSG:
-            s = ops[at];
-            if (s >= 0) {
-                f->body[s] = ops + at + 3;
-                f->body_len[s] = (size_t)ops[at + 2];
-                f->body_slots[s] = ops[at + 1];
-            }
-            at += 3 + (size_t)ops[at + 2];
-            break;
-        default:
-            return -1;
-        }
-        if (s >= 0) {
-            if (f->codes[s]) return -1; /* one op per slot */
-            f->codes[s] = code;
+        const char *layout = READ_LAYOUT(code);
+        if (layout == NULL || rgb_operands(ops, n, &at, layout, nslots, w)) return -1;
+        int32_t s = ops[w[strchr(layout, 'S') - layout]];
+        if (s < 0) continue;
+        struct filled *slot = &f->slots[s];
+        if (slot->code) return -1; /* one op per slot */
+        slot->code = code;
+        if (layout[0] == 'k') slot->kind = ops[w[0]];
+        if (code == R_SEQ_MSG) {
+            slot->body = ops + w[2] + 1;
+            slot->body_len = (size_t)ops[w[2]];
+            slot->body_slots = ops[w[1]];
         }
     }
     return 0;
 }
 
 static int check_write(const int32_t *ops, size_t n, const struct frame_info *f, int depth) {
-    size_t at = 0;
+    size_t at = 0, w[RGB_MAX_OPERANDS];
     if (depth > MAX_DEPTH) return -1;
-#define FILLED(s, code) ((s) >= 0 && (s) < f->nslots && f->codes[s] == (code))
+#define FILLED(s, c) ((s) >= 0 && (s) < f->nslots && f->slots[s].code == (c))
     while (at < n) {
         int32_t code = ops[at++];
+        if (code == W_END) return at == n ? 0 : -1;
+        const char *layout = WRITE_LAYOUT(code);
+        if (layout == NULL || rgb_operands(ops, n, &at, layout, 0, w)) return -1;
+        int32_t s = ops[w[1]]; /* the slot, where it is the second operand */
+        int ok = 1;
         switch (code) {
-        case W_END:
-            return at == n ? 0 : -1;
-        case W_NUM:
-            if (rgb_room(n, at, 5) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
-                !kind_ok(ops[at + 2]) ||
-                (ops[at + 3] != CONV_EXACT && ops[at + 3] != CONV_WRAP) ||
-                !FILLED(ops[at + 4], R_NUM) || f->kinds[ops[at + 4]] != ops[at + 2])
-                return -1;
-            at += 5;
+        case W_NUM: /* field, pb type, ros kind, conv, slot */
+            ok = FILLED(ops[w[4]], R_NUM) && f->slots[ops[w[4]]].kind == ops[w[2]];
             break;
         case W_STR:
         case W_STR_REP:
-            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_STR)) return -1;
-            at += 2;
-            break;
-        case W_CONST_STR:
-            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 0 ||
-                rgb_room(n, at + 1, rgb_text_span(ops[at + 1])))
-                return -1;
-            at += 1 + rgb_text_span(ops[at + 1]);
+            ok = FILLED(s, R_STR);
             break;
         case W_MSG:
-            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || ops[at + 1] < 1 ||
-                rgb_room(n, at + 2, (size_t)ops[at + 1]) ||
-                check_write(ops + at + 2, (size_t)ops[at + 1], f, depth + 1))
-                return -1;
-            at += 2 + (size_t)ops[at + 1];
+            ok = !check_write(ops + w[1] + 1, (size_t)ops[w[1]], f, depth + 1);
             break;
-        case W_SEQ_MSG: {
-            if (rgb_room(n, at, 4) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_MSG) ||
-                ops[at + 2] != f->body_slots[ops[at + 1]] || ops[at + 3] < 1 ||
-                rgb_room(n, at + 4, (size_t)ops[at + 3]))
-                return -1;
+        case W_SEQ_MSG: { /* field, slot, nslots, body */
+            if (!FILLED(s, R_SEQ_MSG) || ops[w[2]] != f->slots[s].body_slots) return -1;
+            const struct filled *sequence = &f->slots[s];
             struct frame_info element = {0};
-            int32_t s = ops[at + 1];
-            int bad = frame_of(f->body[s], f->body_len[s], f->body_slots[s], &element) ||
-                      check_write(ops + at + 4, (size_t)ops[at + 3], &element, depth + 1);
-            frame_free(&element);
-            if (bad) return -1;
-            at += 4 + (size_t)ops[at + 3];
+            ok = !frame_of(sequence->body, sequence->body_len, sequence->body_slots, &element) &&
+                 !check_write(ops + w[3] + 1, (size_t)ops[w[3]], &element, depth + 1);
+            free(element.slots);
             break;
         }
-        case W_PACKED:
-            if (rgb_room(n, at, 4) || !field_ok(ops[at]) || !pb_ok(ops[at + 1]) ||
-                !kind_ok(ops[at + 2]) ||
-                !(FILLED(ops[at + 3], R_ARR) || FILLED(ops[at + 3], R_SEQ_NUM)) ||
-                f->kinds[ops[at + 3]] != ops[at + 2])
-                return -1;
-            at += 4;
+        case W_PACKED: /* field, pb type, ros kind, slot */
+            ok = (FILLED(ops[w[3]], R_ARR) || FILLED(ops[w[3]], R_SEQ_NUM)) &&
+                 f->slots[ops[w[3]]].kind == ops[w[2]];
             break;
         case W_SEQ_STR:
-            if (rgb_room(n, at, 2) || !field_ok(ops[at]) || !FILLED(ops[at + 1], R_SEQ_STR)) return -1;
-            at += 2;
+            ok = FILLED(s, R_SEQ_STR);
             break;
-        default:
-            return -1;
+        default: /* W_CONST_STR: its operands say it all */
+            break;
         }
+        if (!ok) return -1;
     }
 #undef FILLED
     return -1;
@@ -211,7 +161,7 @@ int rgb_encoder_load(struct rgb_encoder *encoder, const int32_t *words, size_t l
     }
     struct frame_info top = {0};
     int bad = frame_of(read, read_len, words[0], &top) || check_write(write, write_len, &top, 0);
-    frame_free(&top);
+    free(top.slots);
     if (bad) {
         *why = "encoder: a write op is not well-formed";
         return -1;

@@ -59,6 +59,8 @@ static inline uint64_t load(const uint8_t *b, size_t size) {
 
 /* Reads a CDR string at r->pos into `s` (its bytes without the NUL; s may be NULL). */
 int enc_cdr_string(struct reader *r, struct slot *s);
+/* The fewest bytes a message read by ops [op, end) takes (encode_load.c). */
+size_t enc_min_size(const int32_t *op, const int32_t *end);
 /* Runs write ops [op, end) for the frame at `frame` into `out`. */
 int enc_write_message(const struct reader *r, const int32_t *op, const int32_t *end,
                       size_t frame, struct rgb_out *out, int depth);

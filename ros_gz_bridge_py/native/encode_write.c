@@ -127,21 +127,14 @@ static int pb_value(int32_t type, int32_t conv, struct rgb_number v, uint64_t *w
 
 static int put_value(struct rgb_out *out, int32_t type, uint64_t wire) {
     switch (rgb_wire_of(type)) {
-    case 1: {
-        uint8_t b[8];
-        for (int k = 0; k < 8; k++) b[k] = (uint8_t)(wire >> (8 * k));
-        return rgb_put(out, b, 8);
-    }
-    case 5: {
-        uint8_t b[4];
-        for (int k = 0; k < 4; k++) b[k] = (uint8_t)(wire >> (8 * k));
-        return rgb_put(out, b, 4);
-    }
+    case WIRE_I64:
+        return rgb_put_le(out, wire, 8);
+    case WIRE_I32:
+        return rgb_put_le(out, wire, 4);
     default:
         return put_varint(out, wire);
     }
 }
-
 
 /* Starts a length-delimited value: room for its length, filled in by close_length. */
 static int open_length(struct rgb_out *out, size_t *mark) {

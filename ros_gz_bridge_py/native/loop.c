@@ -25,7 +25,7 @@
  * which `add` and `remove` take too, and epoll names a member by its slot and a generation, so
  * once `remove` returns no pass touches the member and no event read before can reach it: its
  * socket or subscription may go. While the loop runs, a member refuses Python calls that would
- * change what a pass reads (rgb_member_idle). */
+ * change what a pass reads (rgb_member_usable). */
 #include "_native.h"
 
 #include <errno.h>

@@ -42,7 +42,6 @@ static int validate_packed(struct view run, int32_t type) {
     return 0;
 }
 
-/* Validates message `v` of schema type `msg`, as the Python runtime's parse would. */
 int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth) {
     if (depth > MAX_DEPTH) return RGB_FALLBACK;
     const int32_t *m = message_words(c->pr, msg);
@@ -83,13 +82,13 @@ int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth) {
 
 /* ---- finding values (in a validated message) --------------------------------------------- */
 
-/* The last occurrence of field `number` (a singular field: the one Python keeps), found by
- * scanning `v`; found 0 when absent. */
-int pb_find_last(struct ctx *c, struct view v, uint32_t number, struct field *out,
-                     int *found) {
+/* The last occurrence of field `number` (a singular field: the one Python keeps), or the first
+ * (`first`: a repeated field's first element), found by scanning `v`; found 0 when absent. */
+int pb_find(struct ctx *c, struct view v, uint32_t number, int first, struct field *out,
+            int *found) {
     size_t pos = 0;
     *found = 0;
-    while (pos < v.n) {
+    while (pos < v.n && !(first && *found)) {
         struct field f;
         int status = read_field(c, v, &pos, &f);
         if (status) return status;
@@ -111,14 +110,7 @@ static int push_node(struct ctx *c, int32_t msg, size_t *offset) {
     size_t size = sizeof(struct node) + (size_t)m[0] * sizeof(struct slot);
     if (size > MAX_SCRATCH - c->top) return RGB_FALLBACK;
     size_t need = c->top + size;
-    if (need > c->out->scratch_cap) {
-        size_t cap = c->out->scratch_cap ? c->out->scratch_cap : 4096;
-        while (cap < need) cap *= 2;
-        void *data = realloc(c->out->scratch, cap);
-        if (data == NULL) return RGB_FALLBACK;
-        c->out->scratch = data;
-        c->out->scratch_cap = cap;
-    }
+    if (rgb_reserve(&c->out->scratch, &c->out->scratch_cap, need, 1, 4096)) return RGB_FALLBACK;
     *offset = c->top;
     c->top = need;
     struct node *n = node_at(c, *offset);
@@ -128,7 +120,6 @@ static int push_node(struct ctx *c, int32_t msg, size_t *offset) {
     return 0;
 }
 
-/* Indexes `v`, a validated message of schema type `msg`, in one scan. */
 int pb_index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset) {
     int status = push_node(c, msg, offset);
     if (status) return status;
@@ -159,10 +150,9 @@ static int slot_of(struct ctx *c, struct at a, uint32_t number, const int32_t **
     return k;
 }
 
-/* The last occurrence of field `number` in `a`; found 0 when absent. */
 int pb_last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, int *found) {
     int k = slot_of(c, a, number, NULL);
-    if (k < 0) return pb_find_last(c, a.v, number, out, found);
+    if (k < 0) return pb_find(c, a.v, number, 0, out, found);
     const struct slot *s = &node_at(c, a.node)->slots[k];
     *found = s->count > 0;
     if (*found) *out = s->last;
@@ -200,8 +190,7 @@ int pb_descend(struct ctx *c, struct at a, const int32_t *steps, int32_t nsteps,
     return 0;
 }
 
-/* The value of one scalar element of protobuf `type` from its wire form. */
-struct rgb_number pb_decode_scalar(int32_t type, const struct field *f, uint64_t raw) {
+struct rgb_number pb_decode_scalar(int32_t type, uint64_t raw) {
     struct rgb_number val = {0, 0, 0, 0, 0.0};
     switch (type) {
     case PB_DOUBLE:
@@ -238,27 +227,23 @@ struct rgb_number pb_decode_scalar(int32_t type, const struct field *f, uint64_t
     default:
         break;
     }
-    (void)f;
     return val;
 }
 
-/* The raw bits of a non-packed scalar field. */
 uint64_t pb_raw_of(const struct field *f) {
     if (f->wire == WIRE_VARINT) return f->varint;
     if (f->wire == WIRE_I64) return le64(f->payload.p);
     return le32(f->payload.p);
 }
 
-/* The value of singular scalar `number` of protobuf `type` in `v` (0 when absent). */
 int pb_scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct rgb_number *val) {
     struct field f;
     int found, status = pb_last_of(c, v, number, &f, &found);
     if (status) return status;
     if (found && f.wire != rgb_wire_of(type)) return RGB_FALLBACK;
-    *val = pb_decode_scalar(type, &f, found ? pb_raw_of(&f) : 0);
+    *val = pb_decode_scalar(type, found ? pb_raw_of(&f) : 0);
     return 0;
 }
-
 
 int pb_for_each(struct ctx *c, struct at v, uint32_t number, element_fn each, void *arg) {
     size_t pos = 0, end = v.v.n;
@@ -280,14 +265,12 @@ int pb_for_each(struct ctx *c, struct at v, uint32_t number, element_fn each, vo
     return 0;
 }
 
-
 static int count_field(void *ctx, const struct field *f) {
     (void)f;
     (*(size_t *)ctx)++;
     return 0;
 }
 
-/* The number of occurrences of field `number` in `v`. */
 int pb_count_of(struct ctx *c, struct at v, uint32_t number, size_t *count) {
     int k = slot_of(c, v, number, NULL);
     if (k >= 0) {
@@ -298,7 +281,6 @@ int pb_count_of(struct ctx *c, struct at v, uint32_t number, size_t *count) {
     return pb_for_each(c, v, number, count_field, count);
 }
 
-/* The schema type of the elements of message field `number` of `v`, or -1 where unknown. */
 int32_t pb_element_type(struct ctx *c, struct at v, uint32_t number) {
     const int32_t *sf = NULL;
     if (slot_of(c, v, number, &sf) < 0 || sf[1] != PB_MESSAGE) return -1;

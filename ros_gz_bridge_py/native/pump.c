@@ -17,14 +17,8 @@ _Static_assert(sizeof(struct zmq_foreign) == 9 * sizeof(void *), "the functions,
 /* Routes a full table keeps: the most recently used (and those a waiting message names). */
 #define KEEP_ROUTES (MAX_ROUTES / 2)
 
-/* 0, or -1 with a Python error when the pump was never initialised (Pump.__new__ alone) or
- * (`idle`) while the loop runs it. */
 static int usable(PumpObject *self, int idle) {
-    if (self->member.hooks == NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "the Pump is not initialised");
-        return -1;
-    }
-    return idle ? rgb_member_idle(&self->member, "Pump") : 0;
+    return rgb_member_usable(&self->member, idle, "Pump", "the Pump is not initialised");
 }
 
 static int out_of_loop(PumpObject *self, const char *what) {
@@ -276,8 +270,6 @@ static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     Py_RETURN_NONE;
 }
 
-static Py_ssize_t clamp(size_t n) { return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n; }
-
 /* One handed message for Python: its frames (a list of bytes), a Refused or a TooLarge. */
 static PyObject *handed_item(PumpObject *self, const struct handed *h) {
     if (h->kind == HANDED_UNROUTED) {
@@ -293,8 +285,9 @@ static PyObject *handed_item(PumpObject *self, const struct handed *h) {
     if (h->kind == HANDED_TOO_LARGE)
         return rgb_record(rgb_records.too_large,
                           Py_BuildValue("(y#y#nnn)", (char *)r->sender, (Py_ssize_t)r->sender_len,
-                                        (char *)r->type, (Py_ssize_t)r->type_len, clamp(h->items),
-                                        clamp(h->least), clamp(h->payload_size)));
+                                        (char *)r->type, (Py_ssize_t)r->type_len,
+                                        rgb_clamp(h->items), rgb_clamp(h->least),
+                                        rgb_clamp(h->payload_size)));
     return rgb_record(rgb_records.refused,
                       Py_BuildValue("(y#y#y#i)", (char *)r->sender, (Py_ssize_t)r->sender_len,
                                     (char *)r->type, (Py_ssize_t)r->type_len, (char *)h->data[0],
@@ -328,8 +321,9 @@ static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
     pump_clear_handover(self);
     PyObject *handover = NULL;
     if (!failed) {
-        handover = rgb_record(rgb_records.handover, Py_BuildValue("(OOOn)", lists[0], lists[1],
-                                                                  lists[2], clamp(self->grown)));
+        handover = rgb_record(rgb_records.handover,
+                              Py_BuildValue("(OOOn)", lists[0], lists[1], lists[2],
+                                            rgb_clamp(self->grown)));
         if (handover != NULL) self->grown = 0;
     }
     for (int k = 0; k < 3; k++) Py_XDECREF(lists[k]);

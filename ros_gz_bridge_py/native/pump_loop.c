@@ -84,15 +84,10 @@ void pump_clear_handover(PumpObject *self) {
 
 /* A new entry of the hand-over (NULL, counted as lost, when memory runs out). */
 static struct handed *hand(PumpObject *self, int kind, int route, int status) {
-    if (self->nhanded == self->handed_cap) {
-        size_t cap = self->handed_cap ? self->handed_cap * 2 : 16;
-        struct handed *grown = realloc(self->handover, cap * sizeof *grown);
-        if (grown == NULL) {
-            self->lost++;
-            return NULL;
-        }
-        self->handover = grown;
-        self->handed_cap = cap;
+    if (rgb_reserve(&self->handover, &self->handed_cap, self->nhanded + 1,
+                    sizeof *self->handover, 16)) {
+        self->lost++;
+        return NULL;
     }
     struct handed *h = &self->handover[self->nhanded++];
     memset(h, 0, sizeof *h);
@@ -216,7 +211,7 @@ static void deliver(PumpObject *self, struct queued *q) {
         uint64_t sequence = pump_begin_publication(self);
         int ret = self->f.publish(self->publisher, &message, NULL);
         pump_end_publication(self, sequence, ret == 0);
-        rgb_out_trim(&self->out); /* a large message's buffer goes back at once */
+        rgb_trim(&self->out); /* a large message's buffer goes back at once */
         if (ret == 0) {
             self->published++;
             return;

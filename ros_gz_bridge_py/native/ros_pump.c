@@ -17,13 +17,10 @@
 
 /* ---- Python -------------------------------------------------------------------------------- */
 
-/* Every method first: an object made by __new__ alone has no functions to call. */
+/* Every method first (rgb_member_usable). */
 static int usable(RosPumpObject *self, int idle) {
-    if (self->member.hooks == NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "the RosPump is not initialised (call __init__)");
-        return -1;
-    }
-    return idle ? rgb_member_idle(&self->member, "RosPump") : 0;
+    const char *unset = "the RosPump is not initialised (call __init__)";
+    return rgb_member_usable(&self->member, idle, "RosPump", unset);
 }
 
 static void ros_pump_dealloc(RosPumpObject *self) {
@@ -39,7 +36,6 @@ static void ros_pump_dealloc(RosPumpObject *self) {
     for (int i = 0; i < MAX_SPELLINGS; i++) rgb_out_free(&self->out[i]);
     ros_pump_clear_refused(self);
     free(self->refused);
-    free(self->refused_len);
     Py_XDECREF(self->encoders);
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
@@ -183,8 +179,8 @@ static PyObject *ros_pump_take_handed(RosPumpObject *self, PyObject *unused) {
     PyObject *refused = PyList_New(0);
     if (refused == NULL) self->lost += self->nrefused;
     for (size_t k = 0; refused != NULL && k < self->nrefused; k++) {
-        PyObject *cdr = PyBytes_FromStringAndSize((char *)self->refused[k],
-                                                  (Py_ssize_t)self->refused_len[k]);
+        PyObject *cdr = PyBytes_FromStringAndSize((char *)self->refused[k].cdr,
+                                                  (Py_ssize_t)self->refused[k].len);
         if (cdr == NULL) {
             PyErr_Clear();
             self->lost++;

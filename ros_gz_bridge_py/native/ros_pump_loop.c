@@ -36,29 +36,19 @@ static int is_ignored(const RosPumpObject *self, const rmw_gid *gid) {
 /* Hands a message to Python as a copy. When memory runs out it is counted as lost instead
  * (never handed over empty: an empty payload would be sent as an all-default message). */
 static void refuse(RosPumpObject *self, const uint8_t *cdr, size_t len) {
-    if (self->nrefused == self->refused_cap) {
-        size_t cap = self->refused_cap ? self->refused_cap * 2 : 16;
-        uint8_t **grown = realloc(self->refused, cap * sizeof *grown);
-        if (grown != NULL) self->refused = grown;
-        size_t *grown_len = realloc(self->refused_len, cap * sizeof *grown_len);
-        if (grown_len != NULL) self->refused_len = grown_len;
-        if (grown == NULL || grown_len == NULL) {
-            self->lost++;
-            return;
-        }
-        self->refused_cap = cap;
-    }
-    uint8_t *copy = rgb_copy(cdr, len);
+    uint8_t *copy = NULL;
+    if (!rgb_reserve(&self->refused, &self->refused_cap, self->nrefused + 1,
+                     sizeof *self->refused, 16))
+        copy = rgb_copy(cdr, len);
     if (copy == NULL) {
         self->lost++;
         return;
     }
-    self->refused[self->nrefused] = copy;
-    self->refused_len[self->nrefused++] = len;
+    self->refused[self->nrefused++] = (struct refused){copy, len};
 }
 
 void ros_pump_clear_refused(RosPumpObject *self) {
-    for (size_t i = 0; i < self->nrefused; i++) free(self->refused[i]);
+    for (size_t i = 0; i < self->nrefused; i++) free(self->refused[i].cdr);
     self->nrefused = 0;
 }
 

@@ -26,10 +26,7 @@ static int align(struct rgb_out *out, size_t size) {
 
 static int put_u32(struct rgb_out *out, uint32_t value) {
     int status = align(out, 4);
-    if (status) return status;
-    uint8_t b[4] = {(uint8_t)value, (uint8_t)(value >> 8), (uint8_t)(value >> 16),
-                    (uint8_t)(value >> 24)};
-    return rgb_put(out, b, 4);
+    return status ? status : rgb_put_le(out, value, 4);
 }
 
 /* Writes `val` as ROS `kind` the way the Python path would, or RGB_FALLBACK where Python
@@ -52,10 +49,7 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
     }
     if (val.is_float) return RGB_FALLBACK;
     uint64_t bits = val.is_unsigned ? val.u : (uint64_t)val.i;
-    if (kind == ROS_BOOL) {
-        b[0] = val.i != 0;
-        return rgb_put(out, b, 1);
-    }
+    if (kind == ROS_BOOL) return rgb_put_le(out, val.i != 0, 1);
     if (conv == CONV_EXACT) {
         int ok;
         int64_t i = val.i;
@@ -72,8 +66,7 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
         }
         if (!ok) return RGB_FALLBACK;
     }
-    for (size_t k = 0; k < size; k++) b[k] = (uint8_t)(bits >> (8 * k));
-    return rgb_put(out, b, size);
+    return rgb_put_le(out, bits, size);
 }
 
 /* A CDR string: length with the NUL, the bytes, the NUL. A NUL inside is left to Python. */
@@ -120,14 +113,6 @@ static int put_frame(struct rgb_out *out, struct view s) {
 
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v);
 
-/* Reads the path at *op (count, then field numbers) and returns the message it reaches. */
-static int path(struct ctx *c, const int32_t **op, struct at v, struct at *out) {
-    int32_t nsteps = (*op)[0];
-    int status = pb_descend(c, v, *op + 1, nsteps, out);
-    *op += 1 + nsteps;
-    return status;
-}
-
 /* Counting, and then reading, the elements of a repeated scalar (packed or not). */
 struct scalars {
     int32_t type;
@@ -143,20 +128,12 @@ static int scalar_element(void *ctx, const struct field *f) {
         size_t pos = 0;
         while (pos < f->payload.n) {
             struct field one = {f->number, wire, 0, {NULL, 0}};
-            if (wire == WIRE_VARINT) {
-                int status = read_varint(f->payload, &pos, &one.varint);
-                if (status) return status;
-            } else {
-                size_t size = wire == WIRE_I64 ? 8 : 4;
-                if (f->payload.n - pos < size) return RGB_UNDECODABLE;
-                one.payload.p = f->payload.p + pos;
-                one.payload.n = size;
-                pos += size;
-            }
+            int status = read_value(f->payload, &pos, wire, &one);
+            if (status) return status;
             s->count++;
             if (s->kind) {
-                int status = put_value(s->out, s->kind, CONV_EXACT,
-                                       pb_decode_scalar(s->type, &one, pb_raw_of(&one)));
+                status = put_value(s->out, s->kind, CONV_EXACT,
+                                   pb_decode_scalar(s->type, pb_raw_of(&one)));
                 if (status) return status;
             }
         }
@@ -165,7 +142,7 @@ static int scalar_element(void *ctx, const struct field *f) {
     if (f->wire != wire) return RGB_FALLBACK;
     s->count++;
     if (!s->kind) return 0;
-    return put_value(s->out, s->kind, CONV_EXACT, pb_decode_scalar(s->type, f, pb_raw_of(f)));
+    return put_value(s->out, s->kind, CONV_EXACT, pb_decode_scalar(s->type, pb_raw_of(f)));
 }
 /* The elements of a repeated submessage field, each indexed (when its type is known) and run
  * through a body of ops; the element's index is popped after. */
@@ -206,7 +183,7 @@ static int column_element(void *ctx, const struct field *f) {
     if (c->kind == 0) {
         struct field s;
         int found;
-        status = pb_find_last(c->c, element.v, c->number, &s, &found);
+        status = pb_find(c->c, element.v, c->number, 0, &s, &found);
         if (status) return status;
         if (found && s.wire != WIRE_LEN) return RGB_FALLBACK;
         return found ? put_string(c->out, s.payload.p, s.payload.n) : put_string(c->out, NULL, 0);
@@ -242,28 +219,20 @@ static int header_entry(void *ctx, const struct field *f) {
     if (h->found && !h->last) return 0;
     if (f->wire != WIRE_LEN) return RGB_FALLBACK; /* f->payload is only set for WIRE_LEN */
     struct field key, value;
-    int found_key, status = pb_find_last(h->c, f->payload, 1, &key, &found_key);
+    int found_key, found_value, status = pb_find(h->c, f->payload, 1, 0, &key, &found_key);
     if (status) return status;
     if (found_key && key.wire != WIRE_LEN) return RGB_FALLBACK;
     struct view key_bytes = found_key ? key.payload : (struct view){NULL, 0};
     if (key_bytes.n != h->key_len || (h->key_len && memcmp(key_bytes.p, h->key, h->key_len)))
         return 0;
     /* value[0]: the first occurrence of field 2 */
-    size_t pos = 0;
-    while (pos < f->payload.n) {
-        status = read_field(h->c, f->payload, &pos, &value);
-        if (status) return status;
-        if (value.number == 2) {
-            if (value.wire != WIRE_LEN) return RGB_FALLBACK;
-            h->found = 1;
-            h->value = value.payload;
-            return 0;
-        }
-    }
+    status = pb_find(h->c, f->payload, 2, 1, &value, &found_value);
+    if (status || !found_value) return status;
+    if (value.wire != WIRE_LEN) return RGB_FALLBACK;
+    h->found = 1;
+    h->value = value.payload;
     return 0;
 }
-
-/* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
 
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v) {
     struct rgb_out *out = c->out;
@@ -271,10 +240,14 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         int32_t code = *op++;
         struct at at;
         int status;
+        const char *layout = rgb_layout(rgb_op_layouts, OP_COUNT, code);
+        if (layout != NULL && layout[0] == 'P') { /* the message its path (count, steps) reaches */
+            status = pb_descend(c, v, op + 1, op[0], &at);
+            if (status) return status;
+            op += 1 + op[0];
+        }
         switch (code) {
         case OP_NUM: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             struct rgb_number val;
             status = pb_scalar(c, at, (uint32_t)op[0], op[1], &val);
             if (status) return status;
@@ -285,16 +258,12 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         case OP_CONST: {
             uint64_t bits = (uint32_t)op[1] | (uint64_t)(uint32_t)op[2] << 32;
             size_t size = rgb_ros_size(op[0]);
-            uint8_t b[8];
-            for (size_t k = 0; k < size; k++) b[k] = (uint8_t)(bits >> (8 * k));
             status = align(out, size);
-            if (!status) status = rgb_put(out, b, size);
+            if (!status) status = rgb_put_le(out, bits, size);
             op += 3;
             break;
         }
         case OP_STR: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             struct field f;
             int found;
             status = pb_last_of(c, at, (uint32_t)op[0], &f, &found);
@@ -309,8 +278,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += rgb_text_span(op[0]);
             break;
         case OP_HEADER_STR: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             struct header_lookup h = {c, word_bytes(op + 1), (size_t)op[1], op[0], 0, {NULL, 0}};
             op += 1 + rgb_text_span(op[1]);
             status = pb_for_each(c, at, 2, header_entry, &h);
@@ -321,8 +288,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             break;
         }
         case OP_FIXED_LIST: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t type = op[1], kind = op[2], count = op[3];
             op += 4;
@@ -342,8 +307,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             break;
         }
         case OP_SEQ_MSG: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t body_len = op[1];
             const int32_t *body = op + 2;
@@ -368,8 +331,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         }
         case OP_COLUMN:
         case OP_COLUMN_STR: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             uint32_t number = (uint32_t)op[0];
             int32_t nsub = op[1];
             struct column col = {c, op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0, out};
@@ -388,8 +349,6 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             break;
         }
         case OP_CLOCK: {
-            status = path(c, &op, v, &at);
-            if (status) return status;
             int32_t part = op[0];
             op += 1;
             struct rgb_number sec, nsec;
@@ -453,8 +412,6 @@ static size_t refusal_limit(size_t n) {
     if (n > (RGB_OUTPUT_MAX - RGB_OUTPUT_FLOOR) / (2 * RGB_OUTPUT_RATIO)) return RGB_OUTPUT_MAX;
     return RGB_OUTPUT_FLOOR + 2 * RGB_OUTPUT_RATIO * n;
 }
-
-void rgb_out_trim(struct rgb_out *out) { rgb_trim(out); }
 
 enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
                                    size_t payload_len, struct rgb_out *out, size_t *steps) {

@@ -59,9 +59,6 @@ enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *pay
 enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
                                    size_t payload_len, struct rgb_out *out, size_t *steps);
 
-/* Frees the buffers that grew past 1 MiB; call after a large output was used. */
-void rgb_out_trim(struct rgb_out *out);
-
 /* Frees the output buffer and the scratch. */
 void rgb_out_free(struct rgb_out *out);
 

@@ -3,6 +3,13 @@
  * body write at the least, which bounds a sequence before it is written. */
 #include "transcode_ops.h"
 
+const char *const rgb_op_layouts[OP_COUNT] = {
+    [OP_NUM] = "Pfskc",      [OP_CONST] = "kww",        [OP_STR] = "Pf",
+    [OP_CONST_STR] = "T",    [OP_HEADER_STR] = "PcTT",  [OP_FIXED_LIST] = "Pfskn",
+    [OP_SEQ_MSG] = "PfB",    [OP_COLUMN] = "PfPfsk",    [OP_COLUMN_STR] = "PfPf",
+    [OP_CLOCK] = "Pc",       [OP_WALL_STAMP] = "",      [OP_CONST_BLOCK] = "aT",
+};
+#define LAYOUT(code) rgb_layout(rgb_op_layouts, OP_COUNT, code)
 
 /* The fewest bytes the ops of a body (checked by check_ops) write for one element, whatever
  * its values: a CDR string or sequence writes at least its 4-byte length, a number or a fixed
@@ -10,72 +17,35 @@
  * `count` times this, which lets OP_SEQ_MSG see at once that it would pass the output bound
  * (a Pose_V of 4 M empty poses wrote 128 MiB of transforms, 0.9 s, before giving up). */
 size_t rgb_least_bytes(const int32_t *op, const int32_t *end) {
-    size_t least = 0;
-    while (op < end && *op != OP_END) {
-        int32_t code = *op++;
+    size_t least = 0, n = (size_t)(end - op), at = 0, w[RGB_MAX_OPERANDS];
+    while (at < n && op[at] != OP_END) {
+        int32_t code = op[at++];
+        const char *layout = LAYOUT(code);
+        if (layout == NULL || rgb_operands(op, n, &at, layout, 0, w))
+            return least; /* rgb_load admits no such op */
         switch (code) {
         case OP_NUM:
-            op += 1 + op[0]; /* the path */
-            least += rgb_ros_size(op[2]);
-            op += 4;
+            least += rgb_ros_size(op[w[3]]);
             break;
         case OP_CONST:
-            least += rgb_ros_size(op[0]);
-            op += 3;
-            break;
-        case OP_STR:
-            op += 1 + op[0];
-            least += 4;
-            op += 1;
-            break;
-        case OP_CONST_STR:
-            least += 4;
-            op += rgb_text_span(op[0]);
-            break;
-        case OP_HEADER_STR:
-            op += 1 + op[0];
-            least += 4;
-            op += 1;
-            op += rgb_text_span(op[0]);
-            op += rgb_text_span(op[0]);
+            least += rgb_ros_size(op[w[0]]);
             break;
         case OP_FIXED_LIST:
-            op += 1 + op[0];
-            least += (size_t)op[3] * rgb_ros_size(op[2]);
-            op += 4;
-            break;
-        case OP_SEQ_MSG:
-            op += 1 + op[0];
-            least += 4;
-            op += 2 + op[1];
-            break;
-        case OP_COLUMN:
-        case OP_COLUMN_STR:
-            op += 1 + op[0];
-            op += 1;
-            op += 1 + op[0];
-            op += 1;
-            if (code == OP_COLUMN) op += 2;
-            least += 4;
-            break;
-        case OP_CLOCK:
-            op += 1 + op[0];
-            least += 4; /* one int32 or uint32 */
-            op += 1;
+            least += (size_t)op[w[4]] * rgb_ros_size(op[w[3]]);
             break;
         case OP_WALL_STAMP:
             least += 8;
             break;
         case OP_CONST_BLOCK:
-            least += (size_t)op[1];
-            op += 1 + rgb_text_span(op[1]);
+            least += (size_t)op[w[1]];
             break;
-        default:
-            return least; /* rgb_load admits no other op */
+        default: /* a string's or a sequence's length, a clock's int32 or uint32 */
+            least += 4;
         }
     }
     return least;
 }
+
 /* ---- loading: every word checked once ----------------------------------------------------- */
 
 static int check_schema(const int32_t *s, size_t n, const char **why) {
@@ -103,107 +73,17 @@ static int check_schema(const int32_t *s, size_t n, const char **why) {
     return 0;
 }
 
-static int check_pb_scalar(int32_t type) {
-    return type >= PB_DOUBLE && type <= PB_SINT64 && type != PB_STRING && type != PB_GROUP &&
-           type != PB_MESSAGE && type != PB_BYTES;
-}
-
-static int check_ros(int32_t kind) { return kind >= ROS_BOOL && kind <= ROS_DOUBLE; }
-
-/* Checks a path at *at (advancing past it). */
-static int check_path(const int32_t *ops, size_t n, size_t *at) {
-    if (*at >= n || ops[*at] < 0 || ops[*at] > MAX_STEPS || (size_t)ops[*at] >= n - *at) return -1;
-    for (int32_t k = 1; k <= ops[*at]; k++)
-        if (ops[*at + (size_t)k] <= 0) return -1;
-    *at += 1 + (size_t)ops[*at];
-    return 0;
-}
-
-/* Checks that `k` more words exist at `at`. */
-
-static int check_text(const int32_t *ops, size_t n, size_t *at) {
-    if (rgb_room(n, *at, 1) || ops[*at] < 0) return -1;
-    size_t span = rgb_text_span(ops[*at]);
-    if (rgb_room(n, *at, span)) return -1;
-    *at += span;
-    return 0;
-}
-
+/* Checks the ops of a body, [0, n), and those of the bodies in it. */
 static int check_ops(const int32_t *ops, size_t n, int depth) {
-    size_t at = 0;
+    size_t at = 0, w[RGB_MAX_OPERANDS];
     if (depth > MAX_DEPTH) return -1;
     while (at < n) {
         int32_t code = ops[at++];
-        switch (code) {
-        case OP_END:
-            return at == n ? 0 : -1;
-        case OP_NUM:
-            if (check_path(ops, n, &at) || rgb_room(n, at, 4) || ops[at] <= 0 ||
-                !check_pb_scalar(ops[at + 1]) || !check_ros(ops[at + 2]) ||
-                (ops[at + 3] != CONV_EXACT && ops[at + 3] != CONV_WRAP))
-                return -1;
-            at += 4;
-            break;
-        case OP_CONST:
-            if (rgb_room(n, at, 3) || !check_ros(ops[at])) return -1;
-            at += 3;
-            break;
-        case OP_STR:
-            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || ops[at] <= 0) return -1;
-            at += 1;
-            break;
-        case OP_CONST_STR:
-            if (check_text(ops, n, &at)) return -1;
-            break;
-        case OP_HEADER_STR:
-            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || (ops[at] != 0 && ops[at] != 1))
-                return -1;
-            at += 1;
-            if (check_text(ops, n, &at) || check_text(ops, n, &at)) return -1;
-            break;
-        case OP_FIXED_LIST:
-            if (check_path(ops, n, &at) || rgb_room(n, at, 4) || ops[at] <= 0 ||
-                !check_pb_scalar(ops[at + 1]) || !check_ros(ops[at + 2]) || ops[at + 3] < 0 ||
-                ops[at + 3] > 1 << 20)
-                return -1;
-            at += 4;
-            break;
-        case OP_SEQ_MSG:
-            if (check_path(ops, n, &at) || rgb_room(n, at, 2) || ops[at] <= 0 || ops[at + 1] < 1 ||
-                rgb_room(n, at + 2, (size_t)ops[at + 1]) ||
-                check_ops(ops + at + 2, (size_t)ops[at + 1], depth + 1))
-                return -1;
-            at += 2 + (size_t)ops[at + 1];
-            break;
-        case OP_COLUMN:
-        case OP_COLUMN_STR: {
-            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || ops[at] <= 0) return -1;
-            at += 1;
-            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || ops[at] <= 0) return -1;
-            at += 1;
-            if (code == OP_COLUMN) {
-                if (rgb_room(n, at, 2) || !check_pb_scalar(ops[at]) || !check_ros(ops[at + 1]))
-                    return -1;
-                at += 2;
-            }
-            break;
-        }
-        case OP_CLOCK:
-            if (check_path(ops, n, &at) || rgb_room(n, at, 1) || (ops[at] != 0 && ops[at] != 1))
-                return -1;
-            at += 1;
-            break;
-        case OP_WALL_STAMP:
-            break;
-        case OP_CONST_BLOCK:
-            if (rgb_room(n, at, 1) || (ops[at] != 1 && ops[at] != 2 && ops[at] != 4 && ops[at] != 8))
-                return -1;
-            at += 1;
-            if (check_text(ops, n, &at)) return -1;
-            break;
-        default:
+        if (code == OP_END) return at == n ? 0 : -1;
+        const char *layout = LAYOUT(code);
+        if (layout == NULL || rgb_operands(ops, n, &at, layout, 0, w)) return -1;
+        if (code == OP_SEQ_MSG && check_ops(ops + w[2] + 1, (size_t)ops[w[2]], depth + 1))
             return -1;
-        }
     }
     return -1; /* a body ends with OP_END */
 }

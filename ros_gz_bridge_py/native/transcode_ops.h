@@ -23,12 +23,11 @@ enum {
     OP_CLOCK = 10,
     OP_CONST_BLOCK = 11,
     OP_WALL_STAMP = 12,
+    OP_COUNT
 };
 
 /* Deepest nesting validated natively; deeper payloads are left to Python. */
 #define MAX_DEPTH 64
-/* Longest path of field numbers in an op. */
-#define MAX_STEPS 16
 
 struct view {
     const uint8_t *p;
@@ -71,6 +70,17 @@ struct ctx {
     size_t steps; /* fields read */
 };
 
+/* Reads a value of wire type `wire` (a varint, or 4 or 8 bytes) at *pos into `f`. */
+static inline int read_value(struct view v, size_t *pos, int wire, struct field *f) {
+    if (wire == WIRE_VARINT) return read_varint(v, pos, &f->varint);
+    size_t size = wire == WIRE_I64 ? 8 : 4;
+    if (v.n - *pos < size) return RGB_UNDECODABLE;
+    f->payload.p = v.p + *pos;
+    f->payload.n = size;
+    *pos += size;
+    return 0;
+}
+
 /* Reads the field at *pos. Groups and odd tags are left to Python. */
 static inline int read_field(struct ctx *c, struct view v, size_t *pos, struct field *f) {
     uint64_t tag;
@@ -84,16 +94,9 @@ static inline int read_field(struct ctx *c, struct view v, size_t *pos, struct f
     if (f->number == 0) return RGB_FALLBACK;
     switch (f->wire) {
     case WIRE_VARINT:
-        return read_varint(v, pos, &f->varint);
     case WIRE_I64:
-    case WIRE_I32: {
-        size_t size = f->wire == WIRE_I64 ? 8 : 4;
-        if (v.n - *pos < size) return RGB_UNDECODABLE;
-        f->payload.p = v.p + *pos;
-        f->payload.n = size;
-        *pos += size;
-        return 0;
-    }
+    case WIRE_I32:
+        return read_value(v, pos, f->wire, f);
     case WIRE_LEN: {
         uint64_t length;
         size_t at = *pos;
@@ -157,21 +160,24 @@ struct at {
 int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth);
 /* Indexes `v`, a validated message of schema type `msg`, in one scan. */
 int pb_index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset);
-/* The last occurrence of field `number` in `v`, scanned (found 0 when absent). */
-int pb_find_last(struct ctx *c, struct view v, uint32_t number, struct field *out, int *found);
+/* The last (or `first`) occurrence of field `number` in `v`, scanned (found 0 when absent). */
+int pb_find(struct ctx *c, struct view v, uint32_t number, int first, struct field *out,
+            int *found);
 /* The same in `a`, from its index where it has one. */
 int pb_last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, int *found);
 /* The submessage reached through `steps` (an empty view where one is absent). */
 int pb_descend(struct ctx *c, struct at a, const int32_t *steps, int32_t nsteps, struct at *out);
-/* One scalar element of protobuf `type` from its wire form, and a field's raw bits. */
-struct rgb_number pb_decode_scalar(int32_t type, const struct field *f, uint64_t raw);
+/* One scalar element of protobuf `type` from its wire form, and a field's raw bits (not
+ * packed). */
+struct rgb_number pb_decode_scalar(int32_t type, uint64_t raw);
 uint64_t pb_raw_of(const struct field *f);
 /* The value of singular scalar `number` of protobuf `type` in `v` (0 when absent). */
 int pb_scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct rgb_number *val);
 /* Calls `each(arg, element)` for every element of repeated field `number` in `v`. */
 typedef int (*element_fn)(void *ctx, const struct field *f);
 int pb_for_each(struct ctx *c, struct at v, uint32_t number, element_fn each, void *arg);
-/* The occurrences of field `number` in `v`; the schema type of its elements (-1: unknown). */
+/* The occurrences of field `number` in `v`; the schema type of its elements where it is a
+ * message field (-1: unknown). */
 int pb_count_of(struct ctx *c, struct at v, uint32_t number, size_t *count);
 int32_t pb_element_type(struct ctx *c, struct at v, uint32_t number);
 
@@ -179,6 +185,8 @@ int32_t pb_element_type(struct ctx *c, struct at v, uint32_t number);
 
 /* The bytes of a string stored in words (count, then the bytes packed 4 a word). */
 static inline const uint8_t *word_bytes(const int32_t *words) { return (const uint8_t *)(words + 1); }
+/* Each op's operands (wire.h rgb_operands), by op code (transcode_load.c). */
+extern const char *const rgb_op_layouts[OP_COUNT];
 /* The fewest bytes the ops of a body write for one element (see transcode_load.c). */
 size_t rgb_least_bytes(const int32_t *op, const int32_t *end);
 

@@ -20,44 +20,55 @@ static void program_dealloc(ProgramObject *self) {
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
+/* One copy of the int32 words of buffers[0..n) (PyMem: the caller owns it; lens[i]: the words
+ * of buffers[i]), released; NULL with a Python error (ValueError `not_words` where a buffer is
+ * not whole words). */
+static int32_t *words_of(Py_buffer *buffers, int n, size_t *lens, const char *not_words) {
+    size_t total = 0, at = 0;
+    int whole = 1;
+    for (int i = 0; i < n; i++) {
+        lens[i] = (size_t)buffers[i].len / 4;
+        total += lens[i];
+        whole = whole && buffers[i].len % 4 == 0;
+    }
+    int32_t *words = whole ? PyMem_Malloc((total + 1) * 4) : NULL;
+    if (!whole) PyErr_SetString(PyExc_ValueError, not_words);
+    else if (words == NULL) PyErr_NoMemory();
+    for (int i = 0; i < n; i++) {
+        if (words != NULL) memcpy(words + at, buffers[i].buf, lens[i] * 4);
+        at += lens[i];
+        PyBuffer_Release(&buffers[i]);
+    }
+    return words;
+}
+
 static int program_init(ProgramObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"schema", "ops", NULL};
-    Py_buffer schema, ops;
+    Py_buffer parts[2]; /* schema, ops */
+    size_t lens[2];
     /* A pump may be reading the words with the GIL released: they are never replaced. */
     if (self->words != NULL) {
         PyErr_SetString(PyExc_RuntimeError, "a Program is loaded once; make a new Program");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*y*", keywords, &schema, &ops)) return -1;
-    int result = -1;
-    if (schema.len % 4 || ops.len % 4) {
-        PyErr_SetString(PyExc_ValueError, "schema and ops are int32 words");
-        goto done;
-    }
-    size_t schema_len = (size_t)schema.len / 4, ops_len = (size_t)ops.len / 4;
-    int32_t *words = PyMem_Malloc((schema_len + ops_len + 1) * 4);
-    if (words == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    memcpy(words, schema.buf, (size_t)schema.len);
-    memcpy(words + schema_len, ops.buf, (size_t)ops.len);
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*y*", keywords, &parts[0], &parts[1]))
+        return -1;
+    int32_t *words = words_of(parts, 2, lens, "schema and ops are int32 words");
     const char *why = "";
-    if (rgb_load(&self->program, words, schema_len, words + schema_len, ops_len, &why)) {
+    if (words != NULL && rgb_load(&self->program, words, lens[0], words + lens[0], lens[1], &why)) {
         PyMem_Free(words);
         PyErr_Format(PyExc_ValueError, "not a native program: %s", why);
-        goto done;
+        return -1;
     }
     self->words = words;
-    result = 0;
-done:
-    PyBuffer_Release(&schema);
-    PyBuffer_Release(&ops);
-    return result;
+    return words != NULL ? 0 : -1;
 }
 
-static Py_ssize_t clamp_ssize(size_t n) {
-    return n > (size_t)PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)n;
+/* (status, None), or (0, the output's bytes) when the status is RGB_OK. */
+static PyObject *outcome(enum rgb_status status, const struct rgb_out *out) {
+    if (status != RGB_OK) return Py_BuildValue("(iO)", (int)status, Py_None);
+    const char *data = out->len ? (const char *)out->data : ""; /* empty: no buffer */
+    return Py_BuildValue("(iy#)", 0, data, (Py_ssize_t)out->len);
 }
 
 /* to_cdr(payload) -> (status, bytes, (items, least) for RGB_TOO_LARGE, or None) */
@@ -72,16 +83,14 @@ static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
     enum rgb_status status = rgb_to_cdr_counted(&self->program, payload.buf, (size_t)payload.len,
                                                 &self->out, &steps);
     PyBuffer_Release(&payload);
-    self->steps = steps > PY_SSIZE_T_MAX ? PY_SSIZE_T_MAX : (Py_ssize_t)steps;
+    self->steps = rgb_clamp(steps);
     PyObject *result;
     if (status == RGB_TOO_LARGE)
-        result = Py_BuildValue("(i(nn))", (int)status, clamp_ssize(self->out.refused.items),
-                               clamp_ssize(self->out.refused.least));
-    else if (status != RGB_OK)
-        result = Py_BuildValue("(iO)", (int)status, Py_None);
+        result = Py_BuildValue("(i(nn))", (int)status, rgb_clamp(self->out.refused.items),
+                               rgb_clamp(self->out.refused.least));
     else
-        result = Py_BuildValue("(iy#)", 0, (const char *)self->out.data, (Py_ssize_t)self->out.len);
-    rgb_out_trim(&self->out);
+        result = outcome(status, &self->out);
+    rgb_trim(&self->out);
     return result;
 }
 
@@ -135,35 +144,23 @@ static void encoder_dealloc(EncoderObject *self) {
 
 static int encoder_init(EncoderObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"words", NULL};
-    Py_buffer words;
+    Py_buffer buffer;
+    size_t len;
     /* A loop may be reading the words with the GIL released: they are never replaced. */
     if (self->words != NULL) {
         PyErr_SetString(PyExc_RuntimeError, "an Encoder is loaded once; make a new Encoder");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*", keywords, &words)) return -1;
-    int result = -1;
-    if (words.len % 4) {
-        PyErr_SetString(PyExc_ValueError, "an encoder is int32 words");
-        goto done;
-    }
-    int32_t *copy = PyMem_Malloc((size_t)words.len + 4);
-    if (copy == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    memcpy(copy, words.buf, (size_t)words.len);
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*", keywords, &buffer)) return -1;
+    int32_t *words = words_of(&buffer, 1, &len, "an encoder is int32 words");
     const char *why = "";
-    if (rgb_encoder_load(&self->encoder, copy, (size_t)words.len / 4, &why)) {
-        PyMem_Free(copy);
+    if (words != NULL && rgb_encoder_load(&self->encoder, words, len, &why)) {
+        PyMem_Free(words);
         PyErr_Format(PyExc_ValueError, "not a native encoder: %s", why);
-        goto done;
+        return -1;
     }
-    self->words = copy;
-    result = 0;
-done:
-    PyBuffer_Release(&words);
-    return result;
+    self->words = words;
+    return words != NULL ? 0 : -1;
 }
 
 /* to_pb(cdr) -> (status, bytes or None); the output buffer is the call's own, so channels
@@ -178,13 +175,7 @@ static PyObject *encoder_to_pb(EncoderObject *self, PyObject *arg) {
     struct rgb_out out = {.data = NULL};
     enum rgb_status status = rgb_to_pb(&self->encoder, cdr.buf, (size_t)cdr.len, &out);
     PyBuffer_Release(&cdr);
-    PyObject *result;
-    if (status != RGB_OK) {
-        result = Py_BuildValue("(iO)", (int)status, Py_None);
-    } else {
-        const char *data = out.len ? (const char *)out.data : ""; /* empty: no buffer */
-        result = Py_BuildValue("(iy#)", 0, data, (Py_ssize_t)out.len);
-    }
+    PyObject *result = outcome(status, &out);
     rgb_out_free(&out);
     return result;
 }

@@ -183,6 +183,22 @@ static inline int rgb_grow(struct rgb_out *out, size_t extra) {
     return 0;
 }
 
+/* Makes room for `need` items of `size` bytes in the array at `array` (a pointer to it, NULL
+ * before its first item) of `*cap` items, the capacity doubled from `first`: 0, or -1 without
+ * memory (the array left as it was). */
+static inline int rgb_reserve(void *array, size_t *cap, size_t need, size_t size, size_t first) {
+    if (need <= *cap) return 0;
+    void *items;
+    memcpy(&items, array, sizeof items);
+    size_t grown = *cap ? *cap : first;
+    while (grown < need) grown *= 2;
+    items = realloc(items, grown * size);
+    if (items == NULL) return -1;
+    memcpy(array, &items, sizeof items);
+    *cap = grown;
+    return 0;
+}
+
 /* Buffers above this size are freed once used instead of kept for the next message. */
 #define RGB_KEEP_BYTES ((size_t)1 << 20)
 
@@ -210,11 +226,77 @@ static inline int rgb_put(struct rgb_out *out, const void *bytes, size_t n) {
     return 0;
 }
 
+/* Appends the `size` low bytes of `bits`, little-endian. */
+static inline int rgb_put_le(struct rgb_out *out, uint64_t bits, size_t size) {
+    uint8_t b[8];
+    for (size_t k = 0; k < size && k < 8; k++) b[k] = (uint8_t)(bits >> (8 * k));
+    return rgb_put(out, b, size < 8 ? size : 8);
+}
+
 /* The words a string takes in a program (its length, then the bytes four to a word); counted
  * in size_t, so a damaged length near INT32_MAX cannot overflow. */
 static inline size_t rgb_text_span(int32_t nbytes) { return 1 + ((size_t)nbytes + 3) / 4; }
 
 /* 0 when `k` more words exist at `at` of `n`, else -1. */
 static inline int rgb_room(size_t n, size_t at, size_t k) { return at <= n && k <= n - at ? 0 : -1; }
+
+/* Longest path of field numbers in an op. */
+#define MAX_STEPS 16
+/* Most operands an op has. */
+#define RGB_MAX_OPERANDS 8
+
+/* The operands of one op, as both transcoders' ops are laid out (docs/native.md §3, §6): one
+ * letter an operand in the op's layout, each letter one word unless said otherwise:
+ *   w  any word                          k  a ROS kind
+ *   f  a field number (> 0)              s  a protobuf scalar type (a number, not bytes)
+ *   F  a protobuf field number (1 to 2^29 - 1: the tag keeps 3 bits for the wire type)
+ *   c  0 or 1 (a conversion, a flag)     a  an alignment (1, 2, 4 or 8)
+ *   S  a slot of a frame of `nslots` (-1: none)
+ *   n, N, m  a count of 0 to 2^20, 2^24 or 4096
+ *   P  a path: a count up to MAX_STEPS, then as many field numbers
+ *   T  a text: its length, then its bytes four to a word (rgb_text_span)
+ *   B  a body: its length (at least 1), then as many words, which the caller checks.
+ * Checks the operands at *at of ops[0..n) and advances past them; where[i] is the index of
+ * operand i's (first) word. 0, or -1 when one is not well-formed or past the words. The loaders
+ * check every op with it once; what walks loaded ops again uses it to find their operands. */
+static inline int rgb_operands(const int32_t *ops, size_t n, size_t *at, const char *layout,
+                               int32_t nslots, size_t where[RGB_MAX_OPERANDS]) {
+    for (size_t i = 0; layout[i] != '\0' && i < RGB_MAX_OPERANDS; i++) {
+        if (rgb_room(n, *at, 1)) return -1;
+        int32_t w = ops[*at];
+        size_t span = 1;
+        int ok;
+        switch (layout[i]) {
+        case 'w': ok = 1; break;
+        case 'f': ok = w > 0; break;
+        case 'F': ok = w >= 1 && w <= (1 << 29) - 1; break;
+        case 'k': ok = w >= ROS_BOOL && w <= ROS_DOUBLE; break;
+        case 's': /* not a string, group, message or bytes */
+            ok = (w >= PB_DOUBLE && w <= PB_BOOL) || (w >= PB_UINT32 && w <= PB_SINT64);
+            break;
+        case 'c': ok = w == 0 || w == 1; break;
+        case 'a': ok = w == 1 || w == 2 || w == 4 || w == 8; break;
+        case 'S': ok = w >= -1 && w < nslots; break;
+        case 'n': ok = w >= 0 && w <= 1 << 20; break;
+        case 'N': ok = w >= 0 && w <= 1 << 24; break;
+        case 'm': ok = w >= 0 && w <= 4096; break;
+        case 'P': ok = w >= 0 && w <= MAX_STEPS; span = 1 + (size_t)w; break;
+        case 'T': ok = w >= 0; span = rgb_text_span(w); break;
+        case 'B': ok = w >= 1; span = 1 + (size_t)w; break;
+        default: ok = 0;
+        }
+        if (!ok || rgb_room(n, *at, span)) return -1;
+        for (size_t k = 1; layout[i] == 'P' && k < span; k++)
+            if (ops[*at + k] <= 0) return -1;
+        where[i] = *at;
+        *at += span;
+    }
+    return 0;
+}
+
+/* The layout of op `code` in `layouts` (`count` of them; NULL where there is no such op). */
+static inline const char *rgb_layout(const char *const *layouts, size_t count, int32_t code) {
+    return code >= 0 && (size_t)code < count ? layouts[code] : NULL;
+}
 
 #endif
