@@ -7,12 +7,15 @@
  * descriptors to sleep on, and what one turn does.
  *
  * `run` sleeps in one epoll(7) over every member's descriptors and the loop's own wake-up
- * eventfd, with the GIL released. A member whose descriptor fired becomes active; each pass
- * gives every active member, in the order they became active, one turn within the budget
- * (struct rgb_budget: messages and time), so a flooded member cannot starve another: /clock
- * keeps its rate beside a hundred busy topics. A member with more to do at once (RGB_AGAIN: a
- * socket not read empty yet, messages queued, a whole budget taken) stays active, and the next
- * pass polls the descriptors without sleeping.
+ * eventfd, with the GIL released. A member whose descriptor fired becomes fresh; one with more
+ * to do at once after its turn (RGB_AGAIN: a socket not read empty yet, messages queued, a
+ * whole budget taken) has a backlog, and the loop polls the descriptors without sleeping. Each
+ * turn is within the budget (struct rgb_budget: messages and time). A pass turns every fresh
+ * member first, in the order they fired, then the backlog in turn, round robin, for at most
+ * one slice of the budget before the descriptors are polled again: a message of a quiet topic
+ * (/clock beside a hundred busy ones) waits for at most about one slice and one turn, never
+ * for a pass over every backlog, and goes out alone, not in a burst with those that came
+ * after it (a keep-last-10 subscriber would lose the burst's oldest).
  *
  * `run` returns to Python with the members that need it (what their turns reported: messages
  * handed back, a connection monitor event, a socket or eventfd that cannot be used any more:
@@ -56,7 +59,9 @@ typedef struct {
     struct rgb_budget budget;
     struct slot *slots;
     int nslots, members;
-    int *active, nactive; /* slots to turn, in the order they became active */
+    int *fresh, nfresh;     /* slots whose descriptors fired, in that order: turned first */
+    int *active, nactive;   /* slots with a backlog, in the order of their next turn */
+    int *scratch;           /* a pass's reordering of `active` */
     int *report, nreport; /* slots with events for Python */
 } LoopObject;
 
@@ -67,7 +72,7 @@ static uint64_t token_of(const LoopObject *self, int slot, int fd) {
 static void activate(LoopObject *self, int slot) {
     if (!self->slots[slot].active) {
         self->slots[slot].active = 1;
-        self->active[self->nactive++] = slot;
+        self->fresh[self->nfresh++] = slot;
     }
 }
 
@@ -98,28 +103,45 @@ static void nudge(LoopObject *self) {
     (void)ignored; /* a full counter still wakes the loop */
 }
 
-/* One pass over the active members, under the lock. */
-static void pass(LoopObject *self) {
-    int kept = 0;
-    for (int i = 0; i < self->nactive; i++) {
-        int index = self->active[i];
-        struct slot *s = &self->slots[index];
-        unsigned fired = s->fired;
-        s->fired = 0;
-        int result = s->m->hooks->turn(s->m, fired, &self->budget);
-        int events = result & (RGB_EVENT_HANDED | RGB_EVENT_MONITOR | RGB_EVENT_BROKEN);
-        if (events) {
-            s->events |= events;
-            if (!s->reported) self->report[self->nreport++] = index;
-            s->reported = 1;
-        }
-        if (events & RGB_EVENT_BROKEN) mute(self, s);
-        if ((result & RGB_AGAIN) && !(events & RGB_EVENT_BROKEN))
-            self->active[kept++] = index;
-        else
-            s->active = 0;
+/* One turn of the member in `index`: 1 when it has more to do at once (it stays active). */
+static int turn(LoopObject *self, int index) {
+    struct slot *s = &self->slots[index];
+    unsigned fired = s->fired;
+    s->fired = 0;
+    int result = s->m->hooks->turn(s->m, fired, &self->budget);
+    int events = result & (RGB_EVENT_HANDED | RGB_EVENT_MONITOR | RGB_EVENT_BROKEN);
+    if (events) {
+        s->events |= events;
+        if (!s->reported) self->report[self->nreport++] = index;
+        s->reported = 1;
     }
-    self->nactive = kept;
+    if (events & RGB_EVENT_BROKEN) mute(self, s);
+    if ((result & RGB_AGAIN) && !(events & RGB_EVENT_BROKEN)) return 1;
+    s->active = 0;
+    return 0;
+}
+
+/* One pass, under the lock: the fresh members, then the backlog for one slice (at least one
+ * turn). The backlog's next order: those not reached, those turned, then the fresh ones that
+ * have a backlog now. */
+static void pass(LoopObject *self) {
+    int n = 0, reached = 0;
+    for (int i = 0; i < self->nfresh; i++)
+        if (turn(self, self->fresh[i])) self->fresh[n++] = self->fresh[i];
+    int backlogged = n;
+    self->nfresh = 0;
+    int64_t end = rgb_now_ns(CLOCK_MONOTONIC) + self->budget.slice_ns;
+    int turned = 0;
+    while (reached < self->nactive &&
+           (reached == 0 || rgb_now_ns(CLOCK_MONOTONIC) < end)) {
+        int index = self->active[reached++];
+        if (turn(self, index)) self->scratch[turned++] = index;
+    }
+    int rest = self->nactive - reached;
+    memmove(self->active, self->active + reached, (size_t)rest * sizeof *self->active);
+    memcpy(self->active + rest, self->scratch, (size_t)turned * sizeof *self->active);
+    memcpy(self->active + rest + turned, self->fresh, (size_t)backlogged * sizeof *self->active);
+    self->nactive = rest + turned + backlogged;
 }
 
 /* Runs until something is reported, `wake` is called or `deadline` passes: 1 when woken. An
@@ -130,7 +152,7 @@ static int loop_run(LoopObject *self, int64_t deadline, int *error) {
         if (atomic_exchange(&self->woken, 0)) return 1;
         pthread_mutex_lock(&self->lock);
         pass(self);
-        int reported = self->nreport, active = self->nactive;
+        int reported = self->nreport, active = self->nactive + self->nfresh;
         pthread_mutex_unlock(&self->lock);
         if (reported) return 0;
         int64_t left = deadline - rgb_now_ns(CLOCK_MONOTONIC);
@@ -246,7 +268,9 @@ static void loop_dealloc(LoopObject *self) {
         }
     }
     free(self->slots);
+    free(self->fresh);
     free(self->active);
+    free(self->scratch);
     free(self->report);
     if (self->wake_fd >= 0) close(self->wake_fd);
     if (self->epoll_fd >= 0) close(self->epoll_fd);
@@ -263,12 +287,12 @@ static int free_slot(LoopObject *self) {
     if (slots == NULL) return -1;
     self->slots = slots;
     memset(slots + self->nslots, 0, (size_t)(cap - self->nslots) * sizeof *slots);
-    int *active = realloc(self->active, (size_t)cap * sizeof *active);
-    if (active == NULL) return -1;
-    self->active = active;
-    int *report = realloc(self->report, (size_t)cap * sizeof *report);
-    if (report == NULL) return -1;
-    self->report = report;
+    int **lists[] = {&self->fresh, &self->active, &self->scratch, &self->report};
+    for (size_t i = 0; i < sizeof lists / sizeof *lists; i++) {
+        int *grown = realloc(*lists[i], (size_t)cap * sizeof *grown);
+        if (grown == NULL) return -1;
+        *lists[i] = grown;
+    }
     int slot = self->nslots;
     self->nslots = cap;
     return slot;
@@ -337,7 +361,10 @@ static PyObject *loop_remove(LoopObject *self, PyObject *object) {
     int index = slot_of(self, object);
     if (index >= 0) {
         struct slot *s = &self->slots[index];
-        if (s->active) unlist(self->active, &self->nactive, index);
+        if (s->active) {
+            unlist(self->fresh, &self->nfresh, index);
+            unlist(self->active, &self->nactive, index);
+        }
         if (s->reported) unlist(self->report, &self->nreport, index);
         release(self, s);
     }

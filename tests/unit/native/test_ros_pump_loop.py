@@ -202,6 +202,40 @@ def test_a_pass_gives_each_channel_its_budget_and_a_wake_ends_the_run(
     run_until(loop, lambda _m: all(c.pump.counts().received == 100 for c in flooded), "the rest")
 
 
+def test_a_member_that_fired_is_turned_before_the_backlog_goes_on(
+    native: Any, channels: Callable[..., Channel]
+) -> None:
+    """A pass turns the members whose descriptors fired first, then the backlog in turn for one
+    slice, round robin across passes (loop.c, pass): a quiet topic's message does not wait for
+    every flooded channel's turn. A budget of one message and one nanosecond makes a pass one
+    turn of each fired member and one backlog turn."""
+    loop = native.Loop(1, 1)
+    flooded = [channels(f"flood_{index}") for index in range(3)]
+    quiet = channels("quiet")
+    for channel in flooded:
+        for index in range(10):
+            channel.publish(f"flood {index}")
+    quiet.publish("tick")
+    time.sleep(0.5)  # the samples reach every subscription's queue
+
+    def received() -> list[int]:
+        return [channel.pump.counts().received for channel in (*flooded, quiet)]
+
+    for channel in flooded:
+        loop.add(channel.pump)
+        channel.remove_from(loop)
+    loop.run(0, [])  # the three fired: one turn each, then each has a backlog
+    assert received() == [1, 1, 1, 0]
+    loop.add(quiet.pump)
+    quiet.remove_from(loop)
+    loop.run(0, [])
+    assert received() == [2, 1, 1, 1]  # the quiet one first, then one backlog turn
+    loop.run(0, [])
+    assert received() == [2, 2, 1, 1]  # the backlog goes on where it stopped
+    loop.run(0, [])
+    assert received() == [2, 2, 2, 1]
+
+
 def test_channels_join_and_leave_while_the_loop_runs_and_the_others_keep_flowing(
     native: Any, channels: Callable[..., Channel]
 ) -> None:
