@@ -97,20 +97,22 @@ def expected(topics: Topics) -> dict[str, str]:
 
 
 def start_causes(topics: Topics, ros: RosSide, processes: list[PeerProcess]) -> float:
-    """Put every cause in place; returns when the last one started."""
-    processes.append(
+    """Put every cause in place; returns when the last one is: the Fortress processes have
+    their endpoints (READY), which on a busy machine can take seconds after they start."""
+    env = dict(os.environ, IGN_PARTITION=OTHER_PARTITION, GZ_PARTITION=OTHER_PARTITION)
+    peers = [
         start_peer(
             "pub", topics.wrong_gz_publisher, "ignition.msgs.Pose", "5", "0", "", "--wait", "0"
-        )
-    )
-    processes.append(start_peer("echo", topics.wrong_gz_subscriber, "ignition.msgs.Vector3d", "60"))
-    env = dict(os.environ, IGN_PARTITION=OTHER_PARTITION, GZ_PARTITION=OTHER_PARTITION)
-    processes.append(
+        ),
+        start_peer("echo", topics.wrong_gz_subscriber, "ignition.msgs.Vector3d", "60"),
         start_peer(
             "pub", topics.other_partition, "ignition.msgs.Clock", "5", "0", "sim { sec: 1 }",
             "--wait", "0", env=env,
-        )
-    )  # fmt: skip
+        ),
+    ]  # fmt: skip
+    processes.extend(peers)
+    for peer in peers:
+        wait_for_line(peer, r"^READY$", timeout=3 * WAIT)
     ros.run(lambda: ros.node.create_subscription(Int32, topics.wrong_ros_type, lambda _: None, 10))
     latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
     ros.run(
