@@ -24,6 +24,7 @@ from benchmarks import (
     discovery,
     first_call,
     fleet,
+    fleet_clock,
     headline,
     images,
     memory,
@@ -75,6 +76,13 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
                 *("--seconds", "5" if quick else "20"),
                 *("--rounds", "1" if quick else "2"),
                 *("--idle-seconds", "5" if quick else "20"),
+            ]
+        ),
+        "fleet_clock": lambda: fleet_clock.main(
+            [
+                *("--robots", "50"),
+                *("--seconds", "5" if quick else "20"),
+                *("--rounds", "1" if quick else "3"),
             ]
         ),
         "memory": lambda: memory.main(
