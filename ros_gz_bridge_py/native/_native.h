@@ -167,9 +167,11 @@ typedef struct {
     uint8_t *topic;
     size_t topic_len;
     PyObject *program_objects; /* list, keeps the programs alive */
-    struct rgb_program **programs;
-    uint8_t **program_types;
-    size_t *program_type_lens;
+    struct pump_program {
+        struct rgb_program *program;
+        uint8_t *type; /* the wire type it takes */
+        size_t type_len;
+    } *programs;
     int nprograms;
     struct route *routes;
     int nroutes;

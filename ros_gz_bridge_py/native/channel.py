@@ -55,13 +55,9 @@ def native_programs(
         return {}
     if not gz_node.runs_native_loops or not native_path_available():
         return {}
-    programs = {}
     stamp = bool(options.override_timestamps_with_wall_time)
-    for wire_type, pair in layouts.items():
-        program = program_of(pair, frame_id, stamp)
-        if program is not None:
-            programs[wire_type] = program
-    return programs
+    programs = {wire_type: program_of(pair, frame_id, stamp) for wire_type, pair in layouts.items()}
+    return {wire_type: program for wire_type, program in programs.items() if program is not None}
 
 
 @functools.cache

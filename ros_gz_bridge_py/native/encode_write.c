@@ -31,35 +31,11 @@ static int put_length_delimited(struct rgb_out *out, int32_t field, const uint8_
 
 /* A ROS number of `kind` from its bits, as Python holds it. */
 static struct rgb_number ros_number(int32_t kind, uint64_t bits) {
-    struct rgb_number v = {0, 0, 0, 0, 0.0};
-    switch (kind) {
-    case ROS_BOOL:
-    case ROS_UINT8:
-    case ROS_UINT16:
-    case ROS_UINT32:
-        v.i = (int64_t)bits;
-        break;
-    case ROS_INT8:
-        v.i = (int8_t)(uint8_t)bits;
-        break;
-    case ROS_INT16:
-        v.i = (int16_t)(uint16_t)bits;
-        break;
-    case ROS_INT32:
-        v.i = (int32_t)(uint32_t)bits;
-        break;
-    case ROS_INT64:
-        v.i = (int64_t)bits;
-        break;
-    case ROS_UINT64:
-        return rgb_u64(bits);
-    case ROS_FLOAT:
-    case ROS_DOUBLE:
-        return rgb_float_bits(bits, rgb_ros_size(kind));
-    default:
-        break;
-    }
-    return v;
+    struct rgb_ros_type type = rgb_ros_type(kind);
+    if (kind == ROS_FLOAT || kind == ROS_DOUBLE) return rgb_float_bits(bits, type.size);
+    if (type.min == 0) return rgb_u64(bits); /* unsigned (a kind not ROS's: none loads) */
+    uint64_t sign = (uint64_t)1 << (8 * type.size - 1); /* of the `size` bytes read */
+    return (struct rgb_number){0, 0, (int64_t)((bits ^ sign) - sign), 0, 0.0};
 }
 
 /* The wire value of `v` in a field of protobuf `type`, or RGB_FALLBACK where Python's
@@ -79,48 +55,29 @@ static int pb_value(int32_t type, int32_t conv, struct rgb_number v, uint64_t *w
         return 0;
     }
     if (v.is_float) return RGB_FALLBACK;
-    int64_t i = v.i;
-    int ok = 1;
-    switch (type) {
-    case PB_INT32:
-    case PB_SFIXED32:
-    case PB_SINT32:
-    case PB_ENUM:
-        if (conv == CONV_WRAP) i = (int32_t)(uint32_t)(v.is_unsigned ? v.u : (uint64_t)v.i);
-        else ok = !v.is_unsigned && i >= INT32_MIN && i <= INT32_MAX;
-        if (type == PB_SINT32) *wire = (uint32_t)(((uint32_t)i << 1) ^ (uint32_t)(i >> 31));
-        else if (type == PB_SFIXED32) *wire = (uint32_t)i;
-        else *wire = (uint64_t)i; /* negative int32: 10-byte varint, as the runtime writes */
-        break;
-    case PB_UINT32:
-    case PB_FIXED32:
-        if (conv == CONV_WRAP) {
-            *wire = (uint32_t)(v.is_unsigned ? v.u : (uint64_t)v.i);
-        } else {
-            ok = !v.is_unsigned && i >= 0 && i <= (int64_t)UINT32_MAX;
-            *wire = (uint64_t)i;
-        }
-        break;
-    case PB_INT64:
-    case PB_SFIXED64:
-    case PB_SINT64:
-        ok = conv == CONV_WRAP || !v.is_unsigned;
-        *wire = v.is_unsigned ? v.u : (uint64_t)i;
-        if (type == PB_SINT64) *wire = (*wire << 1) ^ (uint64_t)((int64_t)*wire >> 63);
-        break;
-    case PB_UINT64:
-    case PB_FIXED64:
-        ok = conv == CONV_WRAP || v.is_unsigned || i >= 0;
-        *wire = v.is_unsigned ? v.u : (uint64_t)i;
-        break;
-    case PB_BOOL:
-        ok = !v.is_unsigned && (i == 0 || i == 1);
-        *wire = (uint64_t)i;
-        break;
-    default:
-        ok = 0;
+    /* The field's range as a ROS integer of the same width and sign: what an exact assignment
+     * takes, and what CONV_WRAP narrows to (C++'s static_cast); a bool is always exact. */
+    int32_t as = ROS_UINT64;
+    if (type == PB_INT32 || type == PB_SFIXED32 || type == PB_SINT32 || type == PB_ENUM)
+        as = ROS_INT32;
+    else if (type == PB_UINT32 || type == PB_FIXED32) as = ROS_UINT32;
+    else if (type == PB_INT64 || type == PB_SFIXED64 || type == PB_SINT64) as = ROS_INT64;
+    else if (type == PB_BOOL) as = ROS_BOOL;
+    else if (type != PB_UINT64 && type != PB_FIXED64) return RGB_FALLBACK;
+    struct rgb_ros_type range = rgb_ros_type(as);
+    uint64_t bits = v.is_unsigned ? v.u : (uint64_t)v.i;
+    if (conv != CONV_WRAP || as == ROS_BOOL) {
+        if (!rgb_in_range(v, range.min, range.max)) return RGB_FALLBACK;
+    } else if (range.size == 4) {
+        bits = (uint64_t)ros_number(as, bits & UINT32_MAX).i; /* sign-extended for int32 */
     }
-    if (!ok) return RGB_FALLBACK;
+    if (type == PB_SINT32) /* zigzag: 0, -1, 1, -2 ... as 0, 1, 2, 3 ... */
+        bits = (uint32_t)(((uint32_t)bits << 1) ^ (uint32_t)((int64_t)bits >> 31));
+    else if (type == PB_SINT64)
+        bits = (bits << 1) ^ (uint64_t)((int64_t)bits >> 63);
+    else if (type == PB_SFIXED32)
+        bits = (uint32_t)bits;
+    *wire = bits; /* a negative int32 as a varint: 10 bytes, as the runtime writes */
     *zero = *wire == 0;
     return 0;
 }

@@ -17,16 +17,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from ros_gz_bridge_py.converters._fields import (
-    Each,
-    Fill,
-    Table,
-    Value,
-    gz_declaration_of,
-)
-from ros_gz_bridge_py.converters.builtin_interfaces import (
-    fill_gz_present_time,
-)
+from ros_gz_bridge_py.converters._fields import Each, gz_declaration_of
+from ros_gz_bridge_py.converters.builtin_interfaces import fill_gz_present_time
 from ros_gz_bridge_py.converters.covariance import fill_gz_covariance
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.converters.std_msgs import (
@@ -38,11 +30,11 @@ from ros_gz_bridge_py.converters.std_msgs import (
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.native import words
 from ros_gz_bridge_py.native.words import (
+    Half,
     NotExpressibleError,
     Path,
     named,
     ros_kind,
-    split_path,
     text_words,
 )
 from ros_gz_bridge_py.ros import cdr_types as cdr
@@ -148,34 +140,17 @@ _LEAVES: dict[Callable[[Any, Any], None], Callable[[Path, Path, Node], None]] = 
 }
 
 
-def _assign(fill: Fill, ros: Path, gz: Path, out: Node) -> None:
-    leaf = _LEAVES.get(fill.to_gz)
-    if leaf is not None:
-        leaf(ros, gz, out)
-    elif isinstance(fill.shape, Table):
-        for ros_path, gz_path, how in fill.shape.parts:
-            _entry((*ros, *split_path(ros_path)), (*gz, *split_path(gz_path)), how, out)
-    elif isinstance(fill.shape, Each):
-        element = Node()
-        _assign(fill.shape.fill, (), (), element)
-        out.set(gz, Sequence(ros, element))
-    else:
-        msg = f"a Fill of hand-written functions ({fill.to_gz.__qualname__})"
-        raise NotExpressibleError(msg)
+def _copy(ros: Path, gz: Path, wrap: bool, out: Node) -> None:
+    out.set(gz, Copy(ros, wrap))
 
 
-def _entry(ros: Path, gz: Path, how: Fill | Value | None, out: Node) -> None:
-    if how is None:
-        out.set(gz, Copy(ros))
-    elif isinstance(how, Fill):
-        _assign(how, ros, gz, out)
-    elif how.to_gz is None:
-        return
-    elif how.to_gz in words.VALUES:
-        out.set(gz, Copy(ros, wrap=words.VALUES[how.to_gz]))
-    else:
-        msg = f"a Value of {how.to_gz.__qualname__}"
-        raise NotExpressibleError(msg)
+def _each(shape: Each, ros: Path, gz: Path, out: Node) -> None:
+    element = Node()
+    _TO_GZ.assign(shape.fill, (), (), element)
+    out.set(gz, Sequence(ros, element))
+
+
+_TO_GZ = Half("to_gz", _LEAVES, _copy, _each)
 
 
 # ---- the ROS side: read ops and slots ---------------------------------------------------------
@@ -370,7 +345,7 @@ def compile_to_gz(pair: Pair) -> bytes:
     fill = gz_declaration_of(pair.to_gz)
     whole = named(pair.to_gz, _WHOLE)
     if fill is not None:
-        _assign(fill, (), (), tree)
+        _TO_GZ.assign(fill, (), (), tree)
     elif whole is not None:
         whole(tree)
     else:

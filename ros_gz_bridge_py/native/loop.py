@@ -41,7 +41,7 @@ from ros_gz_bridge_py.transport.budget import TURN_MESSAGES, TURN_SLICE
 from ros_gz_bridge_py.transport.heap import BurstTrimmer, trim_heap
 
 if TYPE_CHECKING:
-    from ros_gz_bridge_py.native._native import Member
+    from ros_gz_bridge_py.native._native import Member, PumpCounts, RosPumpCounts
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 #: The thread of each direction's loop (in Python and in the OS, for ``top -H``).
@@ -60,10 +60,8 @@ LOOP_TRIM_AFTER = 8 * 1024 * 1024
 class LoopMember(Protocol):
     """What a loop runs: a C pump (``Pump`` or ``RosPump``) and its channel's Python share."""
 
-    @property
-    def pump(self) -> Member:
-        """The C pump."""
-        ...
+    #: The C pump.
+    pump: Member
 
     @property
     def bytes_read(self) -> int:
@@ -75,6 +73,37 @@ class LoopMember(Protocol):
         C turns reported; none: a count, a deadline or a request). Returns when the member
         wants its next turn at the latest (``time.monotonic()``), or None."""
         ...
+
+
+class PumpMember(LoopMember):
+    """What both kinds of channel member (``pump.py``, ``ros_pump.py``) do alike: the bytes
+    their C pump took, its counts since the last look, and joining their direction's loop
+    (releasing what the member holds for the loop if it cannot)."""
+
+    _loop: NativeLoop
+    _seen: PumpCounts | RosPumpCounts
+
+    @property
+    def bytes_read(self) -> int:
+        """Payload bytes the C pump took so far (:class:`NativeLoop` trims after a burst)."""
+        return self.pump.counts().bytes_read
+
+    def _deltas(self, *names: str) -> tuple[int, ...]:
+        """The counts ``names`` of the C pump since the last call."""
+        now, before = self.pump.counts(), self._seen
+        self._seen = now
+        return tuple(getattr(now, name) - getattr(before, name) for name in names)
+
+    def _join(self) -> None:
+        try:
+            self._loop.attach(self)
+        except Exception:
+            self._release()
+            raise
+
+    def _release(self) -> None:
+        """Lets go of what the member holds while on the loop."""
+        raise NotImplementedError
 
 
 class NativeLoop:

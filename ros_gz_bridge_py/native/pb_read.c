@@ -192,21 +192,24 @@ int pb_descend(struct ctx *c, struct at a, const int32_t *steps, int32_t nsteps,
 
 struct rgb_number pb_decode_scalar(int32_t type, uint64_t raw) {
     struct rgb_number val = {0, 0, 0, 0, 0.0};
+    if (type == PB_SINT32) raw = (uint32_t)raw;
+    if (type == PB_SINT32 || type == PB_SINT64) raw = (raw >> 1) ^ (~(raw & 1) + 1); /* zigzag */
     switch (type) {
     case PB_DOUBLE:
-        return rgb_float_bits(raw, 8);
     case PB_FLOAT:
-        return rgb_float_bits(raw, 4);
-    case PB_INT64:
-    case PB_SFIXED64:
-        val.i = (int64_t)raw;
-        break;
+        return rgb_float_bits(raw, type == PB_DOUBLE ? 8 : 4);
     case PB_UINT64:
     case PB_FIXED64:
         return rgb_u64(raw);
+    case PB_INT64:
+    case PB_SFIXED64:
+    case PB_SINT64:
+        val.i = (int64_t)raw;
+        break;
     case PB_INT32:
     case PB_ENUM:
     case PB_SFIXED32:
+    case PB_SINT32:
         val.i = (int32_t)(uint32_t)raw;
         break;
     case PB_UINT32:
@@ -215,14 +218,6 @@ struct rgb_number pb_decode_scalar(int32_t type, uint64_t raw) {
         break;
     case PB_BOOL:
         val.i = raw != 0;
-        break;
-    case PB_SINT32: {
-        uint32_t n = (uint32_t)raw;
-        val.i = (int32_t)((n >> 1) ^ (~(n & 1) + 1));
-        break;
-    }
-    case PB_SINT64:
-        val.i = (int64_t)((raw >> 1) ^ (~(raw & 1) + 1));
         break;
     default:
         break;

@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ros_gz_bridge_py.converters._fields import Each, Fill, Table, Value, declaration_of
+from ros_gz_bridge_py.converters._fields import Each, Fill, declaration_of
 from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time
 from ros_gz_bridge_py.converters.covariance import fill_ros_covariance
 from ros_gz_bridge_py.converters.registry import Pair
@@ -34,13 +34,12 @@ from ros_gz_bridge_py.native.words import (
     CONV_EXACT,
     CONV_WRAP,
     ROS_KINDS,
-    VALUES,
+    Half,
     NotExpressibleError,
     Path,
     descend,
     named,
     ros_kind,
-    split_path,
     text_words,
     walk,
 )
@@ -186,36 +185,19 @@ def assignments_of(fill: Fill, ros: Path = (), gz: Path = ()) -> Assignments:
         NotExpressibleError: a step of the Fill is not one a program can express.
     """
     out: Assignments = {}
-    _assign(fill, ros, gz, out)
+    _TO_ROS.assign(fill, ros, gz, out)
     return out
 
 
-def _assign(fill: Fill, ros: Path, gz: Path, out: Assignments) -> None:
-    leaf = _LEAVES.get(fill.to_ros)
-    if leaf is not None:
-        leaf(ros, gz, out)
-    elif isinstance(fill.shape, Table):
-        for ros_path, gz_path, how in fill.shape.parts:
-            _entry((*ros, *split_path(ros_path)), (*gz, *split_path(gz_path)), how, out)
-    elif isinstance(fill.shape, Each):
-        out[ros] = Sequence(gz, assignments_of(fill.shape.fill), fill.shape.new_ros)
-    else:
-        msg = f"a Fill of hand-written functions ({fill.to_ros.__qualname__})"
-        raise NotExpressibleError(msg)
+def _copy(ros: Path, gz: Path, wrap: bool, out: Assignments) -> None:
+    out[ros] = Copy(gz, wrap)
 
 
-def _entry(ros: Path, gz: Path, how: Fill | Value | None, out: Assignments) -> None:
-    if how is None:
-        out[ros] = Copy(gz)
-    elif isinstance(how, Fill):
-        _assign(how, ros, gz, out)
-    elif how.to_ros is None:
-        return
-    elif how.to_ros in VALUES:
-        out[ros] = Copy(gz, wrap=VALUES[how.to_ros])
-    else:
-        msg = f"a Value of {how.to_ros.__qualname__}"
-        raise NotExpressibleError(msg)
+def _each(shape: Each, ros: Path, gz: Path, out: Assignments) -> None:
+    out[ros] = Sequence(gz, assignments_of(shape.fill), shape.new_ros)
+
+
+_TO_ROS = Half("to_ros", _LEAVES, _copy, _each)
 
 
 # ---- the schema ------------------------------------------------------------------------------
@@ -414,7 +396,7 @@ def compile_to_ros(pair: Pair, *, frame_id: str = "", wall_stamp: bool = False) 
     given: Assignments = {}
     if declared is not None:
         fill, new_ros = declared
-        _assign(fill, (), (), given)
+        _TO_ROS.assign(fill, (), (), given)
         default = new_ros()
     elif (whole := named(pair.to_ros, _WHOLE)) is not None:
         whole(given)

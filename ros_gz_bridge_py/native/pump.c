@@ -105,9 +105,7 @@ static void pump_dealloc(PumpObject *self) {
     pump_clear_handover(self);
     free(self->handover);
     clear_routes(self);
-    for (int i = 0; i < self->nprograms; i++) free(self->program_types[i]);
-    free(self->program_types);
-    free(self->program_type_lens);
+    for (int i = 0; i < self->nprograms; i++) free(self->programs[i].type);
     free(self->programs);
     free(self->topic);
     Py_XDECREF(self->program_objects);
@@ -156,10 +154,8 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     self->publisher = (void *)(uintptr_t)publisher;
     Py_ssize_t n = PyDict_Size(programs);
     self->programs = calloc((size_t)n + 1, sizeof *self->programs);
-    self->program_types = calloc((size_t)n + 1, sizeof *self->program_types);
-    self->program_type_lens = calloc((size_t)n + 1, sizeof *self->program_type_lens);
     self->ring = calloc((size_t)capacity, sizeof *self->ring);
-    if (!self->programs || !self->program_types || !self->program_type_lens || !self->ring) {
+    if (self->programs == NULL || self->ring == NULL) {
         PyErr_NoMemory();
         goto done;
     }
@@ -177,11 +173,11 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
             goto done;
         }
         if (PyList_Append(self->program_objects, value) < 0) goto done;
-        int i = self->nprograms++;
-        self->programs[i] = program;
-        self->program_type_lens[i] = (size_t)PyBytes_GET_SIZE(key);
-        self->program_types[i] = rgb_copy(PyBytes_AS_STRING(key), self->program_type_lens[i]);
-        if (self->program_types[i] == NULL) {
+        struct pump_program *p = &self->programs[self->nprograms++];
+        p->program = program;
+        p->type_len = (size_t)PyBytes_GET_SIZE(key);
+        p->type = rgb_copy(PyBytes_AS_STRING(key), p->type_len);
+        if (p->type == NULL) {
             PyErr_NoMemory();
             goto done;
         }
@@ -221,8 +217,8 @@ static PyObject *pump_learn(PumpObject *self, PyObject *args) {
     PyObject *result = NULL;
     int program = -1;
     for (int i = 0; take && i < self->nprograms; i++)
-        if (self->program_type_lens[i] == (size_t)type.len &&
-            !memcmp(self->program_types[i], type.buf, (size_t)type.len))
+        if (self->programs[i].type_len == (size_t)type.len &&
+            !memcmp(self->programs[i].type, type.buf, (size_t)type.len))
             program = i;
     if (take && program < 0) { /* taken, but no program: stays with Python */
         result = Py_NewRef(Py_False);

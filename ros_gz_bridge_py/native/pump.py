@@ -23,15 +23,15 @@ from ros_gz_bridge_py.converters._limits import amplification_error
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.abi import zmq_functions
 from ros_gz_bridge_py.native.fallback import ChannelFallback
-from ros_gz_bridge_py.native.loop import GZ_TO_ROS, shared_loop
+from ros_gz_bridge_py.native.loop import GZ_TO_ROS, PumpMember, shared_loop
 from ros_gz_bridge_py.transport import MessageInfo
 from ros_gz_bridge_py.transport.api import NativeHost
 
 if TYPE_CHECKING:
-    from ros_gz_bridge_py.native._native import Program, Pump, PumpCounts
+    from ros_gz_bridge_py.native._native import Program, Pump
 
 
-class ChannelPump:
+class ChannelPump(PumpMember):
     """One channel's C pump (see the module docstring).
 
     ``programs``: the compiled program of each wire spelling the channel takes.
@@ -60,7 +60,7 @@ class ChannelPump:
             msg = "no native extension or foreign functions"
             raise RuntimeError(msg)
         self._handle = publisher.handle
-        self._pump: Pump = native.Pump(
+        self.pump: Pump = native.Pump(
             topic.encode(),
             functions,
             publisher.handle.pointer,
@@ -79,34 +79,25 @@ class ChannelPump:
         self._partition = partition
         self._name = name
         self._infos: dict[tuple[bytes, bytes], MessageInfo] = {}
-        self._seen = self._pump.counts()
-
-    @property
-    def pump(self) -> Pump:
-        """The C Pump."""
-        return self._pump
+        self._seen = self.pump.counts()
 
     # --- the socket owner (transport/api.py NativeLoop) -----------------------------------
 
     def learn(self, sender: bytes, msg_type: bytes, *, take: bool) -> None:
         """Messages of (``sender``, ``msg_type``) go natively from now on (``take``; where a
         program takes the type), or are skipped (another spelling of a type taken)."""
-        self._pump.learn(sender, msg_type, take)
+        self.pump.learn(sender, msg_type, take)
 
     def attach(self, sock: int, monitor: int, host: NativeHost) -> None:
         """Read ``sock`` (with its connection ``monitor``) on the process's loop, no route
         known yet; ``host`` does the socket owner's share on the loop's thread."""
         self._host = host
-        self._pump.read_from(sock, monitor)
-        self._pump.forget()
+        self.pump.read_from(sock, monitor)
+        self.pump.forget()
         if not self._holding:
             self._handle.__enter__()  # the publisher stays while the loop publishes on it
             self._holding = True
-        try:
-            self._loop.attach(self)
-        except Exception:
-            self._release()
-            raise
+        self._join()
 
     def detach(self) -> None:
         """Returns once the loop no longer reads the socket."""
@@ -120,7 +111,7 @@ class ChannelPump:
     def watch(self, size: int | None) -> None:
         """Payloads larger than ``size`` are told to the host (None: none); on the loop's
         thread, or before the pump is attached."""
-        self._pump.watch(-1 if size is None else size)
+        self.pump.watch(-1 if size is None else size)
 
     def _release(self) -> None:
         if self._holding:
@@ -133,8 +124,8 @@ class ChannelPump:
         """What the C loop left to Python: refused payloads to the fallback thread, payloads
         refused as too large counted, the counts; then the host's own turn with the frames of
         senders not known yet."""
-        handover = self._pump.take_handed() if handed else None
-        received, rate_limited, published, _dropped = self.take_counts()
+        handover = self.pump.take_handed() if handed else None
+        received, rate_limited, published = self._deltas("received", "rate_limited", "published")
         if received:
             self._counted(received, rate_limited, published)
         for large in handover.too_large if handover else ():
@@ -151,11 +142,6 @@ class ChannelPump:
             broken=broken,
             grown=handover.grown if handover else 0,
         )
-
-    @property
-    def bytes_read(self) -> int:
-        """Payload bytes read from the socket so far (``loop.py`` trims after a burst)."""
-        return self._pump.counts().bytes_read
 
     def _info(self, sender: bytes, msg_type: bytes) -> MessageInfo:
         info = self._infos.get((sender, msg_type))
@@ -174,40 +160,30 @@ class ChannelPump:
 
     # --- the counts --------------------------------------------------------------------------
 
-    def take_counts(self) -> tuple[int, int, int, int]:
-        """(received, rate_limited, published, dropped) since the last call."""
-        now, before = self._pump.counts(), self._seen
-        self._seen = now
-        return (
-            now.received - before.received,
-            now.rate_limited - before.rate_limited,
-            now.published - before.published,
-            _dropped(now) - _dropped(before),
-        )
-
     @property
     def received(self) -> int:
         """Payloads taken from the socket so far."""
-        return self._pump.counts().received
+        return self.pump.counts().received
 
     @property
     def dropped_sender(self) -> str:
         """The sender of the last payload dropped ("" before any)."""
-        return self._pump.dropped_sender.decode(errors="replace")
+        return self.pump.dropped_sender.decode(errors="replace")
 
     @property
     def dropped(self) -> int:
         """Payloads dropped so far: the oldest, before any work on them (over the queue's count
         or bytes, natively or on the way to the Python path), and those that could not be
         handed to Python (no memory for a copy)."""
-        return _dropped(self._pump.counts()) + self._fallback.dropped
+        counts = self.pump.counts()
+        return counts.dropped + counts.lost + self._fallback.dropped
 
     # --- the loop guard -----------------------------------------------------------------------
 
     def wrap(self, publish: Callable[[Any], None]) -> Callable[[Any], None]:
         """``publish`` (the channel's Python path on the same publisher) numbered in the same
         sequence as the pump's own publications."""
-        pump = self._pump
+        pump = self.pump
 
         def publish_and_record(msg: Any) -> None:
             sequence = pump.begin_publication()
@@ -221,9 +197,4 @@ class ChannelPump:
         return publish_and_record
 
     def is_own(self, sequence: int, stamp: int) -> bool:
-        return self._pump.is_own(sequence, stamp)
-
-
-def _dropped(counts: PumpCounts) -> int:
-    """Payloads dropped: the oldest, and those no copy could be made of for Python."""
-    return counts.dropped + counts.lost
+        return self.pump.is_own(sequence, stamp)

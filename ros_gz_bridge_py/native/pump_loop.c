@@ -205,7 +205,7 @@ static void deliver(PumpObject *self, struct queued *q) {
     int program = self->routes[q->route].program;
     const uint8_t *data = self->f.msg_data(&q->payload);
     size_t size = self->f.msg_size(&q->payload);
-    enum rgb_status status = rgb_to_cdr(self->programs[program], data, size, &self->out);
+    enum rgb_status status = rgb_to_cdr(self->programs[program].program, data, size, &self->out);
     if (status == RGB_OK) {
         rcl_serialized message = {self->out.data, self->out.len, self->out.cap, {0}};
         uint64_t sequence = pump_begin_publication(self);

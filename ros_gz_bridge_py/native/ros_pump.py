@@ -24,14 +24,14 @@ import zmq
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.abi import ros_functions
 from ros_gz_bridge_py.native.fallback import ChannelFallback
-from ros_gz_bridge_py.native.loop import ROS_TO_GZ, shared_loop
+from ros_gz_bridge_py.native.loop import ROS_TO_GZ, PumpMember, shared_loop
 from ros_gz_bridge_py.transport.delivery import Payload
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.native._native import Encoder, RosPump, RosPumpCounts
 
 
-class RosChannelPump:
+class RosChannelPump(PumpMember):
     """The native input of one ROS -> Gazebo channel (see the module docstring).
 
     ``refused(cdr)``: the channel's Python path for one admitted message (on the fallback
@@ -101,11 +101,7 @@ class RosChannelPump:
         self._in_use = contextlib.ExitStack()
         self._in_use.enter_context(subscription.handle)
         self.sync()  # before the loop takes a message: a subscriber's spelling is not missed
-        try:
-            self._loop.attach(self)
-        except Exception:
-            self._release()
-            raise
+        self._join()
 
     def __repr__(self) -> str:
         return f"<native ROS -> Gazebo channel {self.name}>"
@@ -153,11 +149,6 @@ class RosChannelPump:
 
     # --- the loop's thread (loop.py LoopMember) --------------------------------------------
 
-    @property
-    def bytes_read(self) -> int:
-        """CDR bytes taken so far (``loop.py`` trims after a burst)."""
-        return self.pump.counts().bytes_read
-
     def turn(self, *, handed: bool, monitor: bool, broken: bool) -> float | None:
         """The messages an encoder left to Python (to the fallback thread), the counters, the
         spellings and own publishers, and the failure of the channel's socket."""
@@ -178,19 +169,12 @@ class RosChannelPump:
         return None
 
     def _count(self) -> None:
-        now, before = self.pump.counts(), self._seen
-        self._seen = now
-        deltas = (
-            now.received - before.received,
-            now.own_skipped - before.own_skipped,
-            now.rate_limited - before.rate_limited,
-            now.published - before.published,
-            now.send_failures - before.send_failures,
-        )
+        names = "received", "own_skipped", "rate_limited", "published", "send_failures", "lost"
+        *deltas, lost = self._deltas(*names)
         if any(deltas):
             self._counted(*deltas)
         fallback_dropped = self._fallback.dropped
-        lost = now.lost - before.lost + fallback_dropped - self._fallback_dropped
+        lost += fallback_dropped - self._fallback_dropped
         self._fallback_dropped = fallback_dropped
         if lost:
             self._lost(lost)

@@ -50,22 +50,8 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
     if (val.is_float) return RGB_FALLBACK;
     uint64_t bits = val.is_unsigned ? val.u : (uint64_t)val.i;
     if (kind == ROS_BOOL) return rgb_put_le(out, val.i != 0, 1);
-    if (conv == CONV_EXACT) {
-        int ok;
-        int64_t i = val.i;
-        switch (kind) {
-        case ROS_UINT8: ok = !val.is_unsigned && i >= 0 && i <= UINT8_MAX; break;
-        case ROS_INT8: ok = !val.is_unsigned && i >= INT8_MIN && i <= INT8_MAX; break;
-        case ROS_INT16: ok = !val.is_unsigned && i >= INT16_MIN && i <= INT16_MAX; break;
-        case ROS_UINT16: ok = !val.is_unsigned && i >= 0 && i <= UINT16_MAX; break;
-        case ROS_INT32: ok = !val.is_unsigned && i >= INT32_MIN && i <= INT32_MAX; break;
-        case ROS_UINT32: ok = !val.is_unsigned && i >= 0 && i <= (int64_t)UINT32_MAX; break;
-        case ROS_INT64: ok = !val.is_unsigned; break;
-        case ROS_UINT64: ok = val.is_unsigned || i >= 0; break;
-        default: ok = 0;
-        }
-        if (!ok) return RGB_FALLBACK;
-    }
+    struct rgb_ros_type type = rgb_ros_type(kind);
+    if (conv == CONV_EXACT && !rgb_in_range(val, type.min, type.max)) return RGB_FALLBACK;
     return rgb_put_le(out, bits, size);
 }
 

@@ -91,27 +91,38 @@ static inline struct rgb_number rgb_u64(uint64_t bits) {
     return n;
 }
 
+/* A ROS basic type: its wire size and, for an integer, the range of its values (min 0: an
+ * unsigned one); all zero for a kind that is not one. */
+struct rgb_ros_type {
+    size_t size;
+    int64_t min;
+    uint64_t max;
+};
+
+static inline struct rgb_ros_type rgb_ros_type(int32_t kind) {
+    static const struct rgb_ros_type types[ROS_DOUBLE + 1] = {
+        [ROS_BOOL] = {1, 0, 1},
+        [ROS_UINT8] = {1, 0, UINT8_MAX},
+        [ROS_INT8] = {1, INT8_MIN, INT8_MAX},
+        [ROS_INT16] = {2, INT16_MIN, INT16_MAX},
+        [ROS_UINT16] = {2, 0, UINT16_MAX},
+        [ROS_INT32] = {4, INT32_MIN, INT32_MAX},
+        [ROS_UINT32] = {4, 0, UINT32_MAX},
+        [ROS_INT64] = {8, INT64_MIN, INT64_MAX},
+        [ROS_UINT64] = {8, 0, UINT64_MAX},
+        [ROS_FLOAT] = {4, 0, 0},
+        [ROS_DOUBLE] = {8, 0, 0},
+    };
+    struct rgb_ros_type none = {0, 0, 0};
+    return kind >= ROS_BOOL && kind <= ROS_DOUBLE ? types[kind] : none;
+}
+
 /* The wire size of a ROS basic type (0: not one). */
-static inline size_t rgb_ros_size(int32_t kind) {
-    switch (kind) {
-    case ROS_BOOL:
-    case ROS_UINT8:
-    case ROS_INT8:
-        return 1;
-    case ROS_INT16:
-    case ROS_UINT16:
-        return 2;
-    case ROS_INT32:
-    case ROS_UINT32:
-    case ROS_FLOAT:
-        return 4;
-    case ROS_INT64:
-    case ROS_UINT64:
-    case ROS_DOUBLE:
-        return 8;
-    default:
-        return 0;
-    }
+static inline size_t rgb_ros_size(int32_t kind) { return rgb_ros_type(kind).size; }
+
+/* Whether the integer `v` is within [min, max]. */
+static inline int rgb_in_range(struct rgb_number v, int64_t min, uint64_t max) {
+    return v.is_unsigned ? v.u <= max : v.i >= min && (v.i < 0 || (uint64_t)v.i <= max);
 }
 
 /* The wire type of a protobuf field type. */

@@ -1,7 +1,8 @@
 """What the two compilers of native programs share (``program.py``: Gazebo -> ROS,
 ``encoder.py``: ROS -> Gazebo): the error that keeps a pair on the Python path, paths of field
-names, the numbers of ROS basic types and of narrowing, the Value functions a program
-expresses, text as words, and the protobuf fields and ROS slots they read.
+names, the numbers of ROS basic types and of narrowing, the walk of a declaration's Fills and
+the Value functions a program expresses in it, text as words, and the protobuf fields and ROS
+slots they read.
 """
 
 from __future__ import annotations
@@ -9,9 +10,10 @@ from __future__ import annotations
 import sys
 from array import array
 from collections.abc import Callable, Mapping
-from typing import Any, TypeVar
+from dataclasses import dataclass
+from typing import Any, Generic, TypeVar
 
-from ros_gz_bridge_py.converters._fields import same
+from ros_gz_bridge_py.converters._fields import Each, Fill, Table, same
 from ros_gz_bridge_py.converters.builtin_interfaces import to_int32, to_uint32
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
@@ -50,6 +52,43 @@ VALUES: dict[Callable[[Any], Any], bool] = {same: False, to_int32: True, to_uint
 
 
 _T = TypeVar("_T")
+
+
+@dataclass(frozen=True)
+class Half(Generic[_T]):
+    """How a compiler reads one half (``to_ros`` or ``to_gz``) of the declarations into its
+    ``_T``: ``leaves``, the hand-written Fills the tables build on; ``copy(ros, gz, wrap, out)``
+    for a field copied (``wrap``: narrowed as C++ does); ``each(shape, ros, gz, out)`` for a
+    sequence filled element by element."""
+
+    name: str
+    leaves: Mapping[Callable[[Any, Any], None], Callable[[Path, Path, _T], None]]
+    copy: Callable[[Path, Path, bool, _T], None]
+    each: Callable[[Each, Path, Path, _T], None]
+
+    def assign(self, fill: Fill, ros: Path, gz: Path, out: _T) -> None:
+        """What ``fill``'s half writes (from ``gz`` to ``ros`` or back), into ``out``; raises
+        NotExpressibleError at a step a program cannot express."""
+        function = getattr(fill, self.name)
+        leaf = self.leaves.get(function)
+        if leaf is not None:
+            leaf(ros, gz, out)
+        elif isinstance(fill.shape, Table):
+            for ros_path, gz_path, how in fill.shape.parts:
+                at = (*ros, *split_path(ros_path)), (*gz, *split_path(gz_path))
+                step = same if how is None else getattr(how, self.name)  # a Value's, or None
+                if isinstance(how, Fill):
+                    self.assign(how, *at, out)
+                elif step in VALUES:
+                    self.copy(*at, VALUES[step], out)
+                elif step is not None:
+                    msg = f"a Value of {step.__qualname__}"
+                    raise NotExpressibleError(msg)
+        elif isinstance(fill.shape, Each):
+            self.each(fill.shape, ros, gz, out)
+        else:
+            msg = f"a Fill of hand-written functions ({function.__qualname__})"
+            raise NotExpressibleError(msg)
 
 
 def named(function: Callable[..., Any], table: Mapping[tuple[str, str], _T]) -> _T | None:
