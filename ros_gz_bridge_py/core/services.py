@@ -138,7 +138,7 @@ class ServiceBridge:
         self.held = HeldBytes(max_queued_bytes)
         #: Calls answered at once because the waiting ones held the budget.
         self.refused_over_bytes = 0
-        self._refusals = Throttle(DROP_WARN_PERIOD)
+        self._warnings = Throttle(DROP_WARN_PERIOD)
         #: Responses sent again once their client was discovered, and responses given up.
         self.late_answers = 0
         self.unanswered = 0
@@ -208,7 +208,7 @@ class ServiceBridge:
         """A call over the byte budget: answered at once, counted, told once per period."""
         self.failures += 1
         self.refused_over_bytes += 1
-        if self._refusals.ready():
+        if self._warnings.ready("refused"):
             self._logger.warning(
                 f"{self.describe()}: a request of {size} bytes refused (success=false): "
                 f"{self.held.calls} calls holding {self.held.held} bytes already wait for "
@@ -261,16 +261,20 @@ class ServiceBridge:
             )
 
     def not_answered(self, waited: float, why: str) -> None:
-        """A held response is given up after ``waited`` seconds (late_responses.py)."""
+        """A held response is given up after ``waited`` seconds (late_responses.py); told once
+        per period, counted in full."""
         self.unanswered += 1
-        self._logger.warning(
-            f"{self.describe()}: a response is given up after {waited:.1f} s: {why}; "
-            f"{self.unanswered} given up so far"
-        )
+        if self._warnings.ready("unanswered"):
+            self._logger.warning(
+                f"{self.describe()}: a response is given up after {waited:.1f} s: {why}; "
+                f"{self.unanswered} given up so far"
+            )
 
     def _fail(self, why: str) -> Any:
+        """A call answered success=false: counted, told once per period."""
         self.failures += 1
-        self._logger.warning(f"{self.describe()}: {why}")
+        if self._warnings.ready("failed"):
+            self._logger.warning(f"{self.describe()}: {why}; {self.failures} failed so far")
         return self.pair.failure_to_ros()
 
     def close(self) -> None:

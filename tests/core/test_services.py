@@ -274,3 +274,39 @@ def test_a_response_whose_client_is_never_discovered_is_given_up_and_counted(
     (status,) = StatusTracker(rig.bridge).snapshot()
     assert (status.received, status.published, status.dropped) == (1, 0, 1)
     assert bridge.late_answers == 0
+
+
+class Warnings:
+    """Stands in for a service bridge's logger: keeps its warnings."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def warning(self, line: str) -> None:
+        self.lines.append(line)
+
+    def info(self, line: str) -> None:
+        """Late answers are told at INFO; not what these tests count."""
+
+
+def test_failed_and_given_up_calls_are_counted_in_full_and_told_once_per_period(
+    rig: Rig, world: RosWorld
+) -> None:
+    """A provider that fails every call, called three times, and three responses given up:
+    every one counted, each kind told once per period (a client calling fast must not turn
+    the log into one line per call)."""
+    service = unique("failing_often")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    provider = Provider(GzWorldControl, None)
+    rig.gazebo().advertise_service(service, "gz.msgs.WorldControl", "gz.msgs.Boolean", provider)
+    bridge = rig.bridge.services[0]
+    warnings = Warnings()
+    bridge._logger = warnings  # type: ignore[assignment]
+    for _ in range(3):
+        assert call(world, ControlWorld, service, control_request()).success is False
+    for _ in range(3):
+        bridge.not_answered(10.0, "its client was not discovered")
+    assert (bridge.failures, bridge.unanswered) == (3, 3)
+    assert len(warnings.lines) == 2, warnings.lines
+    assert "Gazebo reported failure; 1 failed so far" in warnings.lines[0]
+    assert "given up after 10.0 s: its client was not discovered; 1 given up" in warnings.lines[1]
