@@ -25,6 +25,7 @@ from benchmarks import (
     first_call,
     fleet,
     fleet_clock,
+    fleet_memory,
     headline,
     images,
     memory,
@@ -83,6 +84,13 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
                 *("--robots", "50"),
                 *("--seconds", "5" if quick else "20"),
                 *("--rounds", "1" if quick else "3"),
+            ]
+        ),
+        "fleet_memory": lambda: fleet_memory.main(
+            [
+                *("--robots", "50"),
+                *("--seconds", "10" if quick else "60"),
+                *("--rounds", "1" if quick else "2"),
             ]
         ),
         "memory": lambda: memory.main(
