@@ -99,6 +99,23 @@ static int put_frame(struct rgb_out *out, struct view s) {
 
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v);
 
+/* The string field `number` of `at` (its last occurrence; empty where it is absent). */
+static int put_string_field(struct ctx *c, struct at at, uint32_t number) {
+    struct field f;
+    int found, status = pb_last_of(c, at, number, &f, &found);
+    if (status) return status;
+    if (found && f.wire != WIRE_LEN) return RGB_FALLBACK;
+    return found ? put_string(c->out, f.payload.p, f.payload.n) : put_string(c->out, NULL, 0);
+}
+
+/* The scalar field `number` of protobuf `type` in `at`, written as ROS `kind`. */
+static int put_scalar_field(struct ctx *c, struct at at, uint32_t number, int32_t type,
+                            int32_t kind, int32_t conv) {
+    struct rgb_number val;
+    int status = pb_scalar(c, at, number, type, &val);
+    return status ? status : put_value(c->out, kind, conv, val);
+}
+
 /* Counting, and then reading, the elements of a repeated scalar (packed or not). */
 struct scalars {
     int32_t type;
@@ -156,7 +173,6 @@ struct column {
     int32_t nsteps;
     uint32_t number;
     int32_t type, kind; /* kind 0: a string column */
-    struct rgb_out *out;
 };
 
 static int column_element(void *ctx, const struct field *f) {
@@ -166,18 +182,8 @@ static int column_element(void *ctx, const struct field *f) {
     /* each element is read by one op only: scanned, not indexed */
     int status = pb_descend(c->c, (struct at){f->payload, NO_NODE}, c->steps, c->nsteps, &element);
     if (status) return status;
-    if (c->kind == 0) {
-        struct field s;
-        int found;
-        status = pb_find(c->c, element.v, c->number, 0, &s, &found);
-        if (status) return status;
-        if (found && s.wire != WIRE_LEN) return RGB_FALLBACK;
-        return found ? put_string(c->out, s.payload.p, s.payload.n) : put_string(c->out, NULL, 0);
-    }
-    struct rgb_number val;
-    status = pb_scalar(c->c, element, c->number, c->type, &val);
-    if (status) return status;
-    return put_value(c->out, c->kind, CONV_EXACT, val);
+    if (c->kind == 0) return put_string_field(c->c, element, c->number);
+    return put_scalar_field(c->c, element, c->number, c->type, c->kind, CONV_EXACT);
 }
 
 /* The count written before a sequence, and the alignment Fast CDR gives its elements only
@@ -233,14 +239,10 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += 1 + op[0];
         }
         switch (code) {
-        case OP_NUM: {
-            struct rgb_number val;
-            status = pb_scalar(c, at, (uint32_t)op[0], op[1], &val);
-            if (status) return status;
-            status = put_value(out, op[2], op[3], val);
+        case OP_NUM:
+            status = put_scalar_field(c, at, (uint32_t)op[0], op[1], op[2], op[3]);
             op += 4;
             break;
-        }
         case OP_CONST: {
             uint64_t bits = (uint32_t)op[1] | (uint64_t)(uint32_t)op[2] << 32;
             size_t size = rgb_ros_size(op[0]);
@@ -249,16 +251,10 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += 3;
             break;
         }
-        case OP_STR: {
-            struct field f;
-            int found;
-            status = pb_last_of(c, at, (uint32_t)op[0], &f, &found);
-            if (status) return status;
-            if (found && f.wire != WIRE_LEN) return RGB_FALLBACK;
-            status = found ? put_string(out, f.payload.p, f.payload.n) : put_string(out, NULL, 0);
+        case OP_STR:
+            status = put_string_field(c, at, (uint32_t)op[0]);
             op += 1;
             break;
-        }
         case OP_CONST_STR:
             status = put_string(out, word_bytes(op), (size_t)op[0]);
             op += rgb_text_span(op[0]);
@@ -319,7 +315,7 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         case OP_COLUMN_STR: {
             uint32_t number = (uint32_t)op[0];
             int32_t nsub = op[1];
-            struct column col = {c, op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0, out};
+            struct column col = {c, op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0};
             op += 3 + nsub;
             if (code == OP_COLUMN) {
                 col.type = op[0];
@@ -345,13 +341,9 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             if (s < 0) return RGB_CONVERSION;
             int64_t total = s * 1000000000LL + (int64_t)(uint32_t)(uint64_t)nsec.i;
             struct rgb_number result = {0, 0, 0, 0, 0.0};
-            if (part == 0) {
-                result.i = (int32_t)(uint32_t)(uint64_t)(total / 1000000000LL);
-                status = put_value(out, ROS_INT32, CONV_EXACT, result);
-            } else {
-                result.i = total % 1000000000LL;
-                status = put_value(out, ROS_UINT32, CONV_EXACT, result);
-            }
+            result.i = part == 0 ? (int32_t)(uint32_t)(uint64_t)(total / 1000000000LL)
+                                 : total % 1000000000LL;
+            status = put_value(out, part == 0 ? ROS_INT32 : ROS_UINT32, CONV_EXACT, result);
             break;
         }
         case OP_WALL_STAMP: { /* a Time of the wall clock now: int32 sec, uint32 nanosec */

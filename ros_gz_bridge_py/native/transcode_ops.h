@@ -115,12 +115,6 @@ static inline int read_field(struct ctx *c, struct view v, size_t *pos, struct f
     }
 }
 
-static inline uint32_t le32(const uint8_t *p) {
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static inline uint64_t le64(const uint8_t *p) { return (uint64_t)le32(p) | (uint64_t)le32(p + 4) << 32; }
-
 /* ---- the index: each message read by the ops is scanned once ------------------------------ */
 
 /* Ops read many fields of one message; scanning it for each would cost the ops times its size
