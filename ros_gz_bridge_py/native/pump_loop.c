@@ -197,7 +197,8 @@ static void deliver(PumpObject *self, struct queued *q) {
     int program = self->routes[q->route].program;
     const uint8_t *data = self->f.msg_data(&q->payload);
     size_t size = self->f.msg_size(&q->payload);
-    enum rgb_status status = rgb_to_cdr(self->programs[program].program, data, size, &self->out);
+    enum rgb_status status =
+        rgb_to_cdr(self->programs[program].program, data, size, &self->out, NULL);
     if (status == RGB_OK) {
         /* its allocator left zero: rcl only reads the buffer */
         rcl_bytes message = {self->out.data, self->out.len, self->out.cap, {0}};

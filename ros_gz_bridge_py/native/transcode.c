@@ -391,8 +391,8 @@ static size_t refusal_limit(size_t n) {
     return RGB_OUTPUT_FLOOR + 2 * RGB_OUTPUT_RATIO * n;
 }
 
-enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
-                                   size_t payload_len, struct rgb_out *out, size_t *steps) {
+enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
+                           size_t payload_len, struct rgb_out *out, size_t *steps) {
     static const uint8_t header[4] = {0, 1, 0, 0};
     struct view v = {payload, payload_len};
     struct ctx c = {program, out, 0, 0};
@@ -414,11 +414,6 @@ enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint
     }
     if (steps != NULL) *steps = c.steps;
     return (enum rgb_status)status;
-}
-
-enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
-                           size_t payload_len, struct rgb_out *out) {
-    return rgb_to_cdr_counted(program, payload, payload_len, out, NULL);
 }
 
 void rgb_out_free(struct rgb_out *out) {

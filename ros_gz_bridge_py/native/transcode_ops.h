@@ -62,7 +62,7 @@ struct field {
 
 /* What one rgb_to_cdr call works with: the program, the output, the index of the messages it
  * reads (kept in out->scratch as a stack: each run of ops pops what it indexed) and the number
- * of fields it read, its work (rgb_to_cdr_counted). */
+ * of fields it read, its work (rgb_to_cdr's steps). */
 struct ctx {
     const struct rgb_program *pr;
     struct rgb_out *out;
