@@ -55,44 +55,27 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
     return rgb_put_le(out, bits, size);
 }
 
-/* A CDR string: length with the NUL, the bytes, the NUL. A NUL inside is left to Python. */
-static int put_string(struct rgb_out *out, const uint8_t *p, size_t n) {
+/* A CDR string: length with the NUL, the bytes, the NUL; with `frame`, a Gazebo scoped name as
+ * a ROS frame: each "::" (left to right) becomes "/". A NUL inside is left to Python. */
+static int put_string(struct rgb_out *out, const uint8_t *p, size_t n, int frame) {
     if (n && memchr(p, 0, n) != NULL) return RGB_FALLBACK;
-    if (n >= UINT32_MAX) return RGB_FALLBACK;
-    int status = put_u32(out, (uint32_t)n + 1);
-    if (status) return status;
-    status = rgb_put(out, p, n);
-    if (status) return status;
-    uint8_t nul = 0;
-    return rgb_put(out, &nul, 1);
-}
-
-/* A Gazebo scoped name as a ROS frame: each "::" (left to right) becomes "/". */
-static int put_frame(struct rgb_out *out, struct view s) {
-    if (s.n && memchr(s.p, 0, s.n) != NULL) return RGB_FALLBACK;
-    size_t pairs = 0;
-    for (size_t i = 0; i + 1 < s.n; i++) {
-        if (s.p[i] == ':' && s.p[i + 1] == ':') {
-            pairs++;
+    size_t written = n;
+    for (size_t i = 0; frame && i + 1 < n; i++) {
+        if (p[i] == ':' && p[i + 1] == ':') {
+            written--;
             i++;
         }
     }
-    size_t written = s.n - pairs;
     if (written >= UINT32_MAX) return RGB_FALLBACK;
     int status = put_u32(out, (uint32_t)written + 1);
+    if (!status) status = frame ? rgb_grow(out, written) : rgb_put(out, p, n);
     if (status) return status;
-    status = rgb_grow(out, written + 1);
-    if (status) return status;
-    for (size_t i = 0; i < s.n; i++) {
-        if (s.p[i] == ':' && i + 1 < s.n && s.p[i + 1] == ':') {
-            out->data[out->len++] = '/';
-            i++;
-        } else {
-            out->data[out->len++] = s.p[i];
-        }
+    for (size_t i = 0; frame && i < n; i++) {
+        int pair = p[i] == ':' && i + 1 < n && p[i + 1] == ':';
+        out->data[out->len++] = pair ? '/' : p[i];
+        i += (size_t)pair;
     }
-    out->data[out->len++] = 0;
-    return 0;
+    return rgb_put(out, "", 1);
 }
 
 /* ---- running a program ------------------------------------------------------------------- */
@@ -105,7 +88,7 @@ static int put_string_field(struct ctx *c, struct at at, uint32_t number) {
     int found, status = pb_last_of(c, at, number, &f, &found);
     if (status) return status;
     if (found && f.wire != WIRE_LEN) return RGB_FALLBACK;
-    return found ? put_string(c->out, f.payload.p, f.payload.n) : put_string(c->out, NULL, 0);
+    return found ? put_string(c->out, f.payload.p, f.payload.n, 0) : put_string(c->out, NULL, 0, 0);
 }
 
 /* The scalar field `number` of protobuf `type` in `at`, written as ROS `kind`. */
@@ -256,7 +239,7 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += 1;
             break;
         case OP_CONST_STR:
-            status = put_string(out, word_bytes(op), (size_t)op[0]);
+            status = put_string(out, word_bytes(op), (size_t)op[0], 0);
             op += rgb_text_span(op[0]);
             break;
         case OP_HEADER_STR: {
@@ -264,8 +247,8 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += 1 + rgb_text_span(op[1]);
             status = pb_for_each(c, at, 2, header_entry, &h);
             if (status) return status;
-            status = h.found ? put_frame(out, h.value)
-                             : put_string(out, word_bytes(op), (size_t)op[0]);
+            status = h.found ? put_string(out, h.value.p, h.value.n, 1)
+                             : put_string(out, word_bytes(op), (size_t)op[0], 0);
             op += rgb_text_span(op[0]);
             break;
         }
