@@ -96,11 +96,8 @@ def native_encoders(layouts: dict[str, Pair], options: Any) -> dict[str, Encoder
     if not (options.native and options.light_read) or not _extension_available():
         return {}
     encoders = {wire_type: encoder_of(pair) for wire_type, pair in layouts.items()}
-    return (
-        {wire_type: encoder for wire_type, encoder in encoders.items() if encoder is not None}
-        if None not in encoders.values()
-        else {}
-    )
+    found = {wire_type: encoder for wire_type, encoder in encoders.items() if encoder is not None}
+    return found if len(found) == len(encoders) else {}
 
 
 @functools.cache
