@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ros_gz_bridge_py.converters._fields import Each, Fill, declaration_of
+from ros_gz_bridge_py.converters._fields import Each, declaration_of
 from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time
 from ros_gz_bridge_py.converters.covariance import fill_ros_covariance
 from ros_gz_bridge_py.converters.registry import Pair
@@ -177,26 +177,18 @@ _WHOLE: dict[tuple[str, str], Callable[[Assignments], None]] = {
 }
 
 
-def assignments_of(fill: Fill, ros: Path = (), gz: Path = ()) -> Assignments:
-    """Where each ROS field written by ``fill.to_ros`` comes from (later entries win, as
-    they do when the Python code runs).
-
-    Raises:
-        NotExpressibleError: a step of the Fill is not one a program can express.
-    """
-    out: Assignments = {}
-    _TO_ROS.assign(fill, ros, gz, out)
-    return out
-
-
 def _copy(ros: Path, gz: Path, wrap: bool, out: Assignments) -> None:
     out[ros] = Copy(gz, wrap)
 
 
 def _each(shape: Each, ros: Path, gz: Path, out: Assignments) -> None:
-    out[ros] = Sequence(gz, assignments_of(shape.fill), shape.new_ros)
+    element: Assignments = {}
+    _TO_ROS.assign(shape.fill, (), (), element)
+    out[ros] = Sequence(gz, element, shape.new_ros)
 
 
+#: Where each ROS field written by a Fill's ``to_ros`` comes from (later entries win, as they do
+#: when the Python code runs).
 _TO_ROS = Half("to_ros", _LEAVES, _copy, _each)
 
 
