@@ -107,29 +107,26 @@ struct scalars {
     struct rgb_out *out;
 };
 
-static int scalar_element(void *ctx, const struct field *f) {
-    struct scalars *s = ctx;
-    int wire = rgb_wire_of(s->type);
-    if (f->wire == WIRE_LEN && wire != WIRE_LEN) {
-        size_t pos = 0;
-        while (pos < f->payload.n) {
-            struct field one = {f->number, wire, 0, {NULL, 0}};
-            int status = read_value(f->payload, &pos, wire, &one);
-            if (status) return status;
-            s->count++;
-            if (s->kind) {
-                status = put_value(s->out, s->kind, CONV_EXACT,
-                                   pb_decode_scalar(s->type, pb_raw_of(&one)));
-                if (status) return status;
-            }
-        }
-        return 0;
-    }
-    if (f->wire != wire) return RGB_FALLBACK;
+/* One element: counted, and written as s->kind where there is one. */
+static int scalar_one(struct scalars *s, const struct field *f) {
     s->count++;
     if (!s->kind) return 0;
     return put_value(s->out, s->kind, CONV_EXACT, pb_decode_scalar(s->type, pb_raw_of(f)));
 }
+
+static int scalar_element(void *ctx, const struct field *f) {
+    struct scalars *s = ctx;
+    int wire = rgb_wire_of(s->type), status = 0;
+    if (f->wire != WIRE_LEN || wire == WIRE_LEN) /* one value, not a packed run */
+        return f->wire == wire ? scalar_one(s, f) : RGB_FALLBACK;
+    for (size_t pos = 0; pos < f->payload.n && !status;) {
+        struct field one = {f->number, wire, 0, {NULL, 0}};
+        status = read_value(f->payload, &pos, wire, &one);
+        if (!status) status = scalar_one(s, &one);
+    }
+    return status;
+}
+
 /* The elements of a repeated submessage field, each indexed (when its type is known) and run
  * through a body of ops; the element's index is popped after. */
 struct messages {
