@@ -37,7 +37,7 @@ int main(int argc, char **argv) {
     struct rgb_out out = {0};
     long count = atol(argv[3]);
     enum rgb_status status = RGB_OK;
-    for (long k = 0; k < count; k++) status = rgb_to_cdr(&program, payload, n, &out);
+    for (long k = 0; k < count; k++) status = rgb_to_cdr(&program, payload, n, &out, NULL);
     printf("status %d, %zu payload bytes, %zu CDR bytes\n", (int)status, n, out.len);
     rgb_out_free(&out);
     return 0;

@@ -27,10 +27,10 @@
 static struct rgb_program loaded[PROGRAM_COUNT];
 static struct rgb_out out;
 
-/* Returns the fields read (rgb_to_cdr_counted). */
+/* Returns the fields read (rgb_to_cdr's steps). */
 static size_t transcode(const struct rgb_program *program, const uint8_t *payload, size_t n) {
     size_t steps = 0;
-    enum rgb_status status = rgb_to_cdr_counted(program, payload, n, &out, &steps);
+    enum rgb_status status = rgb_to_cdr(program, payload, n, &out, &steps);
     if (status > RGB_TOO_LARGE) abort();
     /* a refusal as too large only where even Python's most generous bound is passed */
     if (status == RGB_TOO_LARGE &&

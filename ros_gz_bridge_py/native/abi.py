@@ -121,31 +121,25 @@ def _addresses(functions: list[Any]) -> tuple[int, ...] | None:
 
 
 @functools.cache
-def _zmq_resolved() -> tuple[tuple[int, ...] | None, str]:
-    path = libzmq_path()
-    if path is None:
-        return None, "pyzmq's libzmq is not among the loaded libraries"
-    try:
-        libzmq, rcl = ctypes.CDLL(path), ctypes.CDLL("librcl.so")
-        functions = [getattr(libzmq, name) for name in _ZMQ_FUNCTIONS]
-        functions += [
-            rcl.rcl_publish_serialized_message,
-            ctypes.CDLL("librcutils.so").rcutils_reset_error,
-        ]
-    except (OSError, AttributeError) as err:
-        return None, f"libzmq or rcl cannot be used from C ({err})"
-    addresses = _addresses(functions)
-    return addresses, "" if addresses else "a function has no address"
-
-
 def zmq_functions() -> tuple[int, ...] | None:
     """The addresses of the libzmq and rcl functions a Pump calls, or None (then no channel
-    takes the native path; :func:`why_no_zmq_functions` says why)."""
-    return _zmq_resolved()[0]
-
-
-def why_no_zmq_functions() -> str:
-    return _zmq_resolved()[1]
+    takes the native path; logged once why)."""
+    path, addresses = libzmq_path(), None
+    problem = "pyzmq's libzmq is not among the loaded libraries"
+    try:
+        if path is not None:
+            libzmq, rcl = ctypes.CDLL(path), ctypes.CDLL("librcl.so")
+            functions = [getattr(libzmq, name) for name in _ZMQ_FUNCTIONS]
+            functions += [
+                rcl.rcl_publish_serialized_message,
+                ctypes.CDLL("librcutils.so").rcutils_reset_error,
+            ]
+            addresses, problem = _addresses(functions), "a function has no address"
+    except (OSError, AttributeError) as err:
+        problem = f"libzmq or rcl cannot be used from C ({err})"
+    if addresses is None:
+        _LOG.warning("Every channel takes the Python path: %s", problem)
+    return addresses
 
 
 @functools.cache

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.native import extension, unavailable_reason
-from ros_gz_bridge_py.native.abi import why_no_zmq_functions, zmq_functions, zmq_layout_fits
+from ros_gz_bridge_py.native.abi import zmq_functions, zmq_layout_fits
 from ros_gz_bridge_py.native.encoder import compile_to_gz
 from ros_gz_bridge_py.native.program import compile_to_ros
 from ros_gz_bridge_py.native.words import NotExpressibleError
@@ -73,12 +73,7 @@ def _extension_available() -> bool:
 def native_path_available() -> bool:
     """Whether the extension and the functions it calls are there, and libzmq lays out its
     messages as the loop declares (native/abi.py); logged once where not."""
-    if not _extension_available():
-        return False
-    if zmq_functions() is None:
-        _LOG.warning("Every channel takes the Python path: %s", why_no_zmq_functions())
-        return False
-    return zmq_layout_fits()
+    return _extension_available() and zmq_functions() is not None and zmq_layout_fits()
 
 
 @functools.cache
@@ -101,11 +96,8 @@ def native_encoders(layouts: dict[str, Pair], options: Any) -> dict[str, Encoder
     if not (options.native and options.light_read) or not _extension_available():
         return {}
     encoders = {wire_type: encoder_of(pair) for wire_type, pair in layouts.items()}
-    return (
-        {wire_type: encoder for wire_type, encoder in encoders.items() if encoder is not None}
-        if None not in encoders.values()
-        else {}
-    )
+    found = {wire_type: encoder for wire_type, encoder in encoders.items() if encoder is not None}
+    return found if len(found) == len(encoders) else {}
 
 
 @functools.cache

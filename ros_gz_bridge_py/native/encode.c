@@ -25,8 +25,7 @@ static int cdr_u32(struct reader *r, uint32_t *value) {
     int status = cdr_align(r, 4);
     if (status) return status;
     if (r->n - r->pos < 4) return RGB_UNDECODABLE;
-    const uint8_t *b = r->p + r->pos;
-    *value = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+    *value = (uint32_t)rgb_le(r->p + r->pos, 4);
     r->pos += 4;
     return 0;
 }
@@ -54,7 +53,7 @@ static int cdr_number(struct reader *r, int32_t kind, struct slot *s) {
     int status = cdr_align(r, size);
     if (status) return status;
     if (r->n - r->pos < size) return RGB_UNDECODABLE;
-    uint64_t bits = load(r->p + r->pos, size);
+    uint64_t bits = rgb_le(r->p + r->pos, size);
     if (kind == ROS_BOOL && bits > 1) return RGB_FALLBACK;
     if (s != NULL) s->bits = bits;
     r->pos += size;

@@ -45,22 +45,6 @@ size_t enc_min_size(const int32_t *op, const int32_t *end) {
     return size ? size : 1;
 }
 
-/* Checks read ops [0, n) of a frame of `nslots` slots. */
-static int check_read(const int32_t *ops, size_t n, int32_t nslots, int depth) {
-    size_t at = 0, w[RGB_MAX_OPERANDS];
-    if (depth > MAX_DEPTH) return -1;
-    while (at < n) {
-        int32_t code = ops[at++];
-        if (code == R_END) return at == n ? 0 : -1;
-        const char *layout = READ_LAYOUT(code);
-        if (layout == NULL || rgb_operands(ops, n, &at, layout, nslots, w)) return -1;
-        if (code == R_SEQ_MSG &&
-            check_read(ops + w[2] + 1, (size_t)ops[w[2]], ops[w[1]], depth + 1))
-            return -1;
-    }
-    return -1;
-}
-
 /* What the read ops of a frame put in each of its slots, which its write ops are checked
  * against: each slot they use must be one the read ops fill, with the right kind of content. */
 struct frame_info {
@@ -155,7 +139,8 @@ int rgb_encoder_load(struct rgb_encoder *encoder, const int32_t *words, size_t l
     }
     const int32_t *read = words + 2, *write = words + 2 + words[1];
     size_t read_len = (size_t)words[1], write_len = len - 2 - read_len;
-    if (check_read(read, read_len, words[0], 0)) {
+    size_t nread = sizeof READ_LAYOUTS / sizeof *READ_LAYOUTS;
+    if (rgb_check_body(read, read_len, READ_LAYOUTS, nread, words[0], 0, MAX_DEPTH)) {
         *why = "encoder: a read op is not well-formed";
         return -1;
     }

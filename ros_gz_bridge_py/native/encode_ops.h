@@ -50,13 +50,6 @@ struct reader {
     size_t used, cap;
 };
 
-/* The `size` bytes at `b` as a little-endian number. */
-static inline uint64_t load(const uint8_t *b, size_t size) {
-    uint64_t bits = 0;
-    for (size_t k = 0; k < size; k++) bits |= (uint64_t)b[k] << (8 * k);
-    return bits;
-}
-
 /* Reads a CDR string at r->pos into `s` (its bytes without the NUL; s may be NULL). */
 int enc_cdr_string(struct reader *r, struct slot *s);
 /* The fewest bytes a message read by ops [op, end) takes (encode_load.c). */

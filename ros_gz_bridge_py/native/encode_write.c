@@ -191,7 +191,7 @@ int enc_write_message(const struct reader *r, const int32_t *op, const int32_t *
                 for (size_t k = 0; k < s->count && !status; k++) {
                     uint64_t wire = 0;
                     int zero;
-                    uint64_t bits = load(r->p + s->offset + k * size, size);
+                    uint64_t bits = rgb_le(r->p + s->offset + k * size, size);
                     status = pb_value(op[1], CONV_EXACT, ros_number(op[2], bits), &wire, &zero);
                     if (!status) status = put_value(out, op[1], wire);
                 }

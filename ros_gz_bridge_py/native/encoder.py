@@ -13,7 +13,7 @@ of it was assigned (even to its default), a scalar only when it is not zero.
 from __future__ import annotations
 
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -173,15 +173,20 @@ class _Frame:
         return self.slots[path]
 
 
-def _used(node: Node, out: set[Path]) -> set[Path]:
-    """Every ROS path ``node``'s sources read (a sequence's own path, not its elements')."""
+def _sources(node: Node) -> Iterator[Any]:
+    """Every source below ``node``, in the order of its fields (a sequence's, not its
+    elements')."""
     for value in node.fields.values():
         for item in value if isinstance(value, list) else [value]:
             if isinstance(item, Node):
-                _used(item, out)
-            elif isinstance(item, (Copy, Sequence, Packed)):
-                out.add(item.ros)
-    return out
+                yield from _sources(item)
+            else:
+                yield item
+
+
+def _used(node: Node) -> set[Path]:
+    """Every ROS path ``node``'s sources read (a sequence's own path, not its elements')."""
+    return {item.ros for item in _sources(node) if isinstance(item, (Copy, Sequence, Packed))}
 
 
 def _read_ops(
@@ -209,7 +214,7 @@ def _read_ops(
             ops += [R_SEQ_STR, frame.slot(path, rosidl)]
         elif kind in cdr.SEQUENCE_TYPES and type(rosidl.value_type).__name__ == "NamespacedType":
             element_node = elements.get(path, Node())
-            element = _Frame(_used(element_node, set()))
+            element = _Frame(_used(element_node))
             body = _read_ops(
                 cdr.nested_class(rosidl.value_type), (), element, _sequences(element_node)
             )
@@ -225,14 +230,7 @@ def _read_ops(
 
 def _sequences(node: Node) -> dict[Path, Node]:
     """The element Node of each ROS sequence ``node``'s sources read."""
-    found: dict[Path, Node] = {}
-    for value in node.fields.values():
-        for item in value if isinstance(value, list) else [value]:
-            if isinstance(item, Node):
-                found.update(_sequences(item))
-            elif isinstance(item, Sequence):
-                found[item.ros] = item.element
-    return found
+    return {item.ros: item.element for item in _sources(node) if isinstance(item, Sequence)}
 
 
 # ---- the gz side: write ops ---------------------------------------------------------------------
@@ -351,7 +349,7 @@ def compile_to_gz(pair: Pair) -> bytes:
     else:
         msg = f"a hand-written converter ({pair.to_gz.__qualname__})"
         raise NotExpressibleError(msg)
-    top = _Frame(_used(tree, set()))
+    top = _Frame(_used(tree))
     read = _read_ops(pair.ros_class, (), top, _sequences(tree))
     read.append(R_END)
     write = _write_ops(tree, message_class(pair.gz_type).DESCRIPTOR, top)

@@ -7,9 +7,9 @@ converts and publishes it or says why not. That can be slow (a Pose_V of 4 M emp
 second of parsing), so it never runs on a loop's thread; and it must not cost a thread per
 channel either, or a rogue whose payloads fall back on many topics would add a thread to the
 process for each of them. So every channel has a :class:`FallbackLane` (its own drop-oldest
-queue, of the channel's bounds in messages and bytes, its drops counted; made at its first
-payload by its :class:`ChannelFallback`) on the process's one :class:`FallbackWorker`, whose
-thread serves the lanes that hold something one payload each in turn: a channel's payload waits
+queue, of the channel's bounds in messages and bytes, its drops counted; on the worker from its
+first payload) on the process's one :class:`FallbackWorker`, whose thread serves the lanes that
+hold something one payload each in turn: a channel's payload waits
 at most for the one being handled and one of each other lane whose turn came first, so a flood
 on one channel's fallback does not hold up another's behind its whole queue.
 
@@ -52,8 +52,9 @@ def _payload_size(item: tuple[bytes, object]) -> int:
 
 
 class FallbackLane(Generic[Info]):
-    """One channel's queue on the fallback thread: :meth:`put` from the loop's thread,
-    :meth:`close` from any."""
+    """One channel's queue on the fallback thread, which it joins at its first payload (a
+    channel whose payloads never fall back costs no thread): :meth:`put` from the loop's
+    thread, :meth:`close` from any."""
 
     def __init__(
         self,
@@ -71,6 +72,7 @@ class FallbackLane(Generic[Info]):
         )
         # Written under the worker's lock:
         self.closed = False
+        self.joined = False  # among the worker's lanes (from its first payload)
         self.waiting = False  # in the worker's turn order
 
     @property
@@ -112,21 +114,21 @@ class FallbackWorker:
         self, handler: Callable[[bytes, Info], None], size: int, max_bytes: int, name: str
     ) -> FallbackLane[Info]:
         """A new lane (of channel ``name``) whose payloads go to ``handler``, keeping the newest
-        ``size`` and at most ``max_bytes`` of them (always one); starts the thread if it is not
-        running."""
-        lane = FallbackLane(self, handler, size, max_bytes, name)
-        with self._changed:
-            self._lanes.add(lane)
-            if self._thread is None:
-                self._thread = threading.Thread(target=self._run, name=self._name, daemon=True)
-                self._thread.start()
-        return lane
+        ``size`` and at most ``max_bytes`` of them (always one)."""
+        return FallbackLane(self, handler, size, max_bytes, name)
 
     def wake(self, lane: FallbackLane[Any]) -> None:
-        """``lane`` holds a payload: give it a turn."""
+        """``lane`` holds a payload: give it a turn; at its first, it joins the lanes, and the
+        thread starts if it is not running."""
         with self._changed:
             if lane.closed or lane.waiting:
                 return
+            if not lane.joined:
+                lane.joined = True
+                self._lanes.add(lane)
+                if self._thread is None:
+                    self._thread = threading.Thread(target=self._run, name=self._name, daemon=True)
+                    self._thread.start()
             lane.waiting = True
             self._turns.append(lane)
             self._changed.notify()
@@ -197,41 +199,3 @@ class FallbackWorker:
 def fallback_worker() -> FallbackWorker:
     """The process's fallback thread (started at the first channel's first fallback)."""
     return FallbackWorker()
-
-
-class ChannelFallback(Generic[Info]):
-    """A channel's way to the fallback thread: its lane, made at its first payload (a channel
-    whose payloads never fall back costs no thread) and closed with the channel. :meth:`put`
-    from the loop's thread, the rest from any."""
-
-    def __init__(
-        self, handler: Callable[[bytes, Info], None], size: int, max_bytes: int, name: str
-    ) -> None:
-        self._lane: FallbackLane[Info] | None = None
-        self._made = functools.partial(fallback_worker().lane, handler, size, max_bytes, name)
-        self._closed = False
-        self._closing = threading.Lock()  # no lane is made as the channel closes
-
-    def put(self, payload: bytes, info: Info) -> None:
-        """``payload`` to the handler on the fallback thread (nothing once closed)."""
-        lane = self._lane
-        if lane is None:
-            with self._closing:
-                if self._closed:
-                    return
-                lane = self._lane = self._made()
-        lane.put(payload, info)
-
-    @property
-    def dropped(self) -> int:
-        """Payloads dropped on the way so far, oldest first."""
-        return self._lane.dropped if self._lane is not None else 0
-
-    def close(self) -> None:
-        """No more payloads to the handler, after the one it handles if it is this channel's.
-        Idempotent."""
-        with self._closing:
-            self._closed = True
-            lane = self._lane
-        if lane is not None:
-            lane.close()

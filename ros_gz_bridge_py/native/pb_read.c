@@ -227,8 +227,7 @@ struct rgb_number pb_decode_scalar(int32_t type, uint64_t raw) {
 
 uint64_t pb_raw_of(const struct field *f) {
     if (f->wire == WIRE_VARINT) return f->varint;
-    if (f->wire == WIRE_I64) return le64(f->payload.p);
-    return le32(f->payload.p);
+    return rgb_le(f->payload.p, f->wire == WIRE_I64 ? 8 : 4);
 }
 
 int pb_scalar(struct ctx *c, struct at v, uint32_t number, int32_t type, struct rgb_number *val) {

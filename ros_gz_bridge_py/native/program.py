@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ros_gz_bridge_py.converters._fields import Each, Fill, declaration_of
+from ros_gz_bridge_py.converters._fields import Each, declaration_of
 from ros_gz_bridge_py.converters.builtin_interfaces import fill_ros_time
 from ros_gz_bridge_py.converters.covariance import fill_ros_covariance
 from ros_gz_bridge_py.converters.registry import Pair
@@ -177,26 +177,18 @@ _WHOLE: dict[tuple[str, str], Callable[[Assignments], None]] = {
 }
 
 
-def assignments_of(fill: Fill, ros: Path = (), gz: Path = ()) -> Assignments:
-    """Where each ROS field written by ``fill.to_ros`` comes from (later entries win, as
-    they do when the Python code runs).
-
-    Raises:
-        NotExpressibleError: a step of the Fill is not one a program can express.
-    """
-    out: Assignments = {}
-    _TO_ROS.assign(fill, ros, gz, out)
-    return out
-
-
 def _copy(ros: Path, gz: Path, wrap: bool, out: Assignments) -> None:
     out[ros] = Copy(gz, wrap)
 
 
 def _each(shape: Each, ros: Path, gz: Path, out: Assignments) -> None:
-    out[ros] = Sequence(gz, assignments_of(shape.fill), shape.new_ros)
+    element: Assignments = {}
+    _TO_ROS.assign(shape.fill, (), (), element)
+    out[ros] = Sequence(gz, element, shape.new_ros)
 
 
+#: Where each ROS field written by a Fill's ``to_ros`` comes from (later entries win, as they do
+#: when the Python code runs).
 _TO_ROS = Half("to_ros", _LEAVES, _copy, _each)
 
 
@@ -256,111 +248,107 @@ def _scalar_field(field: Any) -> None:
         raise NotExpressibleError(msg)
 
 
-class _Emitter:
-    def __init__(self, schema: _Schema) -> None:
-        self.schema = schema
+def _message(
+    msg_class: type[Any], prefix: Path, given: Mapping[Path, Source], default: Any,
+    gz: Any,
+) -> list[int]:  # fmt: skip
+    fields = cdr.fields_of(msg_class)
+    if not fields:
+        return [OP_CONST, ROS_KINDS["uint8"][0], 0, 0]
+    ops: list[int] = []
+    for name, slot in fields:
+        path = (*prefix, name)
+        value = getattr(default, name)
+        source = given.get(path)
+        if source is not None:
+            ops += _source(slot, source, value, gz)
+        elif type(slot).__name__ == "NamespacedType":
+            nested = {key: src for key, src in given.items() if key[: len(path)] == path}
+            ops += _message(cdr.nested_class(slot), path, nested, value, gz)
+        else:
+            ops += _constant(slot, value)
+    return ops
 
-    def message(
-        self, msg_class: type[Any], prefix: Path, given: Mapping[Path, Source], default: Any,
-        gz: Any,
-    ) -> list[int]:  # fmt: skip
-        fields = cdr.fields_of(msg_class)
-        if not fields:
-            return [OP_CONST, ROS_KINDS["uint8"][0], 0, 0]
-        ops: list[int] = []
-        for name, slot in fields:
-            path = (*prefix, name)
-            value = getattr(default, name)
-            source = given.get(path)
-            if source is not None:
-                ops += self.source(slot, source, value, gz)
-            elif type(slot).__name__ == "NamespacedType":
-                nested = {key: src for key, src in given.items() if key[: len(path)] == path}
-                ops += self.message(cdr.nested_class(slot), path, nested, value, gz)
-            else:
-                ops += self.constant(slot, value)
-        return ops
 
-    def source(self, slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
-        kind = type(slot).__name__
-        if isinstance(source, Copy) and kind in cdr.STRING_TYPES:
-            steps, field = walk(gz, source.gz)
-            if field.type != _PB_STRING or field.is_repeated:
-                msg = f"{field.full_name} is not a string"
-                raise NotExpressibleError(msg)
-            return [OP_STR, len(steps), *steps, field.number]
-        if isinstance(source, Copy):
-            steps, field = walk(gz, source.gz)
-            _scalar_field(field)
-            kind_number, code = ros_kind(slot)
-            if code in "fd" and field.cpp_type not in (5, 6):  # CPPTYPE_DOUBLE, CPPTYPE_FLOAT
-                msg = f"{field.full_name} is not a floating-point number"
-                raise NotExpressibleError(msg)
-            conv = CONV_WRAP if source.wrap else CONV_EXACT
-            return [OP_NUM, len(steps), *steps, field.number, field.type, kind_number, conv]
-        if isinstance(source, HeaderText) and kind in cdr.STRING_TYPES:
-            steps, _header_type = descend(gz, source.gz)
-            return [
-                OP_HEADER_STR, len(steps), *steps, int(source.last),
-                *text_words(source.key.encode()), *text_words(_plain(default)),
-            ]  # fmt: skip
-        if isinstance(source, FixedList) and kind == "Array":
-            steps, field = walk(gz, source.gz)
-            if not field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
-                msg = f"{field.full_name} is not a repeated number"
-                raise NotExpressibleError(msg)
-            kind_number, _code = ros_kind(slot.value_type)
-            return [OP_FIXED_LIST, len(steps), *steps, field.number, field.type, kind_number,
-                    slot.size]  # fmt: skip
-        if isinstance(source, Sequence) and kind in cdr.SEQUENCE_TYPES:
-            steps, field = walk(gz, source.gz)
-            element_class = cdr.nested_class(slot.value_type)
-            if field.message_type is None or not field.is_repeated:
-                msg = f"{field.full_name} is not a repeated message"
-                raise NotExpressibleError(msg)
-            body = self.message(
-                element_class, (), source.element, source.new_ros(), field.message_type
-            )
-            body.append(OP_END)
-            return [OP_SEQ_MSG, len(steps), *steps, field.number, len(body), *body]
-        if isinstance(source, Column) and kind in cdr.SEQUENCE_TYPES:
-            steps, field = walk(gz, source.gz)
-            if field.message_type is None or not field.is_repeated:
-                msg = f"{field.full_name} is not a repeated message"
-                raise NotExpressibleError(msg)
-            sub_steps, sub = walk(field.message_type, source.field)
-            head = [len(steps), *steps, field.number, len(sub_steps), *sub_steps, sub.number]
-            if type(slot.value_type).__name__ in cdr.STRING_TYPES and sub.type == _PB_STRING:
-                return [OP_COLUMN_STR, *head]
-            _scalar_field(sub)
-            kind_number, _code = ros_kind(slot.value_type)
-            return [OP_COLUMN, *head, sub.type, kind_number]
-        if isinstance(source, ClockPart) and cdr.basic_of(slot) is not None:
-            steps, _time_type = descend(gz, source.gz)
-            return [OP_CLOCK, len(steps), *steps, source.part]
-        if isinstance(source, FixedText) and kind in cdr.STRING_TYPES:
-            return [OP_CONST_STR, *text_words(_plain(source.value))]
-        if isinstance(source, WallStamp) and cdr.basic_of(slot) in ("int32", "uint32"):
-            return [OP_WALL_STAMP] if source.part == 0 else []
-        msg = f"{type(source).__name__} into a ROS {kind}"
-        raise NotExpressibleError(msg)
+def _source(slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
+    kind = type(slot).__name__
+    if isinstance(source, Copy) and kind in cdr.STRING_TYPES:
+        steps, field = walk(gz, source.gz)
+        if field.type != _PB_STRING or field.is_repeated:
+            msg = f"{field.full_name} is not a string"
+            raise NotExpressibleError(msg)
+        return [OP_STR, len(steps), *steps, field.number]
+    if isinstance(source, Copy):
+        steps, field = walk(gz, source.gz)
+        _scalar_field(field)
+        kind_number, code = ros_kind(slot)
+        if code in "fd" and field.cpp_type not in (5, 6):  # CPPTYPE_DOUBLE, CPPTYPE_FLOAT
+            msg = f"{field.full_name} is not a floating-point number"
+            raise NotExpressibleError(msg)
+        conv = CONV_WRAP if source.wrap else CONV_EXACT
+        return [OP_NUM, len(steps), *steps, field.number, field.type, kind_number, conv]
+    if isinstance(source, HeaderText) and kind in cdr.STRING_TYPES:
+        steps, _header_type = descend(gz, source.gz)
+        return [
+            OP_HEADER_STR, len(steps), *steps, int(source.last),
+            *text_words(source.key.encode()), *text_words(_plain(default)),
+        ]  # fmt: skip
+    if isinstance(source, FixedList) and kind == "Array":
+        steps, field = walk(gz, source.gz)
+        if not field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
+            msg = f"{field.full_name} is not a repeated number"
+            raise NotExpressibleError(msg)
+        kind_number, _code = ros_kind(slot.value_type)
+        return [OP_FIXED_LIST, len(steps), *steps, field.number, field.type, kind_number,
+                slot.size]  # fmt: skip
+    if isinstance(source, Sequence) and kind in cdr.SEQUENCE_TYPES:
+        steps, field = walk(gz, source.gz)
+        element_class = cdr.nested_class(slot.value_type)
+        if field.message_type is None or not field.is_repeated:
+            msg = f"{field.full_name} is not a repeated message"
+            raise NotExpressibleError(msg)
+        body = _message(element_class, (), source.element, source.new_ros(), field.message_type)
+        body.append(OP_END)
+        return [OP_SEQ_MSG, len(steps), *steps, field.number, len(body), *body]
+    if isinstance(source, Column) and kind in cdr.SEQUENCE_TYPES:
+        steps, field = walk(gz, source.gz)
+        if field.message_type is None or not field.is_repeated:
+            msg = f"{field.full_name} is not a repeated message"
+            raise NotExpressibleError(msg)
+        sub_steps, sub = walk(field.message_type, source.field)
+        head = [len(steps), *steps, field.number, len(sub_steps), *sub_steps, sub.number]
+        if type(slot.value_type).__name__ in cdr.STRING_TYPES and sub.type == _PB_STRING:
+            return [OP_COLUMN_STR, *head]
+        _scalar_field(sub)
+        kind_number, _code = ros_kind(slot.value_type)
+        return [OP_COLUMN, *head, sub.type, kind_number]
+    if isinstance(source, ClockPart) and cdr.basic_of(slot) is not None:
+        steps, _time_type = descend(gz, source.gz)
+        return [OP_CLOCK, len(steps), *steps, source.part]
+    if isinstance(source, FixedText) and kind in cdr.STRING_TYPES:
+        return [OP_CONST_STR, *text_words(_plain(source.value))]
+    if isinstance(source, WallStamp) and cdr.basic_of(slot) in ("int32", "uint32"):
+        return [OP_WALL_STAMP] if source.part == 0 else []
+    msg = f"{type(source).__name__} into a ROS {kind}"
+    raise NotExpressibleError(msg)
 
-    def constant(self, slot: Any, value: Any) -> list[int]:
-        """The ops that write ``value``, a ROS field's default."""
-        kind = type(slot).__name__
-        if cdr.basic_of(slot) is not None:
-            kind_number, code = ros_kind(slot)
-            return [OP_CONST, kind_number, *_bits(code, value)]
-        if kind in cdr.STRING_TYPES:
-            return [OP_CONST_STR, *text_words(_plain(value))]
-        if kind == "Array" and cdr.basic_of(slot.value_type) is not None:
-            _kind_number, code = ros_kind(slot.value_type)
-            data = struct.pack(f"<{slot.size}{code}", *value)
-            return [OP_CONST_BLOCK, struct.calcsize(code), *text_words(data)]
-        if kind in cdr.SEQUENCE_TYPES and len(value) == 0:
-            return [OP_CONST, ROS_KINDS["uint32"][0], 0, 0]
-        msg = f"a default {kind} the program cannot write"
-        raise NotExpressibleError(msg)
+
+def _constant(slot: Any, value: Any) -> list[int]:
+    """The ops that write ``value``, a ROS field's default."""
+    kind = type(slot).__name__
+    if cdr.basic_of(slot) is not None:
+        kind_number, code = ros_kind(slot)
+        return [OP_CONST, kind_number, *_bits(code, value)]
+    if kind in cdr.STRING_TYPES:
+        return [OP_CONST_STR, *text_words(_plain(value))]
+    if kind == "Array" and cdr.basic_of(slot.value_type) is not None:
+        _kind_number, code = ros_kind(slot.value_type)
+        data = struct.pack(f"<{slot.size}{code}", *value)
+        return [OP_CONST_BLOCK, struct.calcsize(code), *text_words(data)]
+    if kind in cdr.SEQUENCE_TYPES and len(value) == 0:
+        return [OP_CONST, ROS_KINDS["uint32"][0], 0, 0]
+    msg = f"a default {kind} the program cannot write"
+    raise NotExpressibleError(msg)
 
 
 def _plain(text: str) -> bytes:
@@ -412,6 +400,6 @@ def compile_to_ros(pair: Pair, *, frame_id: str = "", wall_stamp: bool = False) 
             given[("header", "stamp", "nanosec")] = WallStamp(1)
     root = message_class(pair.gz_type).DESCRIPTOR
     schema = _Schema(root)
-    ops = _Emitter(schema).message(pair.ros_class, (), given, default, root)
+    ops = _message(pair.ros_class, (), given, default, root)
     ops.append(OP_END)
     return Compiled(array("i", schema.words()).tobytes(), array("i", ops).tobytes())

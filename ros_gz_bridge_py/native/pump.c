@@ -54,12 +54,10 @@ static int newest_first(const void *a, const void *b) {
  * keep sending, nor anyone's queue. */
 static void evict_routes(PumpObject *self) {
     size_t n = (size_t)self->nroutes;
-    int *renumber = malloc(n * sizeof *renumber);
-    char *keep = calloc(n, 1);
+    int *renumber = malloc(n * sizeof *renumber); /* a kept route's new index; -1: forgotten */
     uint64_t *uses = malloc(n * sizeof *uses);
-    if (renumber == NULL || keep == NULL || uses == NULL) { /* no memory: forget them all */
+    if (renumber == NULL || uses == NULL) { /* no memory: forget them all */
         free(renumber);
-        free(keep);
         free(uses);
         self->dropped += self->count + self->nhanded;
         pump_clear_ring(self);
@@ -70,14 +68,14 @@ static void evict_routes(PumpObject *self) {
     for (size_t i = 0; i < n; i++) uses[i] = self->routes[i].used;
     qsort(uses, n, sizeof *uses, newest_first);
     uint64_t oldest_kept = uses[KEEP_ROUTES - 1];
-    for (size_t i = 0; i < n; i++) keep[i] = self->routes[i].used > oldest_kept;
+    for (size_t i = 0; i < n; i++) renumber[i] = self->routes[i].used > oldest_kept ? 0 : -1;
     for (size_t i = 0; i < self->count; i++)
-        keep[self->ring[(self->head + i) % self->capacity].route] = 1;
+        renumber[self->ring[(self->head + i) % self->capacity].route] = 0;
     for (size_t i = 0; i < self->nhanded; i++)
-        if (self->handover[i].kind != HANDED_UNROUTED) keep[self->handover[i].route] = 1;
+        if (self->handover[i].kind != HANDED_UNROUTED) renumber[self->handover[i].route] = 0;
     int kept = 0;
     for (size_t i = 0; i < n; i++) {
-        if (keep[i]) {
+        if (renumber[i] >= 0) {
             renumber[i] = kept;
             self->routes[kept++] = self->routes[i];
         } else {
@@ -93,7 +91,6 @@ static void evict_routes(PumpObject *self) {
             self->handover[i].route = renumber[self->handover[i].route];
     self->nroutes = kept;
     free(renumber);
-    free(keep);
     free(uses);
 }
 

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from ros_gz_bridge_py.converters._limits import amplification_error
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.abi import zmq_functions
-from ros_gz_bridge_py.native.fallback import ChannelFallback
+from ros_gz_bridge_py.native.fallback import fallback_worker
 from ros_gz_bridge_py.native.loop import GZ_TO_ROS, PumpMember, shared_loop
 from ros_gz_bridge_py.transport import MessageInfo
 from ros_gz_bridge_py.transport.api import NativeHost
@@ -75,7 +75,7 @@ class ChannelPump(PumpMember):
         self._failed = failed
         self._counted = counted
         #: The refused payloads on their way to ``refused``.
-        self._fallback = ChannelFallback(refused, capacity, max_bytes, name)
+        self._fallback = fallback_worker().lane(refused, capacity, max_bytes, name)
         self._partition = partition
         self._name = name
         self._infos: dict[tuple[bytes, bytes], MessageInfo] = {}

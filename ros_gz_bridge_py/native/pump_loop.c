@@ -18,14 +18,6 @@
 #include <errno.h>
 #include <string.h>
 
-/* rcl_serialized_message_t (its allocator left zero: rcl only reads the buffer). */
-typedef struct {
-    uint8_t *buffer;
-    size_t buffer_length;
-    size_t buffer_capacity;
-    void *allocator[5];
-} rcl_serialized;
-
 enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_FD_ = 14, ZMQ_EVENTS_ = 15 };
 
 /* ---- publication windows (the loop guard, core/loop_guard.py) ----------------------------- */
@@ -205,9 +197,11 @@ static void deliver(PumpObject *self, struct queued *q) {
     int program = self->routes[q->route].program;
     const uint8_t *data = self->f.msg_data(&q->payload);
     size_t size = self->f.msg_size(&q->payload);
-    enum rgb_status status = rgb_to_cdr(self->programs[program].program, data, size, &self->out);
+    enum rgb_status status =
+        rgb_to_cdr(self->programs[program].program, data, size, &self->out, NULL);
     if (status == RGB_OK) {
-        rcl_serialized message = {self->out.data, self->out.len, self->out.cap, {0}};
+        /* its allocator left zero: rcl only reads the buffer */
+        rcl_bytes message = {self->out.data, self->out.len, self->out.cap, {0}};
         uint64_t sequence = pump_begin_publication(self);
         int ret = self->f.publish(self->publisher, &message, NULL);
         pump_end_publication(self, sequence, ret == 0);

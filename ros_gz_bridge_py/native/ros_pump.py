@@ -23,7 +23,7 @@ import zmq
 
 from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.abi import ros_functions
-from ros_gz_bridge_py.native.fallback import ChannelFallback
+from ros_gz_bridge_py.native.fallback import FallbackLane, fallback_worker
 from ros_gz_bridge_py.native.loop import ROS_TO_GZ, PumpMember, shared_loop
 from ros_gz_bridge_py.transport.delivery import Payload
 
@@ -77,7 +77,7 @@ class RosChannelPump(PumpMember):
         self.pump: RosPump = native.RosPump(
             functions, subscription.handle.pointer, publisher.sock.underlying, spellings, max_rate
         )
-        self._fallback: ChannelFallback[None] = ChannelFallback(
+        self._fallback: FallbackLane[None] = fallback_worker().lane(
             lambda cdr, _none: refused(cdr), capacity, max_bytes, name
         )
         self._counted = counted

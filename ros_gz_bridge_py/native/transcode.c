@@ -55,49 +55,49 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
     return rgb_put_le(out, bits, size);
 }
 
-/* A CDR string: length with the NUL, the bytes, the NUL. A NUL inside is left to Python. */
-static int put_string(struct rgb_out *out, const uint8_t *p, size_t n) {
+/* A CDR string: length with the NUL, the bytes, the NUL; with `frame`, a Gazebo scoped name as
+ * a ROS frame: each "::" (left to right) becomes "/". A NUL inside is left to Python. */
+static int put_string(struct rgb_out *out, const uint8_t *p, size_t n, int frame) {
     if (n && memchr(p, 0, n) != NULL) return RGB_FALLBACK;
-    if (n >= UINT32_MAX) return RGB_FALLBACK;
-    int status = put_u32(out, (uint32_t)n + 1);
-    if (status) return status;
-    status = rgb_put(out, p, n);
-    if (status) return status;
-    uint8_t nul = 0;
-    return rgb_put(out, &nul, 1);
-}
-
-/* A Gazebo scoped name as a ROS frame: each "::" (left to right) becomes "/". */
-static int put_frame(struct rgb_out *out, struct view s) {
-    if (s.n && memchr(s.p, 0, s.n) != NULL) return RGB_FALLBACK;
-    size_t pairs = 0;
-    for (size_t i = 0; i + 1 < s.n; i++) {
-        if (s.p[i] == ':' && s.p[i + 1] == ':') {
-            pairs++;
+    size_t written = n;
+    for (size_t i = 0; frame && i + 1 < n; i++) {
+        if (p[i] == ':' && p[i + 1] == ':') {
+            written--;
             i++;
         }
     }
-    size_t written = s.n - pairs;
     if (written >= UINT32_MAX) return RGB_FALLBACK;
     int status = put_u32(out, (uint32_t)written + 1);
+    if (!status) status = frame ? rgb_grow(out, written) : rgb_put(out, p, n);
     if (status) return status;
-    status = rgb_grow(out, written + 1);
-    if (status) return status;
-    for (size_t i = 0; i < s.n; i++) {
-        if (s.p[i] == ':' && i + 1 < s.n && s.p[i + 1] == ':') {
-            out->data[out->len++] = '/';
-            i++;
-        } else {
-            out->data[out->len++] = s.p[i];
-        }
+    for (size_t i = 0; frame && i < n; i++) {
+        int pair = p[i] == ':' && i + 1 < n && p[i + 1] == ':';
+        out->data[out->len++] = pair ? '/' : p[i];
+        i += (size_t)pair;
     }
-    out->data[out->len++] = 0;
-    return 0;
+    return rgb_put(out, "", 1);
 }
 
 /* ---- running a program ------------------------------------------------------------------- */
 
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v);
+
+/* The string field `number` of `at` (its last occurrence; empty where it is absent). */
+static int put_string_field(struct ctx *c, struct at at, uint32_t number) {
+    struct field f;
+    int found, status = pb_last_of(c, at, number, &f, &found);
+    if (status) return status;
+    if (found && f.wire != WIRE_LEN) return RGB_FALLBACK;
+    return found ? put_string(c->out, f.payload.p, f.payload.n, 0) : put_string(c->out, NULL, 0, 0);
+}
+
+/* The scalar field `number` of protobuf `type` in `at`, written as ROS `kind`. */
+static int put_scalar_field(struct ctx *c, struct at at, uint32_t number, int32_t type,
+                            int32_t kind, int32_t conv) {
+    struct rgb_number val;
+    int status = pb_scalar(c, at, number, type, &val);
+    return status ? status : put_value(c->out, kind, conv, val);
+}
 
 /* Counting, and then reading, the elements of a repeated scalar (packed or not). */
 struct scalars {
@@ -107,29 +107,26 @@ struct scalars {
     struct rgb_out *out;
 };
 
-static int scalar_element(void *ctx, const struct field *f) {
-    struct scalars *s = ctx;
-    int wire = rgb_wire_of(s->type);
-    if (f->wire == WIRE_LEN && wire != WIRE_LEN) {
-        size_t pos = 0;
-        while (pos < f->payload.n) {
-            struct field one = {f->number, wire, 0, {NULL, 0}};
-            int status = read_value(f->payload, &pos, wire, &one);
-            if (status) return status;
-            s->count++;
-            if (s->kind) {
-                status = put_value(s->out, s->kind, CONV_EXACT,
-                                   pb_decode_scalar(s->type, pb_raw_of(&one)));
-                if (status) return status;
-            }
-        }
-        return 0;
-    }
-    if (f->wire != wire) return RGB_FALLBACK;
+/* One element: counted, and written as s->kind where there is one. */
+static int scalar_one(struct scalars *s, const struct field *f) {
     s->count++;
     if (!s->kind) return 0;
     return put_value(s->out, s->kind, CONV_EXACT, pb_decode_scalar(s->type, pb_raw_of(f)));
 }
+
+static int scalar_element(void *ctx, const struct field *f) {
+    struct scalars *s = ctx;
+    int wire = rgb_wire_of(s->type), status = 0;
+    if (f->wire != WIRE_LEN || wire == WIRE_LEN) /* one value, not a packed run */
+        return f->wire == wire ? scalar_one(s, f) : RGB_FALLBACK;
+    for (size_t pos = 0; pos < f->payload.n && !status;) {
+        struct field one = {f->number, wire, 0, {NULL, 0}};
+        status = read_value(f->payload, &pos, wire, &one);
+        if (!status) status = scalar_one(s, &one);
+    }
+    return status;
+}
+
 /* The elements of a repeated submessage field, each indexed (when its type is known) and run
  * through a body of ops; the element's index is popped after. */
 struct messages {
@@ -156,7 +153,6 @@ struct column {
     int32_t nsteps;
     uint32_t number;
     int32_t type, kind; /* kind 0: a string column */
-    struct rgb_out *out;
 };
 
 static int column_element(void *ctx, const struct field *f) {
@@ -166,18 +162,8 @@ static int column_element(void *ctx, const struct field *f) {
     /* each element is read by one op only: scanned, not indexed */
     int status = pb_descend(c->c, (struct at){f->payload, NO_NODE}, c->steps, c->nsteps, &element);
     if (status) return status;
-    if (c->kind == 0) {
-        struct field s;
-        int found;
-        status = pb_find(c->c, element.v, c->number, 0, &s, &found);
-        if (status) return status;
-        if (found && s.wire != WIRE_LEN) return RGB_FALLBACK;
-        return found ? put_string(c->out, s.payload.p, s.payload.n) : put_string(c->out, NULL, 0);
-    }
-    struct rgb_number val;
-    status = pb_scalar(c->c, element, c->number, c->type, &val);
-    if (status) return status;
-    return put_value(c->out, c->kind, CONV_EXACT, val);
+    if (c->kind == 0) return put_string_field(c->c, element, c->number);
+    return put_scalar_field(c->c, element, c->number, c->type, c->kind, CONV_EXACT);
 }
 
 /* The count written before a sequence, and the alignment Fast CDR gives its elements only
@@ -233,14 +219,10 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += 1 + op[0];
         }
         switch (code) {
-        case OP_NUM: {
-            struct rgb_number val;
-            status = pb_scalar(c, at, (uint32_t)op[0], op[1], &val);
-            if (status) return status;
-            status = put_value(out, op[2], op[3], val);
+        case OP_NUM:
+            status = put_scalar_field(c, at, (uint32_t)op[0], op[1], op[2], op[3]);
             op += 4;
             break;
-        }
         case OP_CONST: {
             uint64_t bits = (uint32_t)op[1] | (uint64_t)(uint32_t)op[2] << 32;
             size_t size = rgb_ros_size(op[0]);
@@ -249,18 +231,12 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += 3;
             break;
         }
-        case OP_STR: {
-            struct field f;
-            int found;
-            status = pb_last_of(c, at, (uint32_t)op[0], &f, &found);
-            if (status) return status;
-            if (found && f.wire != WIRE_LEN) return RGB_FALLBACK;
-            status = found ? put_string(out, f.payload.p, f.payload.n) : put_string(out, NULL, 0);
+        case OP_STR:
+            status = put_string_field(c, at, (uint32_t)op[0]);
             op += 1;
             break;
-        }
         case OP_CONST_STR:
-            status = put_string(out, word_bytes(op), (size_t)op[0]);
+            status = put_string(out, word_bytes(op), (size_t)op[0], 0);
             op += rgb_text_span(op[0]);
             break;
         case OP_HEADER_STR: {
@@ -268,8 +244,8 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             op += 1 + rgb_text_span(op[1]);
             status = pb_for_each(c, at, 2, header_entry, &h);
             if (status) return status;
-            status = h.found ? put_frame(out, h.value)
-                             : put_string(out, word_bytes(op), (size_t)op[0]);
+            status = h.found ? put_string(out, h.value.p, h.value.n, 1)
+                             : put_string(out, word_bytes(op), (size_t)op[0], 0);
             op += rgb_text_span(op[0]);
             break;
         }
@@ -319,7 +295,7 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
         case OP_COLUMN_STR: {
             uint32_t number = (uint32_t)op[0];
             int32_t nsub = op[1];
-            struct column col = {c, op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0, out};
+            struct column col = {c, op + 2, nsub, (uint32_t)op[2 + nsub], 0, 0};
             op += 3 + nsub;
             if (code == OP_COLUMN) {
                 col.type = op[0];
@@ -345,13 +321,9 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             if (s < 0) return RGB_CONVERSION;
             int64_t total = s * 1000000000LL + (int64_t)(uint32_t)(uint64_t)nsec.i;
             struct rgb_number result = {0, 0, 0, 0, 0.0};
-            if (part == 0) {
-                result.i = (int32_t)(uint32_t)(uint64_t)(total / 1000000000LL);
-                status = put_value(out, ROS_INT32, CONV_EXACT, result);
-            } else {
-                result.i = total % 1000000000LL;
-                status = put_value(out, ROS_UINT32, CONV_EXACT, result);
-            }
+            result.i = part == 0 ? (int32_t)(uint32_t)(uint64_t)(total / 1000000000LL)
+                                 : total % 1000000000LL;
+            status = put_value(out, part == 0 ? ROS_INT32 : ROS_UINT32, CONV_EXACT, result);
             break;
         }
         case OP_WALL_STAMP: { /* a Time of the wall clock now: int32 sec, uint32 nanosec */
@@ -399,8 +371,8 @@ static size_t refusal_limit(size_t n) {
     return RGB_OUTPUT_FLOOR + 2 * RGB_OUTPUT_RATIO * n;
 }
 
-enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
-                                   size_t payload_len, struct rgb_out *out, size_t *steps) {
+enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
+                           size_t payload_len, struct rgb_out *out, size_t *steps) {
     static const uint8_t header[4] = {0, 1, 0, 0};
     struct view v = {payload, payload_len};
     struct ctx c = {program, out, 0, 0};
@@ -422,11 +394,6 @@ enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint
     }
     if (steps != NULL) *steps = c.steps;
     return (enum rgb_status)status;
-}
-
-enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
-                           size_t payload_len, struct rgb_out *out) {
-    return rgb_to_cdr_counted(program, payload, payload_len, out, NULL);
 }
 
 void rgb_out_free(struct rgb_out *out) {

@@ -50,14 +50,11 @@ int rgb_load(struct rgb_program *program, const int32_t *schema, size_t schema_l
              const int32_t *ops, size_t ops_len, const char **why);
 
 /* Transcodes one payload; on RGB_OK, out->data[0..out->len) is the CDR message with its
- * encapsulation header. out is reused between calls (out->len is reset first). */
+ * encapsulation header. out is reused between calls (out->len is reset first). Where `steps`
+ * is not NULL, *steps says how many protobuf fields it read, the work that bounds its time: a
+ * few times the fields of the payload, whatever the program (the tests check it). */
 enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *payload,
-                           size_t payload_len, struct rgb_out *out);
-
-/* rgb_to_cdr that also says how many protobuf fields it read (*steps), the work that bounds
- * its time: a few times the fields of the payload, whatever the program (the tests check it). */
-enum rgb_status rgb_to_cdr_counted(const struct rgb_program *program, const uint8_t *payload,
-                                   size_t payload_len, struct rgb_out *out, size_t *steps);
+                           size_t payload_len, struct rgb_out *out, size_t *steps);
 
 /* Frees the output buffer and the scratch. */
 void rgb_out_free(struct rgb_out *out);

@@ -9,9 +9,8 @@ const char *const rgb_op_layouts[OP_COUNT] = {
     [OP_SEQ_MSG] = "PfB",    [OP_COLUMN] = "PfPfsk",    [OP_COLUMN_STR] = "PfPf",
     [OP_CLOCK] = "Pc",       [OP_WALL_STAMP] = "",      [OP_CONST_BLOCK] = "aT",
 };
-#define LAYOUT(code) rgb_layout(rgb_op_layouts, OP_COUNT, code)
 
-/* The fewest bytes the ops of a body (checked by check_ops) write for one element, whatever
+/* The fewest bytes the ops of a body (checked by rgb_load) write for one element, whatever
  * its values: a CDR string or sequence writes at least its 4-byte length, a number or a fixed
  * list its size; alignment is not counted. A sequence of `count` elements thus writes at least
  * `count` times this, which lets OP_SEQ_MSG see at once that it would pass the output bound
@@ -20,7 +19,7 @@ size_t rgb_least_bytes(const int32_t *op, const int32_t *end) {
     size_t least = 0, n = (size_t)(end - op), at = 0, w[RGB_MAX_OPERANDS];
     while (at < n && op[at] != OP_END) {
         int32_t code = op[at++];
-        const char *layout = LAYOUT(code);
+        const char *layout = rgb_layout(rgb_op_layouts, OP_COUNT, code);
         if (layout == NULL || rgb_operands(op, n, &at, layout, 0, w))
             return least; /* rgb_load admits no such op */
         switch (code) {
@@ -73,25 +72,10 @@ static int check_schema(const int32_t *s, size_t n, const char **why) {
     return 0;
 }
 
-/* Checks the ops of a body, [0, n), and those of the bodies in it. */
-static int check_ops(const int32_t *ops, size_t n, int depth) {
-    size_t at = 0, w[RGB_MAX_OPERANDS];
-    if (depth > MAX_DEPTH) return -1;
-    while (at < n) {
-        int32_t code = ops[at++];
-        if (code == OP_END) return at == n ? 0 : -1;
-        const char *layout = LAYOUT(code);
-        if (layout == NULL || rgb_operands(ops, n, &at, layout, 0, w)) return -1;
-        if (code == OP_SEQ_MSG && check_ops(ops + w[2] + 1, (size_t)ops[w[2]], depth + 1))
-            return -1;
-    }
-    return -1; /* a body ends with OP_END */
-}
-
 int rgb_load(struct rgb_program *program, const int32_t *schema, size_t schema_len,
              const int32_t *ops, size_t ops_len, const char **why) {
     if (check_schema(schema, schema_len, why)) return -1;
-    if (check_ops(ops, ops_len, 0)) {
+    if (rgb_check_body(ops, ops_len, rgb_op_layouts, OP_COUNT, 0, 0, MAX_DEPTH)) {
         *why = "program: an op is not well-formed";
         return -1;
     }

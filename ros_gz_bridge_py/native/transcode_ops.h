@@ -62,7 +62,7 @@ struct field {
 
 /* What one rgb_to_cdr call works with: the program, the output, the index of the messages it
  * reads (kept in out->scratch as a stack: each run of ops pops what it indexed) and the number
- * of fields it read, its work (rgb_to_cdr_counted). */
+ * of fields it read, its work (rgb_to_cdr's steps). */
 struct ctx {
     const struct rgb_program *pr;
     struct rgb_out *out;
@@ -114,12 +114,6 @@ static inline int read_field(struct ctx *c, struct view v, size_t *pos, struct f
         return RGB_FALLBACK;
     }
 }
-
-static inline uint32_t le32(const uint8_t *p) {
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static inline uint64_t le64(const uint8_t *p) { return (uint64_t)le32(p) | (uint64_t)le32(p + 4) << 32; }
 
 /* ---- the index: each message read by the ops is scanned once ------------------------------ */
 

@@ -80,8 +80,8 @@ static PyObject *program_to_cdr(ProgramObject *self, PyObject *arg) {
     Py_buffer payload;
     if (PyObject_GetBuffer(arg, &payload, PyBUF_SIMPLE)) return NULL;
     size_t steps = 0;
-    enum rgb_status status = rgb_to_cdr_counted(&self->program, payload.buf, (size_t)payload.len,
-                                                &self->out, &steps);
+    enum rgb_status status =
+        rgb_to_cdr(&self->program, payload.buf, (size_t)payload.len, &self->out, &steps);
     PyBuffer_Release(&payload);
     self->steps = rgb_clamp(steps);
     PyObject *result;

@@ -237,6 +237,13 @@ static inline int rgb_put(struct rgb_out *out, const void *bytes, size_t n) {
     return 0;
 }
 
+/* The `size` (at most 8) bytes at `b` as a little-endian number. */
+static inline uint64_t rgb_le(const uint8_t *b, size_t size) {
+    uint64_t bits = 0;
+    for (size_t k = 0; k < size && k < 8; k++) bits |= (uint64_t)b[k] << (8 * k);
+    return bits;
+}
+
 /* Appends the `size` low bytes of `bits`, little-endian. */
 static inline int rgb_put_le(struct rgb_out *out, uint64_t bits, size_t size) {
     uint8_t b[8];
@@ -308,6 +315,29 @@ static inline int rgb_operands(const int32_t *ops, size_t n, size_t *at, const c
 /* The layout of op `code` in `layouts` (`count` of them; NULL where there is no such op). */
 static inline const char *rgb_layout(const char *const *layouts, size_t count, int32_t code) {
     return code >= 0 && (size_t)code < count ? layouts[code] : NULL;
+}
+
+/* Checks the ops of a body, [0, n), against their layouts (`count` of them), and the bodies in
+ * them (an op's B operand; its frame has the slots of its m operand, if it has one, else
+ * `nslots`), nested at most `max_depth` deep: each body ends with op 0 at its last word. 0 when
+ * they are well-formed, else -1. Both loaders check their ops with it. */
+static inline int rgb_check_body(const int32_t *ops, size_t n, const char *const *layouts,
+                                 size_t count, int32_t nslots, int depth, int max_depth) {
+    size_t at = 0, w[RGB_MAX_OPERANDS];
+    if (depth > max_depth) return -1;
+    while (at < n) {
+        int32_t code = ops[at++];
+        if (code == 0) return at == n ? 0 : -1;
+        const char *layout = rgb_layout(layouts, count, code);
+        if (layout == NULL || rgb_operands(ops, n, &at, layout, nslots, w)) return -1;
+        const char *body = strchr(layout, 'B'), *slots = strchr(layout, 'm');
+        if (body == NULL) continue;
+        size_t b = w[body - layout];
+        if (rgb_check_body(ops + b + 1, (size_t)ops[b], layouts, count,
+                           slots != NULL ? ops[w[slots - layout]] : nslots, depth + 1, max_depth))
+            return -1;
+    }
+    return -1;
 }
 
 #endif
