@@ -1,7 +1,7 @@
 """How much memory a fleet's bridge holds over time, and what bounds it (issue 36 item 5).
 
 Usage: ``.venv/bin/python -m benchmarks.fleet_memory [--robots 50] [--seconds 60] [--rounds 2]
-[--low-hwm 50]``.
+[--low-hwm 50] [--flood-rounds 3]``.
 
 Three parts. First, what libzmq keeps for a small message waiting in a SUB socket's receive pipe:
 a publisher process sends messages to a subscriber that does not read them (RCVHWM 0: no
@@ -9,18 +9,22 @@ limit), paced (a gap between messages, so each arrives in a read of its own, as 
 topics at 50 Hz to 1 kHz do) and back to back; the subscriber's anonymous resident memory
 (RssAnon) before and after, per message. Second, the fleet of ``benchmarks.fleet`` through a
 bridge for a long window, the bridge's memory read every second (VmRSS, RssAnon) and its peak
-since its start (VmHWM), rounds alternating each topic's default receive queue
-(``GZ_TRANSPORT_RCVHWM`` unset: 1000 messages) and a lower one set in the bridge's environment;
-beside it, the share of ``/clock`` its subscriber got. Third, what the lower mark costs where one
-topic is flooded: Odometry offered at 20 kHz for a few seconds through one native channel to a
-subscriber taking it serialized (``benchmarks.native_overload``'s flow), a busy loop
-(``yes``) beside the bridge all along, a fresh bridge each round, the two marks alternating.
+since its start (VmHWM), its CPU and CPU per message its subscribers took (Gazebo -> ROS), and
+the share of ``/clock`` its subscriber got; rounds alternate gz-transport's receive queue of
+1000 messages a topic (``GZ_TRANSPORT_RCVHWM=1000`` in the bridge's environment) and the
+bridge's default, planned from the number of Gazebo topics of its configuration
+(``transport/settings.py`` ``planned_rcvhwm``). Third, what a lower mark costs where one topic
+is flooded: Odometry offered at 20 kHz for a few seconds through one native channel to a
+subscriber taking it serialized (``benchmarks.native_overload``'s flow), a busy loop (``yes``)
+beside the bridge all along, a fresh bridge each round, the default (1000 for one topic) and
+the low mark alternating.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import statistics
 import subprocess
 import sys
@@ -36,9 +40,10 @@ from benchmarks.harness import Flow, FlowResult, bridge_config, stop_all, topic_
 from benchmarks.native_overload import QUEUE
 from benchmarks.native_paths import path_backend
 from benchmarks.report import write_section
+from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, planned_rcvhwm
 from testing import fleet_sim
 from testing.loopback import free_port
-from testing.procstat import MB, rss_bytes
+from testing.procstat import MB, cpu_seconds, rss_bytes
 from testing.run_env import run_env
 
 #: Part one: how many messages, of what size, and the gap that makes each arrive alone.
@@ -95,19 +100,26 @@ class MemoryRound:
     anon: list[float]
     clock_share: float
     load: float
+    #: Bridge CPU, % of one core, and µs per message its subscribers took (Gazebo -> ROS).
+    cpu: float
+    per_message_us: float
+    #: The default receive HWM planned for this fleet's topics.
+    planned: int
 
     def cells(self) -> str:
         rss, anon = self.rss, self.anon
+        mark = self.hwm or f"{self.planned} (default, planned)"
         return (
-            f"{self.hwm or '1000 (default)'} | {self.peak:.0f} | {statistics.median(rss):.0f} "
+            f"{mark} | {self.peak:.0f} | {statistics.median(rss):.0f} "
             f"| {max(rss):.0f} | {statistics.median(anon):.0f} | {max(anon):.0f} "
+            f"| {self.cpu:.1f}% | {self.per_message_us:.1f} "
             f"| {100 * self.clock_share:.1f}% | {self.load:.1f}"
         )
 
 
 def memory_round(robots: int, seconds: float, hwm: str) -> MemoryRound:
     """The fleet of ``robots`` through a bridge whose topics' receive queues hold ``hwm``
-    messages ("": the default), its memory read every second for ``seconds``."""
+    messages ("": the bridge's default), its memory read every second for ``seconds``."""
     load = os.getloadavg()[0]
     env = run_env()
     if hwm:
@@ -115,21 +127,28 @@ def memory_round(robots: int, seconds: float, hwm: str) -> MemoryRound:
     fleet = start_bridged(robots, env)
     try:
         pid = fleet.bridge.pid
-        counted = fleet.subscribers.counts()[fleet_sim.CLOCK_TOPIC]
+        counted = fleet.subscribers.counts()
+        cpu_before = cpu_seconds(pid)
         began = time.monotonic()
         rss, anon = [], []
         while time.monotonic() - began < seconds:
             time.sleep(1.0)
             rss.append(rss_bytes(pid) / MB)
             anon.append(rss_bytes(pid, "RssAnon") / MB)
-        delivered = fleet.subscribers.counts()[fleet_sim.CLOCK_TOPIC] - counted
+        counts = fleet.subscribers.counts()
+        cpu = cpu_seconds(pid) - cpu_before
         window = time.monotonic() - began
         peak = rss_bytes(pid, "VmHWM") / MB
         fleet.finish()
     finally:
         stop_all()
-    share = delivered / (fleet_sim.CLOCK_HZ * window)
-    return MemoryRound(hwm, window, peak, rss, anon, share, load)
+    clock = counts[fleet_sim.CLOCK_TOPIC] - counted[fleet_sim.CLOCK_TOPIC]
+    taken = sum(n - counted.get(topic, 0) for topic, n in counts.items() if topic != "cmd_vel")
+    planned = planned_rcvhwm(1 + 3 * robots)  # /clock, and odom, imu, joint_states a robot
+    return MemoryRound(
+        hwm, window, peak, rss, anon, clock / (fleet_sim.CLOCK_HZ * window), load,
+        100 * cpu / window, 1e6 * cpu / max(taken, 1), planned,
+    )  # fmt: skip
 
 
 def flooded_topic(hwm: str) -> FlowResult:
@@ -177,8 +196,8 @@ def report(
         f"### The fleet of {robots} robots, each window about {rounds[0].seconds:.0f} s",
         "",
         "| round | RCVHWM | peak MB (VmHWM) | RSS median MB | RSS max MB | RssAnon median MB "
-        "| RssAnon max MB | /clock delivered | 1-min load |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| RssAnon max MB | bridge CPU | µs per message taken | /clock delivered | 1-min load |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
         *(f"| {index} | {r.cells()} |" for index, r in enumerate(rounds, 1)),
         "",
         f"### One topic flooded: Odometry at {FLOOD_HZ / 1000:g} kHz for {FLOOD_SECONDS:g} s, "
@@ -211,9 +230,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(costs, flush=True)
     rounds = []
     for index in range(args.rounds):
-        for hwm in ("", str(args.low_hwm)) if index % 2 == 0 else (str(args.low_hwm), ""):
+        gz_transport = str(DEFAULT_HWM)
+        for hwm in (gz_transport, "") if index % 2 == 0 else ("", gz_transport):
             rounds.append(memory_round(args.robots, args.seconds, hwm))
             print(rounds[-1].cells(), flush=True)
+    # in a process group of its own, killed whole (timeout and yes): it stops by itself after
+    # 15 minutes if this process dies first
     busy = subprocess.Popen(
         ["timeout", "900", "yes"], stdout=subprocess.DEVNULL, start_new_session=True
     )
@@ -224,7 +246,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 floods.append((hwm, flooded_topic(hwm)))
                 print(flood_cells(*floods[-1]), flush=True)
     finally:
-        busy.kill()
+        os.killpg(busy.pid, signal.SIGKILL)
+        busy.wait()
     command = (
         f".venv/bin/python -m benchmarks.fleet_memory --robots {args.robots} "
         f"--seconds {args.seconds:g} --rounds {args.rounds} --low-hwm {args.low_hwm} "

@@ -35,7 +35,12 @@ from ros_gz_bridge_py.app.settings import (
     declare_parameter_bridge_parameters,
     read_switches,
 )
-from ros_gz_bridge_py.app.sources import collect_sources, discovery_rules, placeholder_values
+from ros_gz_bridge_py.app.sources import (
+    collect_sources,
+    discovery_rules,
+    gz_subscriptions,
+    placeholder_values,
+)
 from ros_gz_bridge_py.app.startup import finish_start_up
 from ros_gz_bridge_py.config import (
     USAGE,
@@ -61,6 +66,7 @@ from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, create_gz_node
+from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, planned_rcvhwm
 
 NODE_NAME = "ros_gz_bridge"
 #: ``parameter_bridge --check [SECONDS]``: report on the entries instead of bridging them.
@@ -311,6 +317,7 @@ def build_bridge(
     for message in (problem, queue_problem):
         if message:
             logger.error(message)
+    gz_options = params.shared.gz_node_options(gz_subscriptions(sources))
     bridge = Bridge(
         node,
         options=params.shared.bridge_options(
@@ -320,8 +327,17 @@ def build_bridge(
             max_rate=max_rate,
             max_queued_bytes=max_queued_bytes,
         ),
-        gz_options=params.shared.gz_node_options(),
+        gz_options=gz_options,
     )
+    settings = bridge.gz_node.settings
+    if (gz_options.implementation or settings.implementation) == "zeromq" and (
+        planned_rcvhwm(gz_options.planned_subscriptions) < DEFAULT_HWM
+    ):
+        logger.info(
+            f"{gz_options.planned_subscriptions} Gazebo topics: the ZeroMQ receive queue of each "
+            f"holds {settings.rcvhwm} messages (GZ_TRANSPORT_RCVHWM sets it; "
+            'docs/many-topics.md, "A fleet\'s memory")'
+        )
     bridge.add_all(spec for source in sources for spec in source.specs)
     patterns: list[TopicPattern] = [p for source in sources for p in source.patterns]
     rules = discovery_rules(node, params, enabled=params.auto_bridge)

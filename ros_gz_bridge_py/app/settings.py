@@ -166,8 +166,11 @@ class SharedParameters:
     #: :func:`checked_max_queued_bytes` reads it.
     max_queued_bytes: int = MAX_QUEUED_BYTES
 
-    def gz_node_options(self) -> NodeOptions:
-        return NodeOptions(implementation=self.gz_transport_implementation or None)
+    def gz_node_options(self, planned_subscriptions: int = 0) -> NodeOptions:
+        return NodeOptions(
+            implementation=self.gz_transport_implementation or None,
+            planned_subscriptions=planned_subscriptions,
+        )
 
     def bridge_options(
         self,

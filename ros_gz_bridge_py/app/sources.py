@@ -15,6 +15,7 @@ from rclpy.node import Node
 from ros_gz_bridge_py.app.settings import ParameterBridgeParameters
 from ros_gz_bridge_py.config import (
     BridgeSpec,
+    Direction,
     ParseResult,
     TopicBridgeSpec,
     expand_topic_name,
@@ -93,6 +94,17 @@ def collect_sources(
     for source in sources:
         report(node, source)
     return sources
+
+
+def gz_subscriptions(sources: Sequence[ParseResult]) -> int:
+    """How many Gazebo topics the entries of ``sources`` subscribe (Gazebo -> ROS, both ways):
+    the transport's default receive queue per topic is smaller the more there are."""
+    carried = (Direction.GZ_TO_ROS, Direction.BIDIRECTIONAL)
+    return sum(
+        isinstance(spec, TopicBridgeSpec) and spec.direction in carried
+        for source in sources
+        for spec in source.specs
+    )
 
 
 def placeholder_values(

@@ -76,7 +76,7 @@ def create_gz_node(options: NodeOptions | None = None) -> GzNode:
         TransportError: the implementation is not available or cannot start.
     """
     options = options or NodeOptions()
-    settings = TransportSettings.from_env()
+    settings = TransportSettings.from_env(planned_subscriptions=options.planned_subscriptions)
     if options.legacy_spelling is not None:
         settings = dataclasses.replace(settings, legacy_spelling=options.legacy_spelling)
     node_class = backend_class(options.implementation or settings.implementation)

@@ -47,12 +47,16 @@ class NodeOptions:
     ``implementation`` None reads GZ_TRANSPORT_IMPLEMENTATION (default ``zeromq``).
     ``legacy_spelling`` None assumes Fortress (``ignition.msgs``) for gz-transport 11/12 peers;
     ``Spelling.GZ`` says they are Garden.
+    ``planned_subscriptions``: how many Gazebo topics the caller will subscribe at its start;
+    where GZ_TRANSPORT_RCVHWM is unset, each one's receive queue is smaller the more there are
+    (``settings.planned_rcvhwm``).
     """
 
     partition: str | None = None
     namespace: str = ""
     implementation: str | None = None
     legacy_spelling: Spelling | None = None
+    planned_subscriptions: int = 0
 
 
 @dataclass(frozen=True, slots=True)

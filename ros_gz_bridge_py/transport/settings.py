@@ -23,6 +23,15 @@ DEFAULT_MULTICAST_IP = "239.255.0.7"
 DEFAULT_MSG_PORT = 10317
 DEFAULT_SRV_PORT = 10318
 DEFAULT_HWM = 1000
+#: What libzmq holds for a small message waiting in a receive pipe, whatever its size: the buffer
+#: it read the message into (8 KiB) when the message came alone in its read, as a simulator's
+#: topics at 50 Hz to 1 kHz do (measured 8.9 kB; docs/many-topics.md, "A fleet's memory").
+RECEIVE_BUFFER = 9 * 1024
+#: The bytes the receive pipes of the subscriptions a node plans at its start hold together when
+#: GZ_TRANSPORT_RCVHWM does not say (one channel's ``max_queued_bytes``)...
+PLANNED_RECEIVE_BYTES = 64 * 1024 * 1024
+#: ...each pipe never fewer than this many messages (50 ms of a 1 kHz topic).
+PLANNED_MIN_HWM = 50
 #: Largest message accepted from the network (ours, not gz's, docs/protocol.md §1.4): a 4K
 #: image of 8 bytes per pixel (66 MB) or a 1080p depth cloud of 32 bytes per point (66 MB)
 #: fits twice over; a 200 MB frame does not.
@@ -55,6 +64,18 @@ def default_partition(env: Mapping[str, str]) -> str:
 
 def _port(env: Mapping[str, str], name: str, default: int) -> int:
     return _integer(env, name, default, MAX_PORT, "a port number")
+
+
+def planned_rcvhwm(subscriptions: int) -> int:
+    """The default receive HWM of each of ``subscriptions`` planned together: their pipes hold
+    about :data:`PLANNED_RECEIVE_BYTES` of small messages (at :data:`RECEIVE_BUFFER` each),
+    never more than gz-transport's 1000 a pipe nor fewer than :data:`PLANNED_MIN_HWM`. A few
+    topics keep 1000; the 151 Gazebo topics of a fleet of 50 robots get 50 each, so a loop that
+    falls behind holds about 70 MB in libzmq, not 1.4 GB."""
+    if subscriptions <= 0:
+        return DEFAULT_HWM
+    fits = PLANNED_RECEIVE_BYTES // (RECEIVE_BUFFER * subscriptions)
+    return min(DEFAULT_HWM, max(PLANNED_MIN_HWM, fits))
 
 
 def _positive(env: Mapping[str, str], name: str, default: int) -> int:
@@ -125,8 +146,11 @@ class TransportSettings:
     legacy_spelling: Spelling = Spelling.IGNITION
 
     @classmethod
-    def from_env(cls, env: Mapping[str, str] | None = None) -> TransportSettings:
-        """Read the settings from ``env`` (default ``os.environ``)."""
+    def from_env(
+        cls, env: Mapping[str, str] | None = None, planned_subscriptions: int = 0
+    ) -> TransportSettings:
+        """Read the settings from ``env`` (default ``os.environ``); the default receive HWM is
+        that of :func:`planned_rcvhwm` for ``planned_subscriptions``."""
         env = os.environ if env is None else env
         partition = lookup(env, "PARTITION")
         msg_port = _port(env, "DISCOVERY_MSG_PORT", DEFAULT_MSG_PORT)
@@ -141,7 +165,7 @@ class TransportSettings:
             msg_port=msg_port,
             srv_port=srv_port,
             relays=relays,
-            rcvhwm=_positive(env, "TRANSPORT_RCVHWM", DEFAULT_HWM),
+            rcvhwm=_positive(env, "TRANSPORT_RCVHWM", planned_rcvhwm(planned_subscriptions)),
             sndhwm=_positive(env, "TRANSPORT_SNDHWM", DEFAULT_HWM),
             max_message_size=_max_message_size(env),
             credentials=_credentials(env),

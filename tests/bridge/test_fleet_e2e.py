@@ -23,6 +23,7 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.native import extension
+from ros_gz_bridge_py.transport.settings import planned_rcvhwm
 from testing import fleet_sim
 from testing.behaviour_harness import bridge_command
 from testing.e2e_harness import (
@@ -60,6 +61,14 @@ def test_ten_robots_flow_both_ways_through_one_templated_file(
     group: ProcessGroup, tmp_path: Path
 ) -> None:
     bridge = check_fleet(group, tmp_path, ROBOTS, fleet_sim.bridge_arguments(ROBOTS), clock=True)
+    # /clock, and odom, imu, joint_states a robot: each topic's receive queue planned smaller
+    # than gz-transport's 1000, so that a fleet's queues stay near 64 MiB together.
+    topics = 1 + 3 * len(ROBOTS)
+    planned = planned_rcvhwm(topics)
+    assert f"{topics} Gazebo topics: the ZeroMQ receive queue of each holds {planned}" in (
+        bridge.output()
+    )
+    assert planned < 1000
     if extension() is not None and os.environ.get("ROS_GZ_BRIDGE_NATIVE", "on") != "off":
         # Two loops carry the 41 native channels: no thread per channel.
         assert threads_of(bridge) <= CPP_BRIDGE_THREADS

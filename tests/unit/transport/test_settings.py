@@ -8,6 +8,7 @@ from ros_gz_bridge_py.transport.settings import (
     DEFAULT_MAX_MESSAGE_SIZE,
     TransportSettings,
     default_partition,
+    planned_rcvhwm,
 )
 
 
@@ -87,3 +88,19 @@ def test_credentials_need_both_names_and_stay_out_of_repr() -> None:
     assert TransportSettings.from_env({"GZ_TRANSPORT_USERNAME": "u"}).credentials is None
     assert TransportSettings.from_env({**both, "GZ_TRANSPORT_PASSWORD": ""}).credentials is None
     assert "p'" not in repr(TransportSettings.from_env(both))
+
+
+def test_the_default_receive_queue_shrinks_with_the_topics_planned_at_start() -> None:
+    """A few topics keep gz-transport's 1000 messages a pipe; a fleet's topics share about
+    64 MiB of small messages at 9 KiB each (libzmq's read buffer), at least 50 a pipe."""
+    assert [planned_rcvhwm(n) for n in (0, 1, 7, 8, 41, 101, 145, 201, 10_000)] == [
+        1000, 1000, 1000, 910, 177, 72, 50, 50, 50
+    ]  # fmt: skip
+    assert TransportSettings.from_env({}, planned_subscriptions=201).rcvhwm == 50
+    assert TransportSettings.from_env({}, planned_subscriptions=1).rcvhwm == 1000
+
+
+def test_a_receive_hwm_the_user_sets_wins_over_the_planned_one() -> None:
+    for name in ("GZ_TRANSPORT_RCVHWM", "IGN_TRANSPORT_RCVHWM"):
+        settings = TransportSettings.from_env({name: "300"}, planned_subscriptions=201)
+        assert settings.rcvhwm == 300
