@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from ros_gz_bridge_py.msgs.names import Spelling
+from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 
@@ -25,11 +26,11 @@ DEFAULT_SRV_PORT = 10318
 DEFAULT_HWM = 1000
 #: What libzmq holds for a small message waiting in a receive pipe, whatever its size: the buffer
 #: it read the message into (8 KiB) when the message came alone in its read, as a simulator's
-#: topics at 50 Hz to 1 kHz do (measured 8.9 kB; docs/many-topics.md, "A fleet's memory").
+#: topics at 50 Hz to 1 kHz do (measured 8.7-9.0 kB; docs/many-topics.md, "A fleet's memory").
 RECEIVE_BUFFER = 9 * 1024
 #: The bytes the receive pipes of the subscriptions a node plans at its start hold together when
-#: GZ_TRANSPORT_RCVHWM does not say (one channel's ``max_queued_bytes``)...
-PLANNED_RECEIVE_BYTES = 64 * 1024 * 1024
+#: GZ_TRANSPORT_RCVHWM does not say (one channel's default ``max_queued_bytes``)...
+PLANNED_RECEIVE_BYTES = MAX_QUEUED_BYTES
 #: ...each pipe never fewer than this many messages (50 ms of a 1 kHz topic).
 PLANNED_MIN_HWM = 50
 #: Largest message accepted from the network (ours, not gz's, docs/protocol.md §1.4): a 4K
