@@ -5,11 +5,17 @@ filter every message would go back to Gazebo. The C++ bridge (Jazzy 1.0.21+) ski
 publisher GID is one of its own. rclpy does not expose the publisher GID of a received sample,
 but it does expose the writer's ``publication_sequence_number`` and the ``source_timestamp``
 (the wall clock when the writer wrote it). A sample is ours when its sequence number is one our
-publisher used and its source timestamp falls inside the wall-clock window of that publish call.
-Another writer would need the same sequence number *and* a write inside that microseconds-wide
-window, which a sample from a different process or publisher practically never has (tests check
-both directions). Unlike ``ignore_local_publications``, this never drops messages from other
-nodes in the same process (ros_gz issue #788).
+publisher used, its source timestamp falls inside the wall-clock window of that publish call,
+and, where the subscription hands over the sample, its content is what we published.
+
+The content check is not a formality: another node publishing in step with Gazebo (each of its
+messages right after one of Gazebo's, both counted from 1) meets our publisher's numbers one for
+one, and on a loaded machine a publish call lasts long enough for the other write to fall inside
+it; without the content its messages were skipped as ours (one in ten of such a lockstep batch on
+2 busy cores). What each remembered publication was is kept: the object, or the CDR bytes
+written (of a large message, its length and ends), compared as CDR. Unlike
+``ignore_local_publications``, none of this drops messages from other nodes in the same
+process (ros_gz issue #788).
 """
 
 from __future__ import annotations
@@ -20,12 +26,41 @@ from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from typing import Any, Protocol
 
+from rclpy.serialization import serialize_message
+
 from ros_gz_bridge_py.watchers import Watchers
 
 #: How many recent publications per ROS topic are remembered (covers bursts and slow executors).
 HISTORY = 1024
 #: The end of the window of a publish call that has not returned yet.
 _STILL_PUBLISHING = 2**63
+#: How many bytes of each end of a large CDR message are kept to know it again.
+_ENDS = 256
+
+
+def _ends(cdr: bytes | bytearray | memoryview) -> tuple[int, bytes, bytes]:
+    """A CDR message's length and ends: for a large message the header (stamp, frame) and
+    the last bytes, which a different message practically never shares with ours at the same
+    sequence number and time."""
+    return len(cdr), bytes(cdr[:_ENDS]), bytes(cdr[-_ENDS:])
+
+
+def _kept(content: Any) -> Any:
+    """What a window keeps of a publication: a message object or small CDR as it is (a
+    reference), a large CDR message as its :func:`_ends`."""
+    if isinstance(content, (bytes, bytearray, memoryview)) and len(content) > 2 * _ENDS:
+        return _ends(content)
+    return content
+
+
+def _as_ends(content: Any) -> tuple[int, bytes, bytes]:
+    """``content`` (kept or received: an object, CDR bytes or their ends) as CDR ends.
+    Compared as CDR, not as objects: a NaN field makes a message unequal to itself."""
+    if isinstance(content, tuple):
+        return content
+    if not isinstance(content, (bytes, bytearray, memoryview)):
+        content = serialize_message(content)
+    return _ends(content)
 
 
 class NumberedPublisher(Protocol):
@@ -40,8 +75,9 @@ class OwnPublications:
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        # (publisher id, sequence number) -> (start ns, end ns) of the publish call.
-        self._windows: OrderedDict[tuple[int, int], tuple[int, int]] = OrderedDict()
+        # (publisher id, sequence number) -> (start ns, end ns) of the publish call, and what
+        # was published (_kept).
+        self._windows: OrderedDict[tuple[int, int], tuple[int, int, Any]] = OrderedDict()
         self._sequences: dict[int, int] = {}
         self._numbered: list[NumberedPublisher] = []
         #: The rcl publishers (addresses) the bridge has on the topic: a native ROS -> Gazebo
@@ -84,43 +120,53 @@ class OwnPublications:
         Must be the only way ``publisher`` publishes, from one thread at a time, so the
         sequence numbers stay in step. The window opens before the call: the sample can reach
         our own subscription (on another thread) before ``publish`` returns, all the more
-        when the write is made with the GIL released.
+        when the write is made with the GIL released. What ``publish`` returns, the CDR bytes
+        it wrote if any (``ros/serialized_publisher.py``), is kept in place of the message.
         """
         key = id(publisher)
         publish = publisher.publish
 
         def publish_and_record(msg: Any) -> None:
             start = time.time_ns()
+            kept = _kept(msg)
             with self._lock:
                 sequence = self._sequences.get(key, 0) + 1
                 self._sequences[key] = sequence
-                self._windows[(key, sequence)] = (start, _STILL_PUBLISHING)
+                self._windows[(key, sequence)] = (start, _STILL_PUBLISHING, kept)
                 if len(self._windows) > HISTORY:
                     self._windows.popitem(last=False)
             try:
-                publish(msg)
+                written = publish(msg)
             except BaseException:
                 with self._lock:  # nothing was written: the number was not used
                     self._sequences[key] = sequence - 1
                     self._windows.pop((key, sequence), None)
                 raise
             end = time.time_ns()
+            if written is not None:
+                kept = _kept(written)
             with self._lock:
                 if (key, sequence) in self._windows:
-                    self._windows[(key, sequence)] = (start, end)
+                    self._windows[(key, sequence)] = (start, end, kept)
 
         return publish_and_record
 
-    def is_own(self, info: Mapping[str, Any]) -> bool:
-        """True when the sample described by rclpy's message info is one we published."""
+    def is_own(self, info: Mapping[str, Any], received: Any = None) -> bool:
+        """True when the sample described by rclpy's message info, and ``received`` (the
+        sample itself, where the caller has it), is one we published."""
         sequence = info.get("publication_sequence_number")
         stamp = info.get("source_timestamp")
         if not sequence or not stamp:
             return False
+        matched = []
         with self._lock:
             for key in self._sequences:
                 window = self._windows.get((key, sequence))
                 if window is not None and window[0] <= stamp <= window[1]:
-                    return True
+                    matched.append(window[2])
             numbered = list(self._numbered)
+        if matched and received is None:
+            return True
+        if any(_as_ends(kept) == _as_ends(received) for kept in matched):
+            return True
         return any(publisher.is_own(sequence, stamp) for publisher in numbered)

@@ -218,7 +218,7 @@ class RosToGzChannel(Channel):
         return self._gz_publisher is not None and self._gz_publisher.has_connections()
 
     def _on_ros_message_guarded(self, ros_msg: Any, info: Any) -> None:
-        if self._own.is_own(info):
+        if self._own.is_own(info, ros_msg):
             self.stats.own_skipped += 1
             return
         self._on_ros_message(ros_msg)

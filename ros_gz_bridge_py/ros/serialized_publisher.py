@@ -102,14 +102,17 @@ class WrittenPublisher:
         self._publish_object = publisher.publish
         self.fallbacks = 0
 
-    def publish(self, msg: Any) -> None:
+    def publish(self, msg: Any) -> bytes | None:
+        """Publish ``msg``; the CDR bytes written, or None when rclpy wrote it (the loop
+        guard keeps them to know the sample when it comes back, ``core/loop_guard.py``)."""
         try:
             cdr = self._writer(msg)
         except Exception:  # any refusal: rclpy decides
             self.fallbacks += 1
             self._publish_object(msg)
-            return
+            return None
         self._serialized.publish(cdr)
+        return cdr
 
 
 def object_publisher(publisher: Any, msg_class: type[Any], *, through_rcl: bool) -> Any:

@@ -12,6 +12,8 @@ import time
 from typing import Any
 
 import pytest
+from rclpy.serialization import serialize_message
+from std_msgs.msg import Float64, String
 
 from ros_gz_bridge_py.core.loop_guard import HISTORY, OwnPublications
 
@@ -22,7 +24,7 @@ class StampingPublisher:
     def __init__(self) -> None:
         self.samples: list[dict[str, int]] = []
 
-    def publish(self, _msg: Any) -> None:
+    def publish(self, _msg: Any) -> Any:
         self.samples.append(
             {
                 "publication_sequence_number": len(self.samples) + 1,
@@ -135,3 +137,51 @@ def test_watchers_hear_each_change_of_the_rcl_publishers() -> None:
     own.remove_rcl_publisher(0x20)
     assert heard == [frozenset({0x10}), frozenset({0x10, 0x20}), frozenset({0x20})]
     assert own.rcl_publishers() == frozenset()
+
+
+class WritingPublisher(StampingPublisher):
+    """Publishes objects as CDR and says which bytes it wrote, as ``WrittenPublisher`` does."""
+
+    def publish(self, msg: Any) -> Any:
+        super().publish(msg)
+        return serialize_message(msg)
+
+
+@pytest.mark.parametrize("publisher_class", [StampingPublisher, WritingPublisher])
+def test_another_writer_in_step_with_ours_is_not_own(publisher_class: type[Any]) -> None:
+    """Another node publishing right after each Gazebo message, numbered from 1 as ours are:
+    its sample has our number and a stamp inside our publish call, but not our content.
+    Each received form is judged: the object, and the CDR bytes of a raw subscription."""
+    own = OwnPublications()
+    ours = publisher_class()
+    publish = own.wrap(ours)
+    for index in range(3):
+        publish(String(data=f"gz {index}"))
+    for index, sample in enumerate(ours.samples):
+        mine, theirs = String(data=f"gz {index}"), String(data=f"ros {index}")
+        assert own.is_own(sample, mine)
+        assert own.is_own(sample, serialize_message(mine))
+        assert not own.is_own(sample, theirs)
+        assert not own.is_own(sample, serialize_message(theirs))
+
+
+def test_published_cdr_is_compared_as_cdr() -> None:
+    """A bulk channel publishes CDR bytes and its raw subscription receives CDR bytes; a
+    large message is told apart by its ends (its header) as well as by its length."""
+    own = OwnPublications()
+    ours = StampingPublisher()
+    frame = b"\x00\x01\x00\x00" + b"stamp 1 " + bytes(100_000)
+    own.wrap(ours)(frame)
+    (sample,) = ours.samples
+    assert own.is_own(sample, frame)
+    assert not own.is_own(sample, b"\x00\x01\x00\x00" + b"stamp 2 " + bytes(100_000))
+    assert not own.is_own(sample, frame + b"\x00")
+
+
+def test_a_nan_field_does_not_make_our_sample_foreign() -> None:
+    """NaN is unequal to itself as a float, not as CDR: our own NaN sample is still ours."""
+    own = OwnPublications()
+    ours = StampingPublisher()
+    own.wrap(ours)(Float64(data=float("nan")))
+    (sample,) = ours.samples
+    assert own.is_own(sample, Float64(data=float("nan")))
