@@ -311,10 +311,14 @@ class Inbox:
     def wait_for(
         self, condition: Callable[[list[tuple[Any, Any]]], bool], timeout: float, what: str
     ) -> list[tuple[Any, Any]]:
-        """Wait until ``condition(items)`` holds; fail the test naming ``what`` on timeout."""
+        """Wait until ``condition(items)`` holds; fail the test naming ``what`` on timeout,
+        with the last messages received (which one is missing tells a loss from a delay)."""
         if not self.holds_within(condition, timeout):
+            items = self.items()
+            last = ", ".join(repr(message)[:80] for message, _ in items[-12:])
             pytest.fail(
-                f"timed out after {timeout} s waiting for {what}; {len(self.items())} received"
+                f"timed out after {timeout} s waiting for {what}; {len(items)} received"
+                + (f", the last: {last}" if items else "")
             )
         return self.items()
 
