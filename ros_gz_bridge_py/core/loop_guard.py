@@ -12,8 +12,8 @@ The content check is not a formality: another node publishing in step with Gazeb
 messages right after one of Gazebo's, both counted from 1) meets our publisher's numbers one for
 one, and on a loaded machine a publish call lasts long enough for the other write to fall inside
 it; without the content its messages were skipped as ours (one in ten of such a lockstep batch on
-2 busy cores). What each remembered publication was is kept: the object, or the CDR bytes
-written (of a large message, its length and ends), compared as CDR. Unlike
+2 busy cores). On a guarded topic, what each remembered publication was is kept as its CDR
+length and ends, and compared as CDR. Unlike
 ``ignore_local_publications``, none of this drops messages from other nodes in the same
 process (ros_gz issue #788).
 """
@@ -34,23 +34,15 @@ from ros_gz_bridge_py.watchers import Watchers
 HISTORY = 1024
 #: The end of the window of a publish call that has not returned yet.
 _STILL_PUBLISHING = 2**63
-#: How many bytes of each end of a large CDR message are kept to know it again.
+#: How many bytes of each end of a CDR message are kept to know it again.
 _ENDS = 256
 
 
 def _ends(cdr: bytes | bytearray | memoryview) -> tuple[int, bytes, bytes]:
-    """A CDR message's length and ends: for a large message the header (stamp, frame) and
-    the last bytes, which a different message practically never shares with ours at the same
-    sequence number and time."""
+    """A CDR message's length and ends: the whole of a small message; of a large one the header
+    (stamp, frame) and the last bytes, which a different message practically never shares with
+    ours at the same sequence number and time."""
     return len(cdr), bytes(cdr[:_ENDS]), bytes(cdr[-_ENDS:])
-
-
-def _kept(content: Any) -> Any:
-    """What a window keeps of a publication: a message object or small CDR as it is (a
-    reference), a large CDR message as its :func:`_ends`."""
-    if isinstance(content, (bytes, bytearray, memoryview)) and len(content) > 2 * _ENDS:
-        return _ends(content)
-    return content
 
 
 def _as_ends(content: Any) -> tuple[int, bytes, bytes]:
@@ -76,9 +68,10 @@ class OwnPublications:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         # (publisher id, sequence number) -> (start ns, end ns) of the publish call, and what
-        # was published (_kept).
+        # was published once it returned (_ends; None before the topic was guarded).
         self._windows: OrderedDict[tuple[int, int], tuple[int, int, Any]] = OrderedDict()
         self._sequences: dict[int, int] = {}
+        self._guarded = False
         self._numbered: list[NumberedPublisher] = []
         #: The rcl publishers (addresses) the bridge has on the topic: a native ROS -> Gazebo
         #: loop skips their samples by publisher GID (``native/ros_pump.py``).
@@ -104,6 +97,11 @@ class OwnPublications:
         :meth:`rcl_publishers`; returns the function that stops it."""
         return self._rcl_watchers.add(changed)
 
+    def guard(self) -> None:
+        """A subscription of the bridge judges samples of this topic from now on: keep what
+        each publication was (only then: it costs a little on every publish)."""
+        self._guarded = True
+
     def add_numbered(self, publisher: NumberedPublisher) -> None:
         """Also ask ``publisher`` whether a sample is ours (until :meth:`remove_numbered`)."""
         with self._lock:
@@ -120,15 +118,17 @@ class OwnPublications:
         Must be the only way ``publisher`` publishes, from one thread at a time, so the
         sequence numbers stay in step. The window opens before the call: the sample can reach
         our own subscription (on another thread) before ``publish`` returns, all the more
-        when the write is made with the GIL released. What ``publish`` returns, the CDR bytes
-        it wrote if any (``ros/serialized_publisher.py``), is kept in place of the message.
+        when the write is made with the GIL released. Once the topic is guarded, what was
+        published is kept as CDR ends: the bytes ``publish`` says it wrote, if any
+        (``ros/serialized_publisher.py``), else the message (serialized if an object).
         """
         key = id(publisher)
         publish = publisher.publish
 
         def publish_and_record(msg: Any) -> None:
             start = time.time_ns()
-            kept = _kept(msg)
+            # During the call the message itself: its sample may come back before it returns.
+            kept = msg if self._guarded else None
             with self._lock:
                 sequence = self._sequences.get(key, 0) + 1
                 self._sequences[key] = sequence
@@ -143,8 +143,8 @@ class OwnPublications:
                     self._windows.pop((key, sequence), None)
                 raise
             end = time.time_ns()
-            if written is not None:
-                kept = _kept(written)
+            if kept is not None:
+                kept = _as_ends(msg if written is None else written)
             with self._lock:
                 if (key, sequence) in self._windows:
                     self._windows[(key, sequence)] = (start, end, kept)
@@ -165,8 +165,9 @@ class OwnPublications:
                 if window is not None and window[0] <= stamp <= window[1]:
                     matched.append(window[2])
             numbered = list(self._numbered)
-        if matched and received is None:
-            return True
-        if any(_as_ends(kept) == _as_ends(received) for kept in matched):
+        if matched and (
+            received is None
+            or any(kept is None or _as_ends(kept) == _as_ends(received) for kept in matched)
+        ):
             return True
         return any(publisher.is_own(sequence, stamp) for publisher in numbered)

@@ -87,6 +87,7 @@ class RosToGzChannel(Channel):
         if self.loop_guard:
             return
         self.loop_guard = True
+        self._own.guard()
         if self.state is ChannelState.ACTIVE and not self._native_loop:
             self._close_input()
             self._open_input()

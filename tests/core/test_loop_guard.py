@@ -153,6 +153,7 @@ def test_another_writer_in_step_with_ours_is_not_own(publisher_class: type[Any])
     its sample has our number and a stamp inside our publish call, but not our content.
     Each received form is judged: the object, and the CDR bytes of a raw subscription."""
     own = OwnPublications()
+    own.guard()
     ours = publisher_class()
     publish = own.wrap(ours)
     for index in range(3):
@@ -169,6 +170,7 @@ def test_published_cdr_is_compared_as_cdr() -> None:
     """A bulk channel publishes CDR bytes and its raw subscription receives CDR bytes; a
     large message is told apart by its ends (its header) as well as by its length."""
     own = OwnPublications()
+    own.guard()
     ours = StampingPublisher()
     frame = b"\x00\x01\x00\x00" + b"stamp 1 " + bytes(100_000)
     own.wrap(ours)(frame)
@@ -181,7 +183,38 @@ def test_published_cdr_is_compared_as_cdr() -> None:
 def test_a_nan_field_does_not_make_our_sample_foreign() -> None:
     """NaN is unequal to itself as a float, not as CDR: our own NaN sample is still ours."""
     own = OwnPublications()
+    own.guard()
     ours = StampingPublisher()
     own.wrap(ours)(Float64(data=float("nan")))
     (sample,) = ours.samples
     assert own.is_own(sample, Float64(data=float("nan")))
+
+
+def test_before_the_topic_is_guarded_number_and_time_decide() -> None:
+    """Nothing is kept of publications made before a subscription judges the topic (the cost
+    stays off topics that are not bridged both ways); their samples are judged as before."""
+    own = OwnPublications()
+    ours = StampingPublisher()
+    publish = own.wrap(ours)
+    publish(String(data="gz 0"))
+    own.guard()
+    publish(String(data="gz 1"))
+    before, after = ours.samples
+    assert own.is_own(before, String(data="ros 0"))
+    assert not own.is_own(after, String(data="ros 1"))
+    assert own.is_own(after, String(data="gz 1"))
+
+
+def test_a_guarded_sample_seen_before_publish_returns_is_judged_by_content() -> None:
+    own = OwnPublications()
+    own.guard()
+    seen: list[tuple[bool, bool]] = []
+
+    class SeenDuringPublish(StampingPublisher):
+        def publish(self, msg: Any) -> Any:
+            super().publish(msg)
+            sample = self.samples[-1]
+            seen.append((own.is_own(sample, msg), own.is_own(sample, String(data="another"))))
+
+    own.wrap(SeenDuringPublish())(String(data="a"))
+    assert seen == [(True, False)]
