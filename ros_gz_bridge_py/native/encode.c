@@ -54,7 +54,7 @@ static int cdr_number(struct reader *r, int32_t kind, struct slot *s) {
     if (status) return status;
     if (r->n - r->pos < size) return RGB_UNDECODABLE;
     uint64_t bits = rgb_le(r->p + r->pos, size);
-    if (kind == ROS_BOOL && bits > 1) return RGB_FALLBACK;
+    if (kind == ROS_BOOLEAN && bits > 1) return RGB_FALLBACK;
     if (s != NULL) s->bits = bits;
     r->pos += size;
     return 0;
@@ -68,7 +68,7 @@ static int cdr_numbers(struct reader *r, int32_t kind, size_t count, struct slot
         if (status) return status;
     }
     if (count > (r->n - r->pos) / size) return RGB_UNDECODABLE;
-    if (kind == ROS_BOOL)
+    if (kind == ROS_BOOLEAN)
         for (size_t k = 0; k < count; k++)
             if (r->p[r->pos + k] > 1) return RGB_FALLBACK;
     if (s != NULL) {

@@ -62,11 +62,11 @@ static int pb_value(int32_t type, int32_t conv, struct rgb_number v, uint64_t *w
         as = ROS_INT32;
     else if (type == PB_UINT32 || type == PB_FIXED32) as = ROS_UINT32;
     else if (type == PB_INT64 || type == PB_SFIXED64 || type == PB_SINT64) as = ROS_INT64;
-    else if (type == PB_BOOL) as = ROS_BOOL;
+    else if (type == PB_BOOL) as = ROS_BOOLEAN;
     else if (type != PB_UINT64 && type != PB_FIXED64) return RGB_FALLBACK;
     struct rgb_ros_type range = rgb_ros_type(as);
     uint64_t bits = v.is_unsigned ? v.u : (uint64_t)v.i;
-    if (conv != CONV_WRAP || as == ROS_BOOL) {
+    if (conv != CONV_WRAP || as == ROS_BOOLEAN) {
         if (!rgb_in_range(v, range.min, range.max)) return RGB_FALLBACK;
     } else if (range.size == 4) {
         bits = (uint64_t)ros_number(as, bits & UINT32_MAX).i; /* sign-extended for int32 */

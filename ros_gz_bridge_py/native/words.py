@@ -15,24 +15,25 @@ from typing import Any, Generic, TypeVar
 
 from ros_gz_bridge_py.converters._fields import Each, Fill, Table, same
 from ros_gz_bridge_py.converters.builtin_interfaces import to_int32, to_uint32
+from ros_gz_bridge_py.native.codes import PbType, RosKind
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
-#: How a number changes type: exactly (out of range: Python decides), or narrowed as C++ (wire.h).
-CONV_EXACT, CONV_WRAP = 0, 1
+#: Protobuf field types whose values are bytes (length-delimited), not numbers.
+LENGTH_DELIMITED = frozenset({PbType.STRING, PbType.MESSAGE, PbType.BYTES})
 #: ROS basic types as the program numbers them, with their struct codes.
-ROS_KINDS: dict[str, tuple[int, str]] = {
-    "boolean": (1, "?"),
-    "uint8": (2, "B"),
-    "octet": (2, "B"),
-    "int8": (3, "b"),
-    "int16": (4, "h"),
-    "uint16": (5, "H"),
-    "int32": (6, "i"),
-    "uint32": (7, "I"),
-    "int64": (8, "q"),
-    "uint64": (9, "Q"),
-    "float": (10, "f"),
-    "double": (11, "d"),
+ROS_KINDS: dict[str, tuple[RosKind, str]] = {
+    "boolean": (RosKind.BOOLEAN, "?"),
+    "uint8": (RosKind.UINT8, "B"),
+    "octet": (RosKind.UINT8, "B"),
+    "int8": (RosKind.INT8, "b"),
+    "int16": (RosKind.INT16, "h"),
+    "uint16": (RosKind.UINT16, "H"),
+    "int32": (RosKind.INT32, "i"),
+    "uint32": (RosKind.UINT32, "I"),
+    "int64": (RosKind.INT64, "q"),
+    "uint64": (RosKind.UINT64, "Q"),
+    "float": (RosKind.FLOAT, "f"),
+    "double": (RosKind.DOUBLE, "d"),
 }
 
 
@@ -141,7 +142,7 @@ def descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
     return [*steps, field.number], field.message_type
 
 
-def ros_kind(slot: Any) -> tuple[int, str]:
+def ros_kind(slot: Any) -> tuple[RosKind, str]:
     """The program's number and the struct code of a ROS basic type."""
     basic = cdr.basic_of(slot)
     if basic not in ROS_KINDS:
