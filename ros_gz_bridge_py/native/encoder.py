@@ -35,7 +35,6 @@ from ros_gz_bridge_py.native.words import (
     Half,
     NotExpressibleError,
     Path,
-    named,
     ros_kind,
     text_words,
 )
@@ -146,7 +145,18 @@ def _each(shape: Each, ros: Path, gz: Path, out: Node) -> None:
     out.set(gz, Sequence(ros, element))
 
 
-_TO_GZ = Half("to_gz", _LEAVES, _copy, _each)
+def _clock(out: Node) -> None:
+    """``clock_to_gz``: the clock as the (present) ``sim`` time."""
+    _time(("clock",), ("sim",), out)
+
+
+#: Whole hand-written converters, by module and name (not imported: see program.py).
+_WHOLE: dict[tuple[str, str], Callable[[Node], None]] = {
+    ("ros_gz_bridge_py.converters.rosgraph_msgs", "clock_to_gz"): _clock,
+}
+
+
+_TO_GZ = Half("to_gz", _LEAVES, _copy, _each, _WHOLE)
 
 
 # ---- the ROS side: read ops and slots ---------------------------------------------------------
@@ -317,36 +327,14 @@ def _check_number(gz_field: Any, kind: int) -> None:
         raise NotExpressibleError(msg)
 
 
-def _clock(out: Node) -> None:
-    """``clock_to_gz``: the clock as the (present) ``sim`` time."""
-    _time(("clock",), ("sim",), out)
-
-
-#: Whole hand-written converters, by module and name (not imported: see program.py).
-_WHOLE: dict[tuple[str, str], Callable[[Node], None]] = {
-    ("ros_gz_bridge_py.converters.rosgraph_msgs", "clock_to_gz"): _clock,
-}
-
-
 def compile_to_gz(pair: Pair) -> bytes:
     """The words of the encoder from ``pair``'s ROS messages (CDR) to its Gazebo payloads.
 
     Raises:
         NotExpressibleError: the pair stays on the Python path (the reason says why).
     """
-    if pair.bulk is not None:
-        msg = "a bulk pair (it has its own path)"
-        raise NotExpressibleError(msg)
     tree = Node()
-    fill = gz_declaration_of(pair.to_gz)
-    whole = named(pair.to_gz, _WHOLE)
-    if fill is not None:
-        _TO_GZ.assign(fill, (), (), tree)
-    elif whole is not None:
-        whole(tree)
-    else:
-        msg = f"a hand-written converter ({pair.to_gz.__qualname__})"
-        raise NotExpressibleError(msg)
+    _TO_GZ.read(pair, gz_declaration_of(pair.to_gz), tree)
     top = _Frame(_used(tree))
     read = _read_ops(pair.ros_class, (), top, _sequences(tree))
     read.append(ReadOp.END)

@@ -37,7 +37,6 @@ from ros_gz_bridge_py.native.words import (
     NotExpressibleError,
     Path,
     descend,
-    named,
     ros_kind,
     text_words,
     walk,
@@ -183,7 +182,7 @@ def _each(shape: Each, ros: Path, gz: Path, out: Assignments) -> None:
 
 #: Where each ROS field written by a Fill's ``to_ros`` comes from (later entries win, as they do
 #: when the Python code runs).
-_TO_ROS = Half("to_ros", _LEAVES, _copy, _each)
+_TO_ROS = Half("to_ros", _LEAVES, _copy, _each, _WHOLE)
 
 
 # ---- the schema ------------------------------------------------------------------------------
@@ -371,21 +370,10 @@ def compile_to_ros(pair: Pair, *, frame_id: str = "", wall_stamp: bool = False) 
     Raises:
         NotExpressibleError: the pair stays on the Python path (the reason says why).
     """
-    if pair.bulk is not None:
-        msg = "a bulk pair (it has its own path)"
-        raise NotExpressibleError(msg)
     declared = declaration_of(pair.to_ros)
     given: Assignments = {}
-    if declared is not None:
-        fill, new_ros = declared
-        _TO_ROS.assign(fill, (), (), given)
-        default = new_ros()
-    elif (whole := named(pair.to_ros, _WHOLE)) is not None:
-        whole(given)
-        default = pair.ros_class()
-    else:
-        msg = f"a hand-written converter ({pair.to_ros.__qualname__})"
-        raise NotExpressibleError(msg)
+    _TO_ROS.read(pair, declared[0] if declared else None, given)
+    default = declared[1]() if declared else pair.ros_class()
     if pair.ros_class.get_fields_and_field_types().get("header") == "std_msgs/Header":
         if frame_id:
             given[("header", "frame_id")] = FixedText(frame_id)

@@ -11,12 +11,15 @@ import sys
 from array import array
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from ros_gz_bridge_py.converters._fields import Each, Fill, Table, same
 from ros_gz_bridge_py.converters.builtin_interfaces import to_int32, to_uint32
 from ros_gz_bridge_py.native.codes import PbType, RosKind
 from ros_gz_bridge_py.ros import cdr_types as cdr
+
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.converters.registry import Pair
 
 #: Protobuf field types whose values are bytes (length-delimited), not numbers.
 LENGTH_DELIMITED = frozenset({PbType.STRING, PbType.MESSAGE, PbType.BYTES})
@@ -60,12 +63,14 @@ class Half(Generic[_T]):
     """How a compiler reads one half (``to_ros`` or ``to_gz``) of the declarations into its
     ``_T``: ``leaves``, the hand-written Fills the tables build on; ``copy(ros, gz, wrap, out)``
     for a field copied (``wrap``: narrowed as C++ does); ``each(shape, ros, gz, out)`` for a
-    sequence filled element by element."""
+    sequence filled element by element; ``whole``, whole hand-written converters by module and
+    name (:func:`named`)."""
 
     name: str
     leaves: Mapping[Callable[[Any, Any], None], Callable[[Path, Path, _T], None]]
     copy: Callable[[Path, Path, bool, _T], None]
     each: Callable[[Each, Path, Path, _T], None]
+    whole: Mapping[tuple[str, str], Callable[[_T], None]]
 
     def assign(self, fill: Fill, ros: Path, gz: Path, out: _T) -> None:
         """What ``fill``'s half writes (from ``gz`` to ``ros`` or back), into ``out``; raises
@@ -89,6 +94,22 @@ class Half(Generic[_T]):
             self.each(fill.shape, ros, gz, out)
         else:
             msg = f"a Fill of hand-written functions ({function.__qualname__})"
+            raise NotExpressibleError(msg)
+
+    def read(self, pair: Pair, fill: Fill | None, out: _T) -> None:
+        """What ``pair``'s converter of this half writes, into ``out``: its declaration
+        ``fill``, or else a whole hand-written converter; raises NotExpressibleError for a bulk
+        pair or other hand-written code."""
+        function = getattr(pair, self.name)
+        if pair.bulk is not None:
+            msg = "a bulk pair (it has its own path)"
+            raise NotExpressibleError(msg)
+        if fill is not None:
+            self.assign(fill, (), (), out)
+        elif (converter := named(function, self.whole)) is not None:
+            converter(out)
+        else:
+            msg = f"a hand-written converter ({function.__qualname__})"
             raise NotExpressibleError(msg)
 
 
