@@ -7,15 +7,20 @@
 #include <math.h>
 #include <string.h>
 
-static int put_varint(struct rgb_out *out, uint64_t value) {
-    int status = rgb_grow(out, 10);
-    if (status) return status;
+/* `value` as a varint at `b` (10 bytes at most); its length. */
+static size_t varint(uint64_t value, uint8_t b[10]) {
+    size_t k = 0;
     do {
         uint8_t byte = value & 0x7f;
         value >>= 7;
-        out->data[out->len++] = byte | (value ? 0x80 : 0);
+        b[k++] = byte | (value ? 0x80 : 0);
     } while (value);
-    return 0;
+    return k;
+}
+
+static int put_varint(struct rgb_out *out, uint64_t value) {
+    uint8_t b[10];
+    return rgb_put(out, b, varint(value, b));
 }
 
 static int put_tag(struct rgb_out *out, int32_t field, int wire) {
@@ -106,15 +111,10 @@ static int open_length(struct rgb_out *out, size_t *mark) {
 static int close_length(struct rgb_out *out, size_t mark) {
     size_t length = out->len - mark - 5;
     if (length >= ((size_t)1 << 35)) return RGB_FALLBACK;
-    uint8_t varint[5];
-    size_t k = 0, rest = length;
-    do {
-        uint8_t byte = rest & 0x7f;
-        rest >>= 7;
-        varint[k++] = byte | (rest ? 0x80 : 0);
-    } while (rest);
+    uint8_t b[10];
+    size_t k = varint(length, b); /* 5 bytes at most */
     memmove(out->data + mark + k, out->data + mark + 5, length);
-    memcpy(out->data + mark, varint, k);
+    memcpy(out->data + mark, b, k);
     out->len = mark + k + length;
     return 0;
 }
