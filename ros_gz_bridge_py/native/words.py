@@ -138,29 +138,24 @@ def gz_field(descriptor: Any, name: str) -> Any:
     return field
 
 
-def walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
-    """The field numbers of the submessages on ``path`` (all but the last name), and the
-    descriptor of the field the last name names."""
+def descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path``, and the message it reaches."""
     steps = []
-    for name in path[:-1]:
+    for name in path:
         field = gz_field(descriptor, name)
         if field.message_type is None or field.is_repeated:
             msg = f"{descriptor.full_name}.{name} is not a singular submessage"
             raise NotExpressibleError(msg)
         steps.append(field.number)
         descriptor = field.message_type
-    return steps, gz_field(descriptor, path[-1])
+    return steps, descriptor
 
 
-def descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
-    """The field numbers of the submessages on ``path``, and the message it reaches."""
-    if not path:
-        return [], descriptor
-    steps, field = walk(descriptor, path)
-    if field.message_type is None or field.is_repeated:
-        msg = f"{descriptor.full_name}.{'.'.join(path)} is not a singular submessage"
-        raise NotExpressibleError(msg)
-    return [*steps, field.number], field.message_type
+def walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path`` (all but the last name), and the
+    descriptor of the field the last name names."""
+    steps, parent = descend(descriptor, path[:-1])
+    return steps, gz_field(parent, path[-1])
 
 
 def ros_kind(slot: Any) -> tuple[RosKind, str]:
