@@ -1,8 +1,8 @@
 """What the two compilers of native programs share (``program.py``: Gazebo -> ROS,
 ``encoder.py``: ROS -> Gazebo): the error that keeps a pair on the Python path, paths of field
-names, the numbers of ROS basic types and of narrowing, the walk of a declaration's Fills and
-the Value functions a program expresses in it, text as words, and the protobuf fields and ROS
-slots they read.
+names, the ROS basic types by name (their numbers, as all of the programs' numbers, are
+``codes.py``'s), the walk of a declaration's Fills and the Value functions a program expresses
+in it, text as words, and the protobuf fields and ROS slots they read.
 """
 
 from __future__ import annotations
