@@ -8,7 +8,13 @@ compiler or Python headers exist, or the build fails, the package installs witho
 bridge runs on the Python path (``ros_gz_bridge_py.native`` logs once why; docs/native.md §1).
 """
 
+import importlib.util
+from pathlib import Path
+
 from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
+
+CODES = Path(__file__).resolve().parent / "ros_gz_bridge_py" / "native" / "codes.py"
 
 NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/_native.c",
@@ -26,13 +32,35 @@ NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/transcoders.c",
 ]
 
+
+class BuildNative(build_ext):
+    """Writes codes.h, the numbers the C transcoders read, from their one declaration
+    (native/codes.py, loaded alone: the package's imports need what is not installed yet) into
+    the build's temporary folder, which the compiler searches."""
+
+    def build_extensions(self) -> None:
+        spec = importlib.util.spec_from_file_location("ros_gz_bridge_codes", CODES)
+        assert spec is not None
+        assert spec.loader is not None
+        codes = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(codes)
+        generated = Path(self.build_temp)
+        generated.mkdir(parents=True, exist_ok=True)
+        codes.write_c_header(generated / "codes.h")
+        for extension in self.extensions:
+            extension.include_dirs.append(str(generated))
+        super().build_extensions()
+
+
 setup(
+    cmdclass={"build_ext": BuildNative},
     ext_modules=[
         Extension(
             "ros_gz_bridge_py.native._native",
             sources=NATIVE_SOURCES,
             depends=[
                 "ros_gz_bridge_py/native/_native.h",
+                "ros_gz_bridge_py/native/codes.py",
                 "ros_gz_bridge_py/native/encode.h",
                 "ros_gz_bridge_py/native/encode_ops.h",
                 "ros_gz_bridge_py/native/transcode.h",
@@ -53,5 +81,5 @@ setup(
             ],
             optional=True,
         )
-    ]
+    ],
 )

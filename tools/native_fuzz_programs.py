@@ -6,7 +6,8 @@ Usage::
     python -m tools.native_fuzz_programs OUT_DIR [--target encode]
 
 writes ``OUT_DIR/programs.h``, the words of every pair whose program compiles
-(``compile_to_ros``) as C arrays, and ``OUT_DIR/corpus/``, the seed inputs: per program, its
+(``compile_to_ros``) as C arrays, ``OUT_DIR/codes.h`` (the numbers the C files read,
+``native/codes.py``), and ``OUT_DIR/corpus/``, the seed inputs: per program, its
 index byte then a valid payload (empty, a message with every field set, :func:`distinctive`,
 and the same shaped to cost: wrapped in small unknown fields, or followed by thousands of
 empty elements); and one seed of each program-loading mode (the fuzz target's comment
@@ -29,17 +30,16 @@ from rclpy.serialization import serialize_message
 
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native import encoder as enc
+from ros_gz_bridge_py.native.codes import Conv, PbType, ReadOp, RosKind, WriteOp, write_c_header
 from ros_gz_bridge_py.native.encoder import compile_to_gz
 from ros_gz_bridge_py.native.program import Compiled, compile_to_ros
-from ros_gz_bridge_py.native.words import CONV_EXACT, CONV_WRAP, ROS_KINDS, NotExpressibleError
+from ros_gz_bridge_py.native.words import NotExpressibleError
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
 #: The fuzz targets' modes, by the first input byte (fuzz/transcode_fuzz.c, fuzz/encode_fuzz.c).
 LOAD_MODE, MUTATE_MODE = 0x80, 0xC0
 _HEADER_TYPES = {"gz.msgs.Header", "ignition.msgs.Header"}
-_FLOAT, _DOUBLE, _BOOL, _STRING, _BYTES, _ENUM = 2, 1, 8, 9, 12, 14
-_WIDE = {3, 4, 6, 16, 18}  # the 64-bit integers
+_WIDE = {PbType.INT64, PbType.UINT64, PbType.FIXED64, PbType.SFIXED64, PbType.SINT64}
 
 
 def compiled_pairs() -> list[tuple[Pair, Compiled]]:
@@ -68,17 +68,17 @@ def _scalar(field: Any, n: int) -> Any:
     """A positive value of ``field``'s type that no other field given another ``n`` has (n >= 1;
     a 64-bit one narrows to the same positive int32, or Clock would refuse the message)."""
     kind = field.type
-    if kind == _DOUBLE:
+    if kind == PbType.DOUBLE:
         return n * 1.5 + 0.25
-    if kind == _FLOAT:
+    if kind == PbType.FLOAT:
         return n + 0.5
-    if kind == _BOOL:
+    if kind == PbType.BOOL:
         return True
-    if kind == _STRING:
+    if kind == PbType.STRING:
         return f"s{n}::part::{n}é"
-    if kind == _BYTES:
+    if kind == PbType.BYTES:
         return bytes([n % 256, 0, 255])
-    if kind == _ENUM:
+    if kind == PbType.ENUM:
         numbers = [value.number for value in field.enum_type.values if value.number != 0]
         return numbers[n % len(numbers)] if numbers else n
     value = n * 7 + 3
@@ -299,37 +299,36 @@ def encoder_seeds(encoders: Sequence[tuple[Pair, bytes]]) -> dict[str, bytes]:
 
 
 def _encoder_words(nslots: int, read: list[int], write: list[int]) -> list[int]:
-    return [nslots, len(read) + 1, *read, enc.R_END, *write, enc.W_END]
+    return [nslots, len(read) + 1, *read, ReadOp.END, *write, WriteOp.END]
 
 
-_ROS = {name: kind for name, (kind, _code) in ROS_KINDS.items()}
-_PB_SINT32, _PB_UINT32, _PB_SINT64, _PB_FIXED32, _PB_ENUM = 17, 13, 18, 7, 14
 #: Encoders no pair compiles to, with a CDR body for each, as seeds of the load mode: the ops
 #: and types the compiled ones leave out (string sequences, 16-bit and 8-bit integers, a
 #: wrapped uint32, zigzag and fixed fields, nested message sequences).
 _SYNTHETIC: dict[str, tuple[list[int], bytes]] = {
     "string-sequence": (
-        _encoder_words(1, [enc.R_SEQ_STR, 0], [enc.W_SEQ_STR, 1, 0]),
+        _encoder_words(1, [ReadOp.SEQ_STR, 0], [WriteOp.SEQ_STR, 1, 0]),
         struct.pack("<II", 2, 2) + b"a\0\0\0" + struct.pack("<I", 3) + b"bc\0",
     ),
     "integers": (
         _encoder_words(
             4,
-            [enc.R_NUM, _ROS["int16"], 0, enc.R_NUM, _ROS["uint32"], 1,
-             enc.R_SEQ_NUM, _ROS["int8"], 2, enc.R_ARR, _ROS["uint16"], 3, 3],
-            [enc.W_NUM, 1, _PB_SINT32, _ROS["int16"], CONV_EXACT, 0,
-             enc.W_NUM, 2, _PB_UINT32, _ROS["uint32"], CONV_WRAP, 1,
-             enc.W_PACKED, 3, _PB_SINT64, _ROS["int8"], 2,
-             enc.W_PACKED, 4, _PB_FIXED32, _ROS["uint16"], 3],
+            [ReadOp.NUM, RosKind.INT16, 0, ReadOp.NUM, RosKind.UINT32, 1,
+             ReadOp.SEQ_NUM, RosKind.INT8, 2, ReadOp.ARR, RosKind.UINT16, 3, 3],
+            [WriteOp.NUM, 1, PbType.SINT32, RosKind.INT16, Conv.EXACT, 0,
+             WriteOp.NUM, 2, PbType.UINT32, RosKind.UINT32, Conv.WRAP, 1,
+             WriteOp.PACKED, 3, PbType.SINT64, RosKind.INT8, 2,
+             WriteOp.PACKED, 4, PbType.FIXED32, RosKind.UINT16, 3],
         ),
         struct.pack("<hxxIIbbbxhhh", -5, 2**32 - 1, 3, -1, 0, 1, 7, -1, 300),
     ),
     "nested-sequences": (
         _encoder_words(
             1,
-            [enc.R_SEQ_MSG, 0, 2, 6, enc.R_NUM, _ROS["int32"], 0, enc.R_STR, 1, enc.R_END],
-            [enc.W_SEQ_MSG, 1, 0, 2, 10,
-             enc.W_NUM, 1, _PB_ENUM, _ROS["int32"], CONV_EXACT, 0, enc.W_STR, 2, 1, enc.W_END],
+            [ReadOp.SEQ_MSG, 0, 2, 6, ReadOp.NUM, RosKind.INT32, 0, ReadOp.STR, 1, ReadOp.END],
+            [WriteOp.SEQ_MSG, 1, 0, 2, 10,
+             WriteOp.NUM, 1, PbType.ENUM, RosKind.INT32, Conv.EXACT, 0, WriteOp.STR, 2, 1,
+             WriteOp.END],
         ),
         struct.pack("<Ii", 2, -3) + struct.pack("<I", 2) + b"x\0\0\0" + struct.pack("<iI", 9, 1)
         + b"\0",
@@ -341,6 +340,7 @@ def _write(out: Path, header: str, text: str, inputs: dict[str, bytes]) -> Path:
     corpus = out / "corpus"
     corpus.mkdir(parents=True, exist_ok=True)
     (out / header).write_text(text)
+    write_c_header(out / "codes.h")
     for name, data in inputs.items():
         (corpus / name).write_bytes(data)
     return corpus

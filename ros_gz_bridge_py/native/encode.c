@@ -21,13 +21,24 @@ static int cdr_align(struct reader *r, size_t size) {
     return 0;
 }
 
-static int cdr_u32(struct reader *r, uint32_t *value) {
-    int status = cdr_align(r, 4);
+static int cdr_number(struct reader *r, int32_t kind, struct slot *s) {
+    size_t size = rgb_ros_size(kind);
+    int status = cdr_align(r, size);
     if (status) return status;
-    if (r->n - r->pos < 4) return RGB_UNDECODABLE;
-    *value = (uint32_t)rgb_le(r->p + r->pos, 4);
-    r->pos += 4;
+    if (r->n - r->pos < size) return RGB_UNDECODABLE;
+    uint64_t bits = rgb_le(r->p + r->pos, size);
+    if (kind == ROS_BOOLEAN && bits > 1) return RGB_FALLBACK;
+    if (s != NULL) s->bits = bits;
+    r->pos += size;
     return 0;
+}
+
+/* A length or a count. */
+static int cdr_u32(struct reader *r, uint32_t *value) {
+    struct slot read = {0, 0, 0, 0};
+    int status = cdr_number(r, ROS_UINT32, &read);
+    *value = (uint32_t)read.bits;
+    return status;
 }
 
 /* A string: its bytes without the NUL, as Python reads them. */
@@ -48,18 +59,6 @@ int enc_cdr_string(struct reader *r, struct slot *s) {
     return 0;
 }
 
-static int cdr_number(struct reader *r, int32_t kind, struct slot *s) {
-    size_t size = rgb_ros_size(kind);
-    int status = cdr_align(r, size);
-    if (status) return status;
-    if (r->n - r->pos < size) return RGB_UNDECODABLE;
-    uint64_t bits = rgb_le(r->p + r->pos, size);
-    if (kind == ROS_BOOL && bits > 1) return RGB_FALLBACK;
-    if (s != NULL) s->bits = bits;
-    r->pos += size;
-    return 0;
-}
-
 /* `count` numbers of `kind` (aligned to their size when there are some). */
 static int cdr_numbers(struct reader *r, int32_t kind, size_t count, struct slot *s) {
     size_t size = rgb_ros_size(kind);
@@ -68,7 +67,7 @@ static int cdr_numbers(struct reader *r, int32_t kind, size_t count, struct slot
         if (status) return status;
     }
     if (count > (r->n - r->pos) / size) return RGB_UNDECODABLE;
-    if (kind == ROS_BOOL)
+    if (kind == ROS_BOOLEAN)
         for (size_t k = 0; k < count; k++)
             if (r->p[r->pos + k] > 1) return RGB_FALLBACK;
     if (s != NULL) {

@@ -7,18 +7,17 @@
 #include <string.h>
 
 /* Each read op's operands (wire.h rgb_operands; S: its slot), by op code. */
-static const char *const READ_LAYOUTS[] = {
+static const char *const READ_LAYOUTS[R_COUNT] = {
     [R_NUM] = "kS",     [R_STR] = "S",     [R_ARR] = "kNS",
     [R_SEQ_NUM] = "kS", [R_SEQ_STR] = "S", [R_SEQ_MSG] = "SmB",
 };
 /* Each write op's operands; their slots (w) are checked against the frame's read ops. */
-static const char *const WRITE_LAYOUTS[] = {
+static const char *const WRITE_LAYOUTS[W_COUNT] = {
     [W_NUM] = "Fskcw", [W_STR] = "Fw",       [W_STR_REP] = "Fw",  [W_CONST_STR] = "FT",
     [W_MSG] = "FB",    [W_SEQ_MSG] = "FwwB", [W_PACKED] = "Fskw", [W_SEQ_STR] = "Fw",
 };
-#define READ_LAYOUT(code) rgb_layout(READ_LAYOUTS, sizeof READ_LAYOUTS / sizeof *READ_LAYOUTS, code)
-#define WRITE_LAYOUT(code) \
-    rgb_layout(WRITE_LAYOUTS, sizeof WRITE_LAYOUTS / sizeof *WRITE_LAYOUTS, code)
+#define READ_LAYOUT(code) rgb_layout(READ_LAYOUTS, R_COUNT, code)
+#define WRITE_LAYOUT(code) rgb_layout(WRITE_LAYOUTS, W_COUNT, code)
 
 /* The fewest bytes a message read by ops [op, end) takes on the wire (alignment aside): a
  * lower bound that keeps a count from sizing more slots than the bytes can hold. */
@@ -139,8 +138,7 @@ int rgb_encoder_load(struct rgb_encoder *encoder, const int32_t *words, size_t l
     }
     const int32_t *read = words + 2, *write = words + 2 + words[1];
     size_t read_len = (size_t)words[1], write_len = len - 2 - read_len;
-    size_t nread = sizeof READ_LAYOUTS / sizeof *READ_LAYOUTS;
-    if (rgb_check_body(read, read_len, READ_LAYOUTS, nread, words[0], 0, MAX_DEPTH)) {
+    if (rgb_check_body(read, read_len, READ_LAYOUTS, R_COUNT, words[0], 0, MAX_DEPTH)) {
         *why = "encoder: a read op is not well-formed";
         return -1;
     }

@@ -1,34 +1,12 @@
 /* What the ROS -> Gazebo transcoder's files share (private: encode.h is its interface): the
- * ops of an encoder (docs/native.md §6) and the slots the read ops fill. encode.c reads the CDR
- * message into slots, encode_write.c writes the protobuf payload from them, encode_load.c
- * checks an encoder's words once. */
+ * slots the read ops fill (the ops of an encoder, docs/native.md §6, are numbered in codes.h).
+ * encode.c reads the CDR message into slots, encode_write.c writes the protobuf payload from
+ * them, encode_load.c checks an encoder's words once. */
 #ifndef RGB_ENCODE_OPS_H
 #define RGB_ENCODE_OPS_H
 
 #include "encode.h"
 #include "wire.h"
-
-enum {
-    R_END = 0,
-    R_NUM = 1,
-    R_STR = 2,
-    R_ARR = 3,
-    R_SEQ_NUM = 4,
-    R_SEQ_STR = 5,
-    R_SEQ_MSG = 6,
-};
-
-enum {
-    W_END = 0,
-    W_NUM = 1,
-    W_STR = 2,
-    W_STR_REP = 3,
-    W_CONST_STR = 4,
-    W_MSG = 5,
-    W_SEQ_MSG = 6,
-    W_PACKED = 7,
-    W_SEQ_STR = 8,
-};
 
 /* Slots of one message at most (40 bytes each): beyond, Python decides. */
 #define MAX_SLOTS ((size_t)1 << 22)

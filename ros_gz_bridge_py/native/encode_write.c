@@ -7,15 +7,20 @@
 #include <math.h>
 #include <string.h>
 
-static int put_varint(struct rgb_out *out, uint64_t value) {
-    int status = rgb_grow(out, 10);
-    if (status) return status;
+/* `value` as a varint at `b` (10 bytes at most); its length. */
+static size_t varint(uint64_t value, uint8_t b[10]) {
+    size_t k = 0;
     do {
         uint8_t byte = value & 0x7f;
         value >>= 7;
-        out->data[out->len++] = byte | (value ? 0x80 : 0);
+        b[k++] = byte | (value ? 0x80 : 0);
     } while (value);
-    return 0;
+    return k;
+}
+
+static int put_varint(struct rgb_out *out, uint64_t value) {
+    uint8_t b[10];
+    return rgb_put(out, b, varint(value, b));
 }
 
 static int put_tag(struct rgb_out *out, int32_t field, int wire) {
@@ -62,11 +67,11 @@ static int pb_value(int32_t type, int32_t conv, struct rgb_number v, uint64_t *w
         as = ROS_INT32;
     else if (type == PB_UINT32 || type == PB_FIXED32) as = ROS_UINT32;
     else if (type == PB_INT64 || type == PB_SFIXED64 || type == PB_SINT64) as = ROS_INT64;
-    else if (type == PB_BOOL) as = ROS_BOOL;
+    else if (type == PB_BOOL) as = ROS_BOOLEAN;
     else if (type != PB_UINT64 && type != PB_FIXED64) return RGB_FALLBACK;
     struct rgb_ros_type range = rgb_ros_type(as);
     uint64_t bits = v.is_unsigned ? v.u : (uint64_t)v.i;
-    if (conv != CONV_WRAP || as == ROS_BOOL) {
+    if (conv != CONV_WRAP || as == ROS_BOOLEAN) {
         if (!rgb_in_range(v, range.min, range.max)) return RGB_FALLBACK;
     } else if (range.size == 4) {
         bits = (uint64_t)ros_number(as, bits & UINT32_MAX).i; /* sign-extended for int32 */
@@ -106,15 +111,10 @@ static int open_length(struct rgb_out *out, size_t *mark) {
 static int close_length(struct rgb_out *out, size_t mark) {
     size_t length = out->len - mark - 5;
     if (length >= ((size_t)1 << 35)) return RGB_FALLBACK;
-    uint8_t varint[5];
-    size_t k = 0, rest = length;
-    do {
-        uint8_t byte = rest & 0x7f;
-        rest >>= 7;
-        varint[k++] = byte | (rest ? 0x80 : 0);
-    } while (rest);
+    uint8_t b[10];
+    size_t k = varint(length, b); /* 5 bytes at most */
     memmove(out->data + mark + k, out->data + mark + 5, length);
-    memcpy(out->data + mark, varint, k);
+    memcpy(out->data + mark, b, k);
     out->len = mark + k + length;
     return 0;
 }

@@ -29,21 +29,16 @@ from ros_gz_bridge_py.converters.std_msgs import (
 )
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.native import words
+from ros_gz_bridge_py.native.codes import Conv, PbType, ReadOp, RosKind, WriteOp
 from ros_gz_bridge_py.native.words import (
+    LENGTH_DELIMITED,
     Half,
     NotExpressibleError,
     Path,
-    named,
     ros_kind,
     text_words,
 )
 from ros_gz_bridge_py.ros import cdr_types as cdr
-
-# Read ops, write ops (encode.c).
-R_END, R_NUM, R_STR, R_ARR, R_SEQ_NUM, R_SEQ_STR, R_SEQ_MSG = 0, 1, 2, 3, 4, 5, 6
-W_END, W_NUM, W_STR, W_STR_REP, W_CONST_STR, W_MSG, W_SEQ_MSG, W_PACKED, W_SEQ_STR = range(9)
-_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP, _PB_BOOL = 9, 11, 12, 10, 8
-_PB_FLOATS = frozenset({1, 2})
 
 
 @dataclass
@@ -150,7 +145,18 @@ def _each(shape: Each, ros: Path, gz: Path, out: Node) -> None:
     out.set(gz, Sequence(ros, element))
 
 
-_TO_GZ = Half("to_gz", _LEAVES, _copy, _each)
+def _clock(out: Node) -> None:
+    """``clock_to_gz``: the clock as the (present) ``sim`` time."""
+    _time(("clock",), ("sim",), out)
+
+
+#: Whole hand-written converters, by module and name (not imported: see program.py).
+_WHOLE: dict[tuple[str, str], Callable[[Node], None]] = {
+    ("ros_gz_bridge_py.converters.rosgraph_msgs", "clock_to_gz"): _clock,
+}
+
+
+_TO_GZ = Half("to_gz", _LEAVES, _copy, _each, _WHOLE)
 
 
 # ---- the ROS side: read ops and slots ---------------------------------------------------------
@@ -195,33 +201,34 @@ def _read_ops(
     ops: list[int] = []
     fields = cdr.fields_of(msg_class)
     if not fields:
-        return [R_NUM, words.ROS_KINDS["uint8"][0], -1]
+        return [ReadOp.NUM, RosKind.UINT8, -1]
     for name, rosidl in fields:
         path = (*prefix, name)
         kind = type(rosidl).__name__
         basic = cdr.basic_of(rosidl)
         if basic is not None:
-            ops += [R_NUM, ros_kind(rosidl)[0], frame.slot(path, rosidl)]
+            ops += [ReadOp.NUM, ros_kind(rosidl)[0], frame.slot(path, rosidl)]
         elif kind in cdr.STRING_TYPES:
-            ops += [R_STR, frame.slot(path, rosidl)]
+            ops += [ReadOp.STR, frame.slot(path, rosidl)]
         elif kind == "NamespacedType":
             ops += _read_ops(cdr.nested_class(rosidl), path, frame, elements)
         elif kind == "Array" and cdr.basic_of(rosidl.value_type) is not None:
-            ops += [R_ARR, ros_kind(rosidl.value_type)[0], rosidl.size, frame.slot(path, rosidl)]
+            ops += [ReadOp.ARR, ros_kind(rosidl.value_type)[0], rosidl.size,
+                    frame.slot(path, rosidl)]  # fmt: skip
         elif kind in cdr.SEQUENCE_TYPES and cdr.basic_of(rosidl.value_type) is not None:
-            ops += [R_SEQ_NUM, ros_kind(rosidl.value_type)[0], frame.slot(path, rosidl)]
+            ops += [ReadOp.SEQ_NUM, ros_kind(rosidl.value_type)[0], frame.slot(path, rosidl)]
         elif kind in cdr.SEQUENCE_TYPES and type(rosidl.value_type).__name__ in cdr.STRING_TYPES:
-            ops += [R_SEQ_STR, frame.slot(path, rosidl)]
+            ops += [ReadOp.SEQ_STR, frame.slot(path, rosidl)]
         elif kind in cdr.SEQUENCE_TYPES and type(rosidl.value_type).__name__ == "NamespacedType":
             element_node = elements.get(path, Node())
             element = _Frame(_used(element_node))
             body = _read_ops(
                 cdr.nested_class(rosidl.value_type), (), element, _sequences(element_node)
             )
-            body.append(R_END)
+            body.append(ReadOp.END)
             slot = frame.slot(path, rosidl)
             frame.elements[path] = element
-            ops += [R_SEQ_MSG, slot, len(element.slots), len(body), *body]
+            ops += [ReadOp.SEQ_MSG, slot, len(element.slots), len(body), *body]
         else:
             msg = f"a ROS {kind} field ({'.'.join(path)}) the encoder does not read"
             raise NotExpressibleError(msg)
@@ -255,79 +262,69 @@ def _write_one(item: Any, gz_field: Any, frame: _Frame, *, repeated: bool) -> li
             msg = f"{gz_field.full_name} is not a message field"
             raise NotExpressibleError(msg)
         body = _write_ops(item, gz_field.message_type, frame)
-        body.append(W_END)
-        return [W_MSG, number, len(body), *body]
+        body.append(WriteOp.END)
+        return [WriteOp.MSG, number, len(body), *body]
     if isinstance(item, Text):
-        if gz_field.type != _PB_STRING or gz_field.is_repeated:
+        if gz_field.type != PbType.STRING or gz_field.is_repeated:
             msg = f"{gz_field.full_name} is not a string"
             raise NotExpressibleError(msg)
-        return [W_CONST_STR, number, *text_words(item.value.encode())]
+        return [WriteOp.CONST_STR, number, *text_words(item.value.encode())]
     if isinstance(item, Sequence):
         element = frame.elements.get(item.ros)
         if element is None or gz_field.message_type is None or not gz_field.is_repeated:
             msg = f"{gz_field.full_name} from {'.'.join(item.ros)}: not a repeated message"
             raise NotExpressibleError(msg)
         body = _write_ops(item.element, gz_field.message_type, element)
-        body.append(W_END)
-        return [W_SEQ_MSG, number, frame.slots[item.ros], len(element.slots), len(body), *body]
+        body.append(WriteOp.END)
+        return [WriteOp.SEQ_MSG, number, frame.slots[item.ros], len(element.slots), len(body),
+                *body]  # fmt: skip
     if isinstance(item, Packed):
         rosidl = frame.kinds[item.ros]
-        if not gz_field.is_repeated or gz_field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
+        if not gz_field.is_repeated or gz_field.type in LENGTH_DELIMITED:
             msg = f"{gz_field.full_name} is not a repeated number"
             raise NotExpressibleError(msg)
         kind = ros_kind(rosidl.value_type)[0]
         _check_number(gz_field, kind)
-        return [W_PACKED, number, gz_field.type, kind, frame.slots[item.ros]]
+        return [WriteOp.PACKED, number, gz_field.type, kind, frame.slots[item.ros]]
     if isinstance(item, Copy):
         rosidl = frame.kinds[item.ros]
         slot = frame.slots[item.ros]
         if type(rosidl).__name__ in cdr.STRING_TYPES:
-            if gz_field.type != _PB_STRING:
+            if gz_field.type != PbType.STRING:
                 msg = f"{gz_field.full_name} is not a string"
                 raise NotExpressibleError(msg)
-            return [W_STR_REP if repeated else W_STR, number, slot]
+            return [WriteOp.STR_REP if repeated else WriteOp.STR, number, slot]
         if repeated or gz_field.is_repeated:
             msg = f"{gz_field.full_name}: one number into a repeated field"
             raise NotExpressibleError(msg)
         kind = ros_kind(rosidl)[0]
         _check_number(gz_field, kind)
         return [
-            W_NUM,
+            WriteOp.NUM,
             number,
             gz_field.type,
             kind,
-            words.CONV_WRAP if item.wrap else words.CONV_EXACT,
+            Conv.WRAP if item.wrap else Conv.EXACT,
             slot,
         ]
     msg = f"{type(item).__name__} into {gz_field.full_name}"
     raise NotExpressibleError(msg)
 
 
-_FLOAT_KINDS = frozenset({words.ROS_KINDS["float"][0], words.ROS_KINDS["double"][0]})
+_FLOAT_KINDS = frozenset({RosKind.FLOAT, RosKind.DOUBLE})
 
 
 def _check_number(gz_field: Any, kind: int) -> None:
     """Only what Python assigns without a conversion of its own: floats into float fields,
     booleans into bool fields, integers into integer fields."""
-    floats = gz_field.type in _PB_FLOATS
-    boolean = kind == words.ROS_KINDS["boolean"][0]
-    if floats != (kind in _FLOAT_KINDS) or (gz_field.type == _PB_BOOL) != boolean:
+    floats = gz_field.type in (PbType.DOUBLE, PbType.FLOAT)
+    boolean = kind == RosKind.BOOLEAN
+    if floats != (kind in _FLOAT_KINDS) or (gz_field.type == PbType.BOOL) != boolean:
         msg = f"{gz_field.full_name} from a ROS number of another sort"
         raise NotExpressibleError(msg)
-    if gz_field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP):
+    if gz_field.type in (*LENGTH_DELIMITED, PbType.GROUP):
         msg = f"{gz_field.full_name} is not a number"
         raise NotExpressibleError(msg)
-
-
-def _clock(out: Node) -> None:
-    """``clock_to_gz``: the clock as the (present) ``sim`` time."""
-    _time(("clock",), ("sim",), out)
-
-
-#: Whole hand-written converters, by module and name (not imported: see program.py).
-_WHOLE: dict[tuple[str, str], Callable[[Node], None]] = {
-    ("ros_gz_bridge_py.converters.rosgraph_msgs", "clock_to_gz"): _clock,
-}
 
 
 def compile_to_gz(pair: Pair) -> bytes:
@@ -336,22 +333,11 @@ def compile_to_gz(pair: Pair) -> bytes:
     Raises:
         NotExpressibleError: the pair stays on the Python path (the reason says why).
     """
-    if pair.bulk is not None:
-        msg = "a bulk pair (it has its own path)"
-        raise NotExpressibleError(msg)
     tree = Node()
-    fill = gz_declaration_of(pair.to_gz)
-    whole = named(pair.to_gz, _WHOLE)
-    if fill is not None:
-        _TO_GZ.assign(fill, (), (), tree)
-    elif whole is not None:
-        whole(tree)
-    else:
-        msg = f"a hand-written converter ({pair.to_gz.__qualname__})"
-        raise NotExpressibleError(msg)
+    _TO_GZ.read(pair, gz_declaration_of(pair.to_gz), tree)
     top = _Frame(_used(tree))
     read = _read_ops(pair.ros_class, (), top, _sequences(tree))
-    read.append(R_END)
+    read.append(ReadOp.END)
     write = _write_ops(tree, message_class(pair.gz_type).DESCRIPTOR, top)
-    write.append(W_END)
+    write.append(WriteOp.END)
     return array("i", [len(top.slots), len(read), *read, *write]).tobytes()

@@ -30,26 +30,19 @@ from ros_gz_bridge_py.converters.std_msgs import (
     HEADER,
 )
 from ros_gz_bridge_py.msgs import message_class
+from ros_gz_bridge_py.native.codes import Conv, Op, PbType, RosKind
 from ros_gz_bridge_py.native.words import (
-    CONV_EXACT,
-    CONV_WRAP,
-    ROS_KINDS,
+    LENGTH_DELIMITED,
     Half,
     NotExpressibleError,
     Path,
     descend,
-    named,
     ros_kind,
     text_words,
     walk,
 )
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
-# Ops (transcode.c).
-OP_END, OP_NUM, OP_CONST, OP_STR, OP_CONST_STR, OP_HEADER_STR = 0, 1, 2, 3, 4, 5
-OP_FIXED_LIST, OP_SEQ_MSG, OP_COLUMN, OP_COLUMN_STR, OP_CLOCK, OP_CONST_BLOCK = 6, 7, 8, 9, 10, 11
-OP_WALL_STAMP = 12
-_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP = 9, 11, 12, 10
 #: Most fields a message of the schema may have (transcode.c keeps one bit per field).
 _MAX_FIELDS = 64
 
@@ -189,7 +182,7 @@ def _each(shape: Each, ros: Path, gz: Path, out: Assignments) -> None:
 
 #: Where each ROS field written by a Fill's ``to_ros`` comes from (later entries win, as they do
 #: when the Python code runs).
-_TO_ROS = Half("to_ros", _LEAVES, _copy, _each)
+_TO_ROS = Half("to_ros", _LEAVES, _copy, _each, _WHOLE)
 
 
 # ---- the schema ------------------------------------------------------------------------------
@@ -225,7 +218,7 @@ class _Schema:
                 raise NotExpressibleError(msg)
             body.append(len(fields))
             for field in fields:
-                if field.type == _PB_GROUP:
+                if field.type == PbType.GROUP:
                     msg = f"group field {descriptor.full_name}.{field.name}"
                     raise NotExpressibleError(msg)
                 sub = self.index[field.message_type.full_name] if field.message_type else -1
@@ -243,7 +236,7 @@ def _bits(code: str, value: Any) -> tuple[int, int]:
 
 
 def _scalar_field(field: Any) -> None:
-    if field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES, _PB_GROUP):
+    if field.is_repeated or field.type in (*LENGTH_DELIMITED, PbType.GROUP):
         msg = f"{field.full_name} is not a plain scalar"
         raise NotExpressibleError(msg)
 
@@ -254,7 +247,7 @@ def _message(
 ) -> list[int]:  # fmt: skip
     fields = cdr.fields_of(msg_class)
     if not fields:
-        return [OP_CONST, ROS_KINDS["uint8"][0], 0, 0]
+        return [Op.CONST, RosKind.UINT8, 0, 0]
     ops: list[int] = []
     for name, slot in fields:
         path = (*prefix, name)
@@ -274,10 +267,10 @@ def _source(slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
     kind = type(slot).__name__
     if isinstance(source, Copy) and kind in cdr.STRING_TYPES:
         steps, field = walk(gz, source.gz)
-        if field.type != _PB_STRING or field.is_repeated:
+        if field.type != PbType.STRING or field.is_repeated:
             msg = f"{field.full_name} is not a string"
             raise NotExpressibleError(msg)
-        return [OP_STR, len(steps), *steps, field.number]
+        return [Op.STR, len(steps), *steps, field.number]
     if isinstance(source, Copy):
         steps, field = walk(gz, source.gz)
         _scalar_field(field)
@@ -285,21 +278,21 @@ def _source(slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
         if code in "fd" and field.cpp_type not in (5, 6):  # CPPTYPE_DOUBLE, CPPTYPE_FLOAT
             msg = f"{field.full_name} is not a floating-point number"
             raise NotExpressibleError(msg)
-        conv = CONV_WRAP if source.wrap else CONV_EXACT
-        return [OP_NUM, len(steps), *steps, field.number, field.type, kind_number, conv]
+        conv = Conv.WRAP if source.wrap else Conv.EXACT
+        return [Op.NUM, len(steps), *steps, field.number, field.type, kind_number, conv]
     if isinstance(source, HeaderText) and kind in cdr.STRING_TYPES:
         steps, _header_type = descend(gz, source.gz)
         return [
-            OP_HEADER_STR, len(steps), *steps, int(source.last),
+            Op.HEADER_STR, len(steps), *steps, int(source.last),
             *text_words(source.key.encode()), *text_words(_plain(default)),
         ]  # fmt: skip
     if isinstance(source, FixedList) and kind == "Array":
         steps, field = walk(gz, source.gz)
-        if not field.is_repeated or field.type in (_PB_STRING, _PB_MESSAGE, _PB_BYTES):
+        if not field.is_repeated or field.type in LENGTH_DELIMITED:
             msg = f"{field.full_name} is not a repeated number"
             raise NotExpressibleError(msg)
         kind_number, _code = ros_kind(slot.value_type)
-        return [OP_FIXED_LIST, len(steps), *steps, field.number, field.type, kind_number,
+        return [Op.FIXED_LIST, len(steps), *steps, field.number, field.type, kind_number,
                 slot.size]  # fmt: skip
     if isinstance(source, Sequence) and kind in cdr.SEQUENCE_TYPES:
         steps, field = walk(gz, source.gz)
@@ -308,8 +301,8 @@ def _source(slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
             msg = f"{field.full_name} is not a repeated message"
             raise NotExpressibleError(msg)
         body = _message(element_class, (), source.element, source.new_ros(), field.message_type)
-        body.append(OP_END)
-        return [OP_SEQ_MSG, len(steps), *steps, field.number, len(body), *body]
+        body.append(Op.END)
+        return [Op.SEQ_MSG, len(steps), *steps, field.number, len(body), *body]
     if isinstance(source, Column) and kind in cdr.SEQUENCE_TYPES:
         steps, field = walk(gz, source.gz)
         if field.message_type is None or not field.is_repeated:
@@ -317,18 +310,18 @@ def _source(slot: Any, source: Source, default: Any, gz: Any) -> list[int]:
             raise NotExpressibleError(msg)
         sub_steps, sub = walk(field.message_type, source.field)
         head = [len(steps), *steps, field.number, len(sub_steps), *sub_steps, sub.number]
-        if type(slot.value_type).__name__ in cdr.STRING_TYPES and sub.type == _PB_STRING:
-            return [OP_COLUMN_STR, *head]
+        if type(slot.value_type).__name__ in cdr.STRING_TYPES and sub.type == PbType.STRING:
+            return [Op.COLUMN_STR, *head]
         _scalar_field(sub)
         kind_number, _code = ros_kind(slot.value_type)
-        return [OP_COLUMN, *head, sub.type, kind_number]
+        return [Op.COLUMN, *head, sub.type, kind_number]
     if isinstance(source, ClockPart) and cdr.basic_of(slot) is not None:
         steps, _time_type = descend(gz, source.gz)
-        return [OP_CLOCK, len(steps), *steps, source.part]
+        return [Op.CLOCK, len(steps), *steps, source.part]
     if isinstance(source, FixedText) and kind in cdr.STRING_TYPES:
-        return [OP_CONST_STR, *text_words(_plain(source.value))]
+        return [Op.CONST_STR, *text_words(_plain(source.value))]
     if isinstance(source, WallStamp) and cdr.basic_of(slot) in ("int32", "uint32"):
-        return [OP_WALL_STAMP] if source.part == 0 else []
+        return [Op.WALL_STAMP] if source.part == 0 else []
     msg = f"{type(source).__name__} into a ROS {kind}"
     raise NotExpressibleError(msg)
 
@@ -338,15 +331,15 @@ def _constant(slot: Any, value: Any) -> list[int]:
     kind = type(slot).__name__
     if cdr.basic_of(slot) is not None:
         kind_number, code = ros_kind(slot)
-        return [OP_CONST, kind_number, *_bits(code, value)]
+        return [Op.CONST, kind_number, *_bits(code, value)]
     if kind in cdr.STRING_TYPES:
-        return [OP_CONST_STR, *text_words(_plain(value))]
+        return [Op.CONST_STR, *text_words(_plain(value))]
     if kind == "Array" and cdr.basic_of(slot.value_type) is not None:
         _kind_number, code = ros_kind(slot.value_type)
         data = struct.pack(f"<{slot.size}{code}", *value)
-        return [OP_CONST_BLOCK, struct.calcsize(code), *text_words(data)]
+        return [Op.CONST_BLOCK, struct.calcsize(code), *text_words(data)]
     if kind in cdr.SEQUENCE_TYPES and len(value) == 0:
-        return [OP_CONST, ROS_KINDS["uint32"][0], 0, 0]
+        return [Op.CONST, RosKind.UINT32, 0, 0]
     msg = f"a default {kind} the program cannot write"
     raise NotExpressibleError(msg)
 
@@ -377,21 +370,10 @@ def compile_to_ros(pair: Pair, *, frame_id: str = "", wall_stamp: bool = False) 
     Raises:
         NotExpressibleError: the pair stays on the Python path (the reason says why).
     """
-    if pair.bulk is not None:
-        msg = "a bulk pair (it has its own path)"
-        raise NotExpressibleError(msg)
     declared = declaration_of(pair.to_ros)
     given: Assignments = {}
-    if declared is not None:
-        fill, new_ros = declared
-        _TO_ROS.assign(fill, (), (), given)
-        default = new_ros()
-    elif (whole := named(pair.to_ros, _WHOLE)) is not None:
-        whole(given)
-        default = pair.ros_class()
-    else:
-        msg = f"a hand-written converter ({pair.to_ros.__qualname__})"
-        raise NotExpressibleError(msg)
+    _TO_ROS.read(pair, declared[0] if declared else None, given)
+    default = declared[1]() if declared else pair.ros_class()
     if pair.ros_class.get_fields_and_field_types().get("header") == "std_msgs/Header":
         if frame_id:
             given[("header", "frame_id")] = FixedText(frame_id)
@@ -401,5 +383,5 @@ def compile_to_ros(pair: Pair, *, frame_id: str = "", wall_stamp: bool = False) 
     root = message_class(pair.gz_type).DESCRIPTOR
     schema = _Schema(root)
     ops = _message(pair.ros_class, (), given, default, root)
-    ops.append(OP_END)
+    ops.append(Op.END)
     return Compiled(array("i", schema.words()).tobytes(), array("i", ops).tobytes())

@@ -49,7 +49,7 @@ static int put_value(struct rgb_out *out, int32_t kind, int32_t conv, struct rgb
     }
     if (val.is_float) return RGB_FALLBACK;
     uint64_t bits = val.is_unsigned ? val.u : (uint64_t)val.i;
-    if (kind == ROS_BOOL) return rgb_put_le(out, val.i != 0, 1);
+    if (kind == ROS_BOOLEAN) return rgb_put_le(out, val.i != 0, 1);
     struct rgb_ros_type type = rgb_ros_type(kind);
     if (conv == CONV_EXACT && !rgb_in_range(val, type.min, type.max)) return RGB_FALLBACK;
     return rgb_put_le(out, bits, size);

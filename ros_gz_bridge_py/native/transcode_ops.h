@@ -1,30 +1,12 @@
-/* What the transcoder's files share (private: transcode.h is its interface): the ops of a
- * program (docs/native.md §3), the structures a call works with, and the reading of protobuf
- * wire data. pb_read.c reads and indexes a payload, transcode.c runs a program on it and
- * writes the CDR message, transcode_load.c checks a program's words once. */
+/* What the transcoder's files share (private: transcode.h is its interface): the structures a
+ * call works with and the reading of protobuf wire data (the ops of a program, docs/native.md
+ * §3, are numbered in codes.h). pb_read.c reads and indexes a payload, transcode.c runs a
+ * program on it and writes the CDR message, transcode_load.c checks a program's words once. */
 #ifndef RGB_TRANSCODE_OPS_H
 #define RGB_TRANSCODE_OPS_H
 
 #include "transcode.h"
 #include "wire.h"
-
-/* Ops of a program (docs/native.md §3). */
-enum {
-    OP_END = 0,
-    OP_NUM = 1,
-    OP_CONST = 2,
-    OP_STR = 3,
-    OP_CONST_STR = 4,
-    OP_HEADER_STR = 5,
-    OP_FIXED_LIST = 6,
-    OP_SEQ_MSG = 7,
-    OP_COLUMN = 8,
-    OP_COLUMN_STR = 9,
-    OP_CLOCK = 10,
-    OP_CONST_BLOCK = 11,
-    OP_WALL_STAMP = 12,
-    OP_COUNT
-};
 
 /* Deepest nesting validated natively; deeper payloads are left to Python. */
 #define MAX_DEPTH 64

@@ -1,6 +1,7 @@
 /* What the two native transcoders share (transcode.c, encode.c; docs/native.md): the numbers
- * the Python compilers write for protobuf field types and ROS basic types, and the helpers of
- * both wire formats. Header-only: the extension and the fuzz targets compile it into each. */
+ * the Python compilers write (codes.h, written from codes.py at build time: ops, protobuf field
+ * types, ROS basic types, conversions), and the helpers of both wire formats. Header-only: the
+ * extension and the fuzz targets compile it into each. */
 #ifndef RGB_WIRE_H
 #define RGB_WIRE_H
 
@@ -8,47 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "codes.h"
 #include "transcode.h"
 
-/* Protobuf field types (google.protobuf.FieldDescriptor.TYPE_*). */
-enum {
-    PB_DOUBLE = 1,
-    PB_FLOAT = 2,
-    PB_INT64 = 3,
-    PB_UINT64 = 4,
-    PB_INT32 = 5,
-    PB_FIXED64 = 6,
-    PB_FIXED32 = 7,
-    PB_BOOL = 8,
-    PB_STRING = 9,
-    PB_GROUP = 10,
-    PB_MESSAGE = 11,
-    PB_BYTES = 12,
-    PB_UINT32 = 13,
-    PB_ENUM = 14,
-    PB_SFIXED32 = 15,
-    PB_SFIXED64 = 16,
-    PB_SINT32 = 17,
-    PB_SINT64 = 18,
-};
-
-/* ROS basic types as the programs name them (program.py ROS_KINDS). */
-enum {
-    ROS_BOOL = 1,
-    ROS_UINT8 = 2,
-    ROS_INT8 = 3,
-    ROS_INT16 = 4,
-    ROS_UINT16 = 5,
-    ROS_INT32 = 6,
-    ROS_UINT32 = 7,
-    ROS_INT64 = 8,
-    ROS_UINT64 = 9,
-    ROS_FLOAT = 10,
-    ROS_DOUBLE = 11,
-};
-
-/* How a number changes type: exactly (out of range: Python decides), or narrowed as C++. */
-enum { CONV_EXACT = 0, CONV_WRAP = 1 };
 /* Protobuf wire types. */
 enum { WIRE_VARINT = 0, WIRE_I64 = 1, WIRE_LEN = 2, WIRE_SGROUP = 3, WIRE_EGROUP = 4, WIRE_I32 = 5 };
 
@@ -101,7 +64,7 @@ struct rgb_ros_type {
 
 static inline struct rgb_ros_type rgb_ros_type(int32_t kind) {
     static const struct rgb_ros_type types[ROS_DOUBLE + 1] = {
-        [ROS_BOOL] = {1, 0, 1},
+        [ROS_BOOLEAN] = {1, 0, 1},
         [ROS_UINT8] = {1, 0, UINT8_MAX},
         [ROS_INT8] = {1, INT8_MIN, INT8_MAX},
         [ROS_INT16] = {2, INT16_MIN, INT16_MAX},
@@ -114,7 +77,7 @@ static inline struct rgb_ros_type rgb_ros_type(int32_t kind) {
         [ROS_DOUBLE] = {8, 0, 0},
     };
     struct rgb_ros_type none = {0, 0, 0};
-    return kind >= ROS_BOOL && kind <= ROS_DOUBLE ? types[kind] : none;
+    return kind >= ROS_BOOLEAN && kind <= ROS_DOUBLE ? types[kind] : none;
 }
 
 /* The wire size of a ROS basic type (0: not one). */
@@ -288,7 +251,7 @@ static inline int rgb_operands(const int32_t *ops, size_t n, size_t *at, const c
         case 'w': ok = 1; break;
         case 'f': ok = w > 0; break;
         case 'F': ok = w >= 1 && w <= (1 << 29) - 1; break;
-        case 'k': ok = w >= ROS_BOOL && w <= ROS_DOUBLE; break;
+        case 'k': ok = w >= ROS_BOOLEAN && w <= ROS_DOUBLE; break;
         case 's': /* not a string, group, message or bytes */
             ok = (w >= PB_DOUBLE && w <= PB_BOOL) || (w >= PB_UINT32 && w <= PB_SINT64);
             break;

@@ -1,8 +1,8 @@
 """What the two compilers of native programs share (``program.py``: Gazebo -> ROS,
 ``encoder.py``: ROS -> Gazebo): the error that keeps a pair on the Python path, paths of field
-names, the numbers of ROS basic types and of narrowing, the walk of a declaration's Fills and
-the Value functions a program expresses in it, text as words, and the protobuf fields and ROS
-slots they read.
+names, the ROS basic types by name (their numbers, as all of the programs' numbers, are
+``codes.py``'s), the walk of a declaration's Fills and the Value functions a program expresses
+in it, text as words, and the protobuf fields and ROS slots they read.
 """
 
 from __future__ import annotations
@@ -11,28 +11,32 @@ import sys
 from array import array
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from ros_gz_bridge_py.converters._fields import Each, Fill, Table, same
 from ros_gz_bridge_py.converters.builtin_interfaces import to_int32, to_uint32
+from ros_gz_bridge_py.native.codes import PbType, RosKind
 from ros_gz_bridge_py.ros import cdr_types as cdr
 
-#: How a number changes type: exactly (out of range: Python decides), or narrowed as C++ (wire.h).
-CONV_EXACT, CONV_WRAP = 0, 1
+if TYPE_CHECKING:
+    from ros_gz_bridge_py.converters.registry import Pair
+
+#: Protobuf field types whose values are bytes (length-delimited), not numbers.
+LENGTH_DELIMITED = frozenset({PbType.STRING, PbType.MESSAGE, PbType.BYTES})
 #: ROS basic types as the program numbers them, with their struct codes.
-ROS_KINDS: dict[str, tuple[int, str]] = {
-    "boolean": (1, "?"),
-    "uint8": (2, "B"),
-    "octet": (2, "B"),
-    "int8": (3, "b"),
-    "int16": (4, "h"),
-    "uint16": (5, "H"),
-    "int32": (6, "i"),
-    "uint32": (7, "I"),
-    "int64": (8, "q"),
-    "uint64": (9, "Q"),
-    "float": (10, "f"),
-    "double": (11, "d"),
+ROS_KINDS: dict[str, tuple[RosKind, str]] = {
+    "boolean": (RosKind.BOOLEAN, "?"),
+    "uint8": (RosKind.UINT8, "B"),
+    "octet": (RosKind.UINT8, "B"),
+    "int8": (RosKind.INT8, "b"),
+    "int16": (RosKind.INT16, "h"),
+    "uint16": (RosKind.UINT16, "H"),
+    "int32": (RosKind.INT32, "i"),
+    "uint32": (RosKind.UINT32, "I"),
+    "int64": (RosKind.INT64, "q"),
+    "uint64": (RosKind.UINT64, "Q"),
+    "float": (RosKind.FLOAT, "f"),
+    "double": (RosKind.DOUBLE, "d"),
 }
 
 
@@ -59,12 +63,14 @@ class Half(Generic[_T]):
     """How a compiler reads one half (``to_ros`` or ``to_gz``) of the declarations into its
     ``_T``: ``leaves``, the hand-written Fills the tables build on; ``copy(ros, gz, wrap, out)``
     for a field copied (``wrap``: narrowed as C++ does); ``each(shape, ros, gz, out)`` for a
-    sequence filled element by element."""
+    sequence filled element by element; ``whole``, whole hand-written converters by module and
+    name (:func:`named`)."""
 
     name: str
     leaves: Mapping[Callable[[Any, Any], None], Callable[[Path, Path, _T], None]]
     copy: Callable[[Path, Path, bool, _T], None]
     each: Callable[[Each, Path, Path, _T], None]
+    whole: Mapping[tuple[str, str], Callable[[_T], None]]
 
     def assign(self, fill: Fill, ros: Path, gz: Path, out: _T) -> None:
         """What ``fill``'s half writes (from ``gz`` to ``ros`` or back), into ``out``; raises
@@ -88,6 +94,22 @@ class Half(Generic[_T]):
             self.each(fill.shape, ros, gz, out)
         else:
             msg = f"a Fill of hand-written functions ({function.__qualname__})"
+            raise NotExpressibleError(msg)
+
+    def read(self, pair: Pair, fill: Fill | None, out: _T) -> None:
+        """What ``pair``'s converter of this half writes, into ``out``: its declaration
+        ``fill``, or else a whole hand-written converter; raises NotExpressibleError for a bulk
+        pair or other hand-written code."""
+        function = getattr(pair, self.name)
+        if pair.bulk is not None:
+            msg = "a bulk pair (it has its own path)"
+            raise NotExpressibleError(msg)
+        if fill is not None:
+            self.assign(fill, (), (), out)
+        elif (converter := named(function, self.whole)) is not None:
+            converter(out)
+        else:
+            msg = f"a hand-written converter ({function.__qualname__})"
             raise NotExpressibleError(msg)
 
 
@@ -116,32 +138,27 @@ def gz_field(descriptor: Any, name: str) -> Any:
     return field
 
 
-def walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
-    """The field numbers of the submessages on ``path`` (all but the last name), and the
-    descriptor of the field the last name names."""
+def descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path``, and the message it reaches."""
     steps = []
-    for name in path[:-1]:
+    for name in path:
         field = gz_field(descriptor, name)
         if field.message_type is None or field.is_repeated:
             msg = f"{descriptor.full_name}.{name} is not a singular submessage"
             raise NotExpressibleError(msg)
         steps.append(field.number)
         descriptor = field.message_type
-    return steps, gz_field(descriptor, path[-1])
+    return steps, descriptor
 
 
-def descend(descriptor: Any, path: Path) -> tuple[list[int], Any]:
-    """The field numbers of the submessages on ``path``, and the message it reaches."""
-    if not path:
-        return [], descriptor
-    steps, field = walk(descriptor, path)
-    if field.message_type is None or field.is_repeated:
-        msg = f"{descriptor.full_name}.{'.'.join(path)} is not a singular submessage"
-        raise NotExpressibleError(msg)
-    return [*steps, field.number], field.message_type
+def walk(descriptor: Any, path: Path) -> tuple[list[int], Any]:
+    """The field numbers of the submessages on ``path`` (all but the last name), and the
+    descriptor of the field the last name names."""
+    steps, parent = descend(descriptor, path[:-1])
+    return steps, gz_field(parent, path[-1])
 
 
-def ros_kind(slot: Any) -> tuple[int, str]:
+def ros_kind(slot: Any) -> tuple[RosKind, str]:
     """The program's number and the struct code of a ROS basic type."""
     basic = cdr.basic_of(slot)
     if basic not in ROS_KINDS:

@@ -4,7 +4,8 @@ then with MemorySanitizer.
 Two targets: fuzz/transcode_fuzz.c links the transcoder (transcode.c, pb_read.c,
 transcode_load.c: Gazebo -> ROS) with every compiled pair's program, fuzz/encode_fuzz.c links
 the encoder (encode.c, encode_write.c, encode_load.c: ROS -> Gazebo) with every compiled pair's
-encoder, each from a header generated here (tools/native_fuzz_programs.py). Each is built with
+encoder, each from a header generated here (tools/native_fuzz_programs.py, which writes
+codes.h beside it). Each is built with
 clang-14 into ``.build/fuzz/<target>-<sanitizer>-<hash>/``, once per hash of its sources,
 header and flags; the builds share ``FUZZ_SECONDS`` (60 by default; ``make fuzz`` and
 ``make soak`` run it longer). Each target's corpus is kept in ``.build/fuzz/`` between runs
@@ -67,13 +68,13 @@ TARGETS = {
     "transcode": Target(
         "transcode_fuzz.c",
         ("transcode.c", "pb_read.c", "transcode_load.c", "transcode.h", "transcode_ops.h",
-         "wire.h"),
+         "wire.h", "codes.py"),
         "programs.h", "corpus", "artifacts", 1 / 2,
     ),
     "encode": Target(
         "encode_fuzz.c",
         ("encode.c", "encode_write.c", "encode_load.c", "encode.h", "encode_ops.h",
-         "transcode.h", "wire.h"),
+         "transcode.h", "wire.h", "codes.py"),
         "encoders.h", "encode-corpus", "encode-artifacts", 1 / 2,
     ),
 }  # fmt: skip

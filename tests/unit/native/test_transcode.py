@@ -29,7 +29,8 @@ from ros_gz_bridge_py import native
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native.program import OP_CONST_STR, OP_END, OP_HEADER_STR, Compiled
+from ros_gz_bridge_py.native.codes import Op
+from ros_gz_bridge_py.native.program import Compiled
 from ros_gz_bridge_py.ros.cdr_writer import writer_for
 from tests.unit.native import gz_payloads as gzp
 from tools.native_fuzz_programs import compiled_pairs, distinctive
@@ -261,7 +262,7 @@ def test_text_lengths_near_the_int32_limit_are_refused() -> None:
     """The words a text takes are counted without overflow (found by fuzz/transcode_fuzz.c)."""
     schema = PAIRS[0][1].schema
     for length in (2**31 - 1, 2**31 - 3, 2**31 - 4, -1):
-        ops = array.array("i", [OP_CONST_STR, length, OP_END])
+        ops = array.array("i", [Op.CONST_STR, length, Op.END])
         with pytest.raises(ValueError, match="not a native program"):
             _native.Program(schema, ops.tobytes())
 
@@ -300,9 +301,9 @@ def test_a_header_lookup_that_reaches_a_number_falls_back() -> None:
     compiled = next(c for p, c in PAIRS if p.gz_type == "gz.msgs.Header")
     key = b"frame_id"
     # path [stamp], last entry, the key's length and bytes, an empty default, the end
-    ops = array.array("i", [OP_HEADER_STR, 1, 1, 1, len(key)])
+    ops = array.array("i", [Op.HEADER_STR, 1, 1, 1, len(key)])
     ops.frombytes(key)
-    ops.extend([0, OP_END])
+    ops.extend([0, Op.END])
     program = _native.Program(compiled.schema, ops.tobytes())
     stamp = gzp.length_delimited(1, gzp.tag(2, gzp.VARINT) + gzp.varint(5))
     assert program.to_cdr(stamp) == (FALLBACK, None)
