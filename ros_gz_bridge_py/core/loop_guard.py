@@ -45,21 +45,33 @@ def _ends(cdr: bytes | bytearray | memoryview) -> tuple[int, bytes, bytes]:
     return len(cdr), bytes(cdr[:_ENDS]), bytes(cdr[-_ENDS:])
 
 
+def _as_cdr(message: Any) -> Any:
+    """``message`` as CDR bytes: as it is if it is, else serialized."""
+    if isinstance(message, (bytes, bytearray, memoryview)):
+        return message
+    return serialize_message(message)
+
+
 def _as_ends(content: Any) -> tuple[int, bytes, bytes]:
     """``content`` (kept or received: an object, CDR bytes or their ends) as CDR ends.
     Compared as CDR, not as objects: a NaN field makes a message unequal to itself."""
     if isinstance(content, tuple):
         return content
-    if not isinstance(content, (bytes, bytearray, memoryview)):
-        content = serialize_message(content)
-    return _ends(content)
+    return _ends(_as_cdr(content))
 
 
 class NumberedPublisher(Protocol):
     """A publisher that numbers and times its publications itself (a native channel's pump,
     ``native/pump.py``, whose C loop publishes without Python)."""
 
-    def is_own(self, sequence: int, stamp: int) -> bool: ...
+    def is_own(self, sequence: int, stamp: int, received: bytes | None, /) -> bool:
+        """Whether we wrote sample ``sequence`` stamped ``stamp``; ``received``, its CDR
+        where known, must then be what we published."""
+        ...
+
+    def guard(self) -> None:
+        """Keep what each publication was from now on."""
+        ...
 
 
 class OwnPublications:
@@ -100,12 +112,19 @@ class OwnPublications:
     def guard(self) -> None:
         """A subscription of the bridge judges samples of this topic from now on: keep what
         each publication was (only then: it costs a little on every publish)."""
-        self._guarded = True
+        with self._lock:
+            self._guarded = True
+            numbered = list(self._numbered)
+        for publisher in numbered:
+            publisher.guard()
 
     def add_numbered(self, publisher: NumberedPublisher) -> None:
         """Also ask ``publisher`` whether a sample is ours (until :meth:`remove_numbered`)."""
         with self._lock:
             self._numbered.append(publisher)
+            guarded = self._guarded
+        if guarded:
+            publisher.guard()
 
     def remove_numbered(self, publisher: NumberedPublisher) -> None:
         with self._lock:
@@ -170,4 +189,7 @@ class OwnPublications:
             or any(kept is None or _as_ends(kept) == _as_ends(received) for kept in matched)
         ):
             return True
-        return any(publisher.is_own(sequence, stamp) for publisher in numbered)
+        if not numbered:
+            return False
+        cdr = None if received is None else _as_cdr(received)
+        return any(publisher.is_own(sequence, stamp, cdr) for publisher in numbered)

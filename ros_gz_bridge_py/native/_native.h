@@ -155,6 +155,7 @@ struct handed {
 struct window {
     uint64_t sequence;
     int64_t start, end;
+    uint64_t digest; /* rgb_cdr_digest of what was published; 0: not known */
 };
 
 typedef struct {
@@ -194,15 +195,17 @@ typedef struct {
     size_t drop_sender_len;
     pthread_mutex_t lock; /* the windows and the sequence (read by is_own from any thread) */
     uint64_t sequence;
+    int guarded; /* (atomic) a subscription of the bridge reads the topic: keep digests */
     struct window windows[PUMP_HISTORY];
 } PumpObject;
 
 extern const struct rgb_hooks rgb_pump_hooks;
 int pump_find_route(PumpObject *self, const uint8_t *sender, size_t sender_len,
                     const uint8_t *type, size_t type_len);
-/* Publication windows (the loop guard, core/loop_guard.py). */
-uint64_t pump_begin_publication(PumpObject *self);
-void pump_end_publication(PumpObject *self, uint64_t sequence, int ok);
+/* Publication windows (the loop guard, core/loop_guard.py); a digest of 0 is not known. */
+uint64_t rgb_cdr_digest(const uint8_t *cdr, size_t len);
+uint64_t pump_begin_publication(PumpObject *self, uint64_t digest);
+void pump_end_publication(PumpObject *self, uint64_t sequence, int ok, uint64_t digest);
 void pump_clear_ring(PumpObject *self);
 void pump_clear_handover(PumpObject *self);
 

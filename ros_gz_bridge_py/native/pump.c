@@ -348,26 +348,50 @@ static PyObject *pump_dropped_sender(PumpObject *self, void *closure) {
 
 static PyObject *pump_begin_publication_method(PumpObject *self, PyObject *unused) {
     (void)unused;
-    return PyLong_FromUnsignedLongLong(pump_begin_publication(self));
+    return PyLong_FromUnsignedLongLong(pump_begin_publication(self, 0));
+}
+
+/* The digest of `cdr` (a bytes-like object; None: 0, not known) into *digest. */
+static int digest_of(PyObject *cdr, uint64_t *digest) {
+    *digest = 0;
+    if (cdr == Py_None) return 0;
+    Py_buffer view;
+    if (PyObject_GetBuffer(cdr, &view, PyBUF_SIMPLE) < 0) return -1;
+    *digest = rgb_cdr_digest(view.buf, (size_t)view.len);
+    PyBuffer_Release(&view);
+    return 0;
 }
 
 static PyObject *pump_end_publication_method(PumpObject *self, PyObject *args) {
     unsigned long long sequence;
     int ok;
-    if (!PyArg_ParseTuple(args, "Kp", &sequence, &ok)) return NULL;
-    pump_end_publication(self, sequence, ok);
+    PyObject *written = Py_None;
+    uint64_t digest;
+    if (!PyArg_ParseTuple(args, "Kp|O", &sequence, &ok, &written)) return NULL;
+    if (digest_of(written, &digest) < 0) return NULL;
+    pump_end_publication(self, sequence, ok, digest);
     Py_RETURN_NONE;
 }
 
 static PyObject *pump_is_own(PumpObject *self, PyObject *args) {
     unsigned long long sequence;
     long long stamp;
-    if (!PyArg_ParseTuple(args, "KL", &sequence, &stamp)) return NULL;
+    PyObject *received = Py_None;
+    uint64_t digest;
+    if (!PyArg_ParseTuple(args, "KL|O", &sequence, &stamp, &received)) return NULL;
+    if (digest_of(received, &digest) < 0) return NULL;
     pthread_mutex_lock(&self->lock);
     struct window *w = &self->windows[sequence % PUMP_HISTORY];
-    int own = sequence != 0 && w->sequence == sequence && w->start <= stamp && stamp <= w->end;
+    int own = sequence != 0 && w->sequence == sequence && w->start <= stamp && stamp <= w->end &&
+              (!digest || !w->digest || digest == w->digest);
     pthread_mutex_unlock(&self->lock);
     return PyBool_FromLong(own);
+}
+
+static PyObject *pump_guard(PumpObject *self, PyObject *unused) {
+    (void)unused;
+    __atomic_store_n(&self->guarded, 1, __ATOMIC_RELAXED);
+    Py_RETURN_NONE;
 }
 
 static PyMethodDef pump_methods[] = {
@@ -385,9 +409,12 @@ static PyMethodDef pump_methods[] = {
     {"begin_publication", (PyCFunction)pump_begin_publication_method, METH_NOARGS,
      "a publication made from Python on the same publisher: its sequence number"},
     {"end_publication", (PyCFunction)pump_end_publication_method, METH_VARARGS,
-     "end_publication(sequence, ok)"},
+     "end_publication(sequence, ok, written=None): written, the CDR bytes published if known"},
     {"is_own", (PyCFunction)pump_is_own, METH_VARARGS,
-     "is_own(sequence, source_timestamp_ns) -> bool: a sample this publisher wrote"},
+     "is_own(sequence, source_timestamp_ns, received=None) -> bool: a sample this publisher "
+     "wrote (received, its CDR bytes if known, must be what was published)"},
+    {"guard", (PyCFunction)pump_guard, METH_NOARGS,
+     "guard(): keep a digest of each publication from now on (the loop guard judges the topic)"},
     {NULL, NULL, 0, NULL},
 };
 

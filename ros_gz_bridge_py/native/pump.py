@@ -180,21 +180,26 @@ class ChannelPump(PumpMember):
 
     # --- the loop guard -----------------------------------------------------------------------
 
-    def wrap(self, publish: Callable[[Any], None]) -> Callable[[Any], None]:
+    def wrap(self, publish: Callable[[Any], Any]) -> Callable[[Any], None]:
         """``publish`` (the channel's Python path on the same publisher) numbered in the same
-        sequence as the pump's own publications."""
+        sequence as the pump's own publications; the CDR it wrote (what it returns, or the
+        message if it is CDR) is the publication's digest."""
         pump = self.pump
 
         def publish_and_record(msg: Any) -> None:
             sequence = pump.begin_publication()
             try:
-                publish(msg)
+                written = publish(msg)
             except BaseException:
                 pump.end_publication(sequence, False)
                 raise
-            pump.end_publication(sequence, True)
+            cdr = msg if isinstance(msg, (bytes, bytearray, memoryview)) else written
+            pump.end_publication(sequence, True, cdr)
 
         return publish_and_record
 
-    def is_own(self, sequence: int, stamp: int) -> bool:
-        return self.pump.is_own(sequence, stamp)
+    def is_own(self, sequence: int, stamp: int, received: bytes | None = None) -> bool:
+        return self.pump.is_own(sequence, stamp, received)
+
+    def guard(self) -> None:
+        self.pump.guard()

@@ -218,3 +218,35 @@ def test_a_guarded_sample_seen_before_publish_returns_is_judged_by_content() -> 
 
     own.wrap(SeenDuringPublish())(String(data="a"))
     assert seen == [(True, False)]
+
+
+class Numbered:
+    """A publisher that numbers its publications itself, as a native pump does: it records
+    what it is asked and answers that sample 1 is its own when it holds ``b"ours"``."""
+
+    def __init__(self) -> None:
+        self.guarded = False
+        self.asked: list[Any] = []
+
+    def is_own(self, sequence: int, stamp: int, received: bytes | None, /) -> bool:
+        self.asked.append(received)
+        return sequence == 1 and (received is None or b"ours" in bytes(received))
+
+    def guard(self) -> None:
+        self.guarded = True
+
+
+def test_a_numbered_publisher_is_guarded_and_given_the_sample_as_cdr() -> None:
+    own = OwnPublications()
+    before, after = Numbered(), Numbered()
+    own.add_numbered(before)
+    own.guard()
+    own.add_numbered(after)
+    assert before.guarded
+    assert after.guarded
+    sample = {"publication_sequence_number": 1, "source_timestamp": time.time_ns()}
+    assert own.is_own(sample, String(data="ours"))
+    assert not own.is_own(sample, String(data="theirs"))
+    assert before.asked[-1] == serialize_message(String(data="theirs"))
+    assert own.is_own(sample)
+    assert before.asked[-1] is None

@@ -1,0 +1,77 @@
+"""A native Gazebo -> ROS pump's publication windows (the loop guard, core/loop_guard.py): once
+the topic is guarded, a sample with the pump's sequence number, written during the pump's call,
+is the pump's only if its CDR is what the pump published. Real ZeroMQ sockets, a real rclpy
+publisher the C loop publishes on and a real subscription that takes the sample and its info.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from rclpy.node import Node
+from rclpy.serialization import serialize_message
+from std_msgs.msg import String
+
+from tests.unit.native.pump_rig import LEGIT, PAYLOAD, Rig
+
+
+def _take(subscription: Any, data: bytes, timeout: float = 10.0) -> tuple[bytes, dict[str, Any]]:
+    """The first CDR sample holding ``data``, with its message info."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        taken = subscription.handle.take_message(String, True)
+        if taken is not None and data in taken[0]:
+            return taken[0], taken[1]
+        if taken is None:
+            time.sleep(0.01)
+    msg = f"no sample holding {data!r} within {timeout} s"
+    raise AssertionError(msg)
+
+
+def test_a_guarded_pump_knows_its_sample_by_content(
+    native: Any, publisher: Any, ros_context: Any
+) -> None:
+    node = Node("pump_own_reader", context=ros_context)
+    subscription = node.create_subscription(
+        String, publisher.topic_name, lambda _msg: None, 100, raw=True
+    )
+    rig = Rig(native, publisher, capacity=100, max_bytes=1 << 20)
+    try:
+        deadline = time.monotonic() + 10
+        while publisher.get_subscription_count() == 0 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        rig.connected()
+        rig.settle()
+        rig.pump.guard()
+        rig.send(LEGIT, PAYLOAD)
+        rig.settle()
+        cdr, info = _take(subscription, b"pumped")
+        sequence, stamp = info["publication_sequence_number"], info["source_timestamp"]
+        assert rig.pump.is_own(sequence, stamp, cdr)
+        assert rig.pump.is_own(sequence, stamp)  # no content to judge: number and time
+        other = serialize_message(String(data="pumpee"))  # same length, another writer's
+        assert len(other) == len(cdr)
+        assert not rig.pump.is_own(sequence, stamp, other)
+        assert not rig.pump.is_own(sequence, stamp - 10**9, cdr)
+    finally:
+        rig.close()
+        node.destroy_node()
+
+
+def test_a_python_publication_keeps_the_cdr_it_wrote(native: Any, publisher: Any) -> None:
+    rig = Rig(native, publisher, capacity=100, max_bytes=1 << 20)
+    try:
+        ours, theirs = (serialize_message(String(data=text)) for text in ("ours", "them"))
+        unknown = rig.pump.begin_publication()
+        during_unknown = time.time_ns()
+        rig.pump.end_publication(unknown, True)
+        known = rig.pump.begin_publication()
+        during_known = time.time_ns()
+        rig.pump.end_publication(known, True, ours)
+        assert rig.pump.is_own(unknown, during_unknown, theirs)  # nothing kept to tell
+        assert rig.pump.is_own(known, during_known, ours)
+        assert not rig.pump.is_own(known, during_known, theirs)
+        assert not rig.pump.is_own(known, during_known, b"")
+    finally:
+        rig.close()
