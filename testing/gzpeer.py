@@ -315,7 +315,7 @@ class Inbox:
         with the last messages received (which one is missing tells a loss from a delay)."""
         if not self.holds_within(condition, timeout):
             items = self.items()
-            last = ", ".join(repr(message)[:80] for message, _ in items[-12:])
+            last = ", ".join(" ".join(repr(message).split())[:80] for message, _ in items[-12:])
             pytest.fail(
                 f"timed out after {timeout} s waiting for {what}; {len(items)} received"
                 + (f", the last: {last}" if items else "")

@@ -39,10 +39,18 @@ _ENDS = 256
 
 
 def _ends(cdr: bytes | bytearray | memoryview) -> tuple[int, bytes, bytes]:
-    """A CDR message's length and ends: the whole of a small message; of a large one the header
-    (stamp, frame) and the last bytes, which a different message practically never shares with
-    ours at the same sequence number and time."""
-    return len(cdr), bytes(cdr[:_ENDS]), bytes(cdr[-_ENDS:])
+    """A CDR message's body length and ends: the whole of a small message; of a large one the
+    header (stamp, frame) and the last bytes, which a different message practically never
+    shares with ours at the same sequence number and time.
+
+    The body is what follows the 4-byte encapsulation header, less the padding a middleware
+    may add on the way to a multiple of 4 bytes: the count XTypes puts in the options' last
+    two bits (CycloneDDS), then trailing zero bytes (Fast DDS before 2.1 padded with zeros
+    and said nothing). Our own sample must compare equal whatever the middleware did to it.
+    """
+    body = bytes(cdr[4 : max(4, len(cdr) - (cdr[3] & 3))]) if len(cdr) >= 4 else bytes(cdr)
+    body = body.rstrip(b"\0")
+    return len(body), body[:_ENDS], body[-_ENDS:]
 
 
 def _as_cdr(message: Any) -> Any:

@@ -22,9 +22,12 @@ enum { ZMQ_POLLIN_ = 1, ZMQ_DONTWAIT_ = 1, ZMQ_FD_ = 14, ZMQ_EVENTS_ = 15 };
 
 /* ---- publication windows (the loop guard, core/loop_guard.py) ----------------------------- */
 
-/* FNV-1a over a CDR message's length and its first and last DIGEST_ENDS bytes (the whole of a
- * small message; a large one's header and end): another writer's sample with our sequence
- * number, written during our publish call, is told from ours by it. Never 0 (not known). */
+/* FNV-1a over a CDR message's body length and the body's first and last DIGEST_ENDS bytes (the
+ * whole of a small message; a large one's header and end): another writer's sample with our
+ * sequence number, written during our publish call, is told from ours by it. Never 0 (not
+ * known). The body is what follows the 4-byte encapsulation header, less a middleware's
+ * padding to a multiple of 4: the count in the options' last two bits (XTypes; CycloneDDS),
+ * then trailing zero bytes (older Fast DDS), as core/loop_guard.py's _ends takes it. */
 enum { DIGEST_ENDS = 256 };
 
 static uint64_t fnv1a(uint64_t hash, const uint8_t *data, size_t len) {
@@ -33,6 +36,12 @@ static uint64_t fnv1a(uint64_t hash, const uint8_t *data, size_t len) {
 }
 
 uint64_t rgb_cdr_digest(const uint8_t *cdr, size_t len) {
+    if (len >= 4) {
+        size_t pad = cdr[3] & 3u;
+        len = len - 4 > pad ? len - 4 - pad : 0;
+        cdr += 4;
+    }
+    while (len && cdr[len - 1] == 0) len--;
     uint8_t length[8];
     for (int i = 0; i < 8; i++) length[i] = (uint8_t)((uint64_t)len >> (8 * i));
     size_t ends = len < DIGEST_ENDS ? len : DIGEST_ENDS;

@@ -172,12 +172,14 @@ def test_published_cdr_is_compared_as_cdr() -> None:
     own = OwnPublications()
     own.guard()
     ours = StampingPublisher()
-    frame = b"\x00\x01\x00\x00" + b"stamp 1 " + bytes(100_000)
+    pixels = bytes(range(1, 256)) * 400
+    frame = b"\x00\x01\x00\x00" + b"stamp 1 " + pixels
     own.wrap(ours)(frame)
     (sample,) = ours.samples
     assert own.is_own(sample, frame)
-    assert not own.is_own(sample, b"\x00\x01\x00\x00" + b"stamp 2 " + bytes(100_000))
-    assert not own.is_own(sample, frame + b"\x00")
+    assert not own.is_own(sample, b"\x00\x01\x00\x00" + b"stamp 2 " + pixels)
+    assert not own.is_own(sample, frame + b"\x07")
+    assert not own.is_own(sample, frame[:-1])
 
 
 def test_a_nan_field_does_not_make_our_sample_foreign() -> None:
@@ -250,3 +252,29 @@ def test_a_numbered_publisher_is_guarded_and_given_the_sample_as_cdr() -> None:
     assert before.asked[-1] == serialize_message(String(data="theirs"))
     assert own.is_own(sample)
     assert before.asked[-1] is None
+
+
+def _padded(cdr: bytes, *, declared: bool) -> bytes:
+    """``cdr`` padded to a multiple of 4 as a middleware may deliver it: with the count in the
+    encapsulation options' last two bits and a byte of any value (XTypes; CycloneDDS), or with
+    zeros and nothing said (Fast DDS before 2.1)."""
+    pad = -len(cdr) % 4
+    if declared:
+        return cdr[:3] + bytes([cdr[3] | pad]) + cdr[4:] + b"\xff" * pad
+    return cdr + bytes(pad)
+
+
+@pytest.mark.parametrize("declared", [True, False])
+def test_our_sample_padded_by_the_middleware_is_still_ours(declared: bool) -> None:
+    own = OwnPublications()
+    own.guard()
+    ours = WritingPublisher()
+    msg = String(data="gz 0")  # 4 + 4 + 5 bytes: 3 bytes short of a multiple of 4
+    own.wrap(ours)(msg)
+    (sample,) = ours.samples
+    padded = _padded(serialize_message(msg), declared=declared)
+    assert len(padded) == len(serialize_message(msg)) + 3
+    assert own.is_own(sample, padded)
+    assert not own.is_own(
+        sample, _padded(serialize_message(String(data="ros 0")), declared=declared)
+    )
