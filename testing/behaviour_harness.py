@@ -116,7 +116,7 @@ class RosSide:
 
 
 def publish_until(
-    publish: Callable[[int], None], done: Callable[[], bool], what: str, period: float = 0.1
+    publish: Callable[[int], object], done: Callable[[], bool], what: str, period: float = 0.1
 ) -> int:
     """Call ``publish(i)`` for i = 0, 1, ... every ``period`` s until ``done()``; returns i.
 

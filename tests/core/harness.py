@@ -68,7 +68,7 @@ def wait_until(condition: Callable[[], bool], what: str, timeout: float = WAIT) 
         time.sleep(0.005)
 
 
-def publish_until(publish: Callable[[int], None], done: Callable[[], bool], what: str) -> int:
+def publish_until(publish: Callable[[int], object], done: Callable[[], bool], what: str) -> int:
     """Call ``publish(i)`` for i = 0, 1, ... until ``done()``; returns how many were sent.
 
     A reliable ROS endpoint gets every message once it has matched its peer, which takes
