@@ -13,8 +13,11 @@ and the same shaped to cost: wrapped in small unknown fields, or followed by tho
 empty elements); and one seed of each program-loading mode (the fuzz target's comment
 says how an input is read). With ``--target encode``, the same for the ROS -> Gazebo encoders
 (``compile_to_gz``): ``OUT_DIR/encoders.h``, and seeds of CDR messages (the default message,
-and one with every field set, :func:`distinctive_ros`). Both are build products under
-``.build/``, never committed.
+and one with every field set, :func:`distinctive_ros`). With ``--target loop``, programs.h and
+seeds of fuzz/loop_fuzz.c: per program, a channel's first messages (handed back, judged,
+then taken natively), and scripts of the queue's bounds, a failing publisher, a flood of
+senders and a topic the channel's own prefixes. All are build products under ``.build/``, never
+committed.
 """
 
 from __future__ import annotations
@@ -25,8 +28,6 @@ import struct
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
-
-from rclpy.serialization import serialize_message
 
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.msgs import message_class
@@ -283,6 +284,9 @@ def encoders_header_text(encoders: Sequence[tuple[Pair, bytes]]) -> str:
 
 def encoder_seeds(encoders: Sequence[tuple[Pair, bytes]]) -> dict[str, bytes]:
     """Seed inputs of fuzz/encode_fuzz.c by file name (its comment says how they are read)."""
+    # Here only: fuzz/loop_fuzz.c's Python imports this module, and loads no ROS library.
+    from rclpy.serialization import serialize_message  # noqa: PLC0415
+
     found = {}
     for i, (pair, words) in enumerate(encoders):
         cdr_default = serialize_message(pair.ros_class())
@@ -336,6 +340,78 @@ _SYNTHETIC: dict[str, tuple[list[int], bytes]] = {
 }  # fmt: skip
 
 
+#: fuzz/loop_fuzz.c's operations, and the frames of its dictionary (its comment says how an
+#: input is read).
+_MESSAGE, _TURN, _TAKE, _FLOOD, _FORGET, _WATCH, _PUBLISH_FAILS, _BREAK = range(8)
+_TOPIC, _PREFIXED, _SENDER, _OTHER_SENDER, _GZ, _IGNITION, _PAYLOAD, _LARGE = (
+    0x80, 0x81, 0x83, 0x84, 0x89, 0x8A, 0x8B, 0x8D,
+)  # fmt: skip
+#: A turn's byte: 8 messages, the socket fired; and the same with the monitor's event.
+_READ, _READ_MONITOR = 0x0F, 0x3F
+
+
+def _loop_message(*frames: int | bytes) -> bytes:
+    """A MESSAGE operation: dictionary frames by index, literal frames by their bytes."""
+    out = bytearray([_MESSAGE, len(frames) - 1])
+    for frame in frames:
+        if isinstance(frame, int):
+            out += bytes([frame])
+        else:
+            out += bytes([0x70]) + struct.pack("<H", len(frame)) + frame
+    return bytes(out)
+
+
+def loop_seeds(programs: Sequence[tuple[Pair, Compiled]]) -> dict[str, bytes]:
+    """Seed inputs of fuzz/loop_fuzz.c by file name: 4 bytes of configuration (program,
+    capacity, byte bound, flags), then operations."""
+    data = _loop_message(_TOPIC, _SENDER, _PAYLOAD, _GZ)
+    first = data + bytes([_TURN, _READ, _TAKE]) + data + data + bytes([_TURN, _READ, _TAKE])
+    found = {}
+    for i in range(len(programs)):  # every other one with the loop guard's digests
+        found[f"loop{i:02d}-first"] = bytes([i, 7, 20, 0x10 * (i % 2)]) + first
+    spelled = _loop_message(_TOPIC, _OTHER_SENDER, b"\x08\x01", _IGNITION)
+    found["loop-scripts"] = bytes([0, 1, 6, 0b1110]) + b"".join([
+        first, spelled, bytes([_TURN, _READ_MONITOR, _TAKE]), spelled * 3,
+        _loop_message(_TOPIC, _SENDER, _LARGE, 3, _GZ), bytes([_TURN, _READ]),
+        bytes([_PUBLISH_FAILS]), data, bytes([_TURN, _READ, _PUBLISH_FAILS]),
+        _loop_message(_TOPIC, _SENDER, _PAYLOAD, _GZ, _GZ), bytes([_TURN, _READ, _TAKE]),
+        bytes([_WATCH, 0x11]), data, bytes([_TURN, _READ, _TAKE, _BREAK, _TURN, _READ]),
+        bytes([_FORGET]), data, bytes([_TURN, _READ, _TAKE]),
+    ])  # fmt: skip
+    flood = bytes([_FLOOD, 0xFF])
+    found["loop-flood"] = bytes([0, 7, 20, 0]) + first + flood + data + bytes([_TURN, _READ, _TAKE])
+    prefixed = _loop_message(_PREFIXED, _SENDER, _PAYLOAD, _GZ)
+    found["loop-prefixed-topic"] = bytes([0, 7, 20, 0]) + b"".join([
+        prefixed, bytes([_TURN, _READ, _TAKE]), data, bytes([_TURN, _READ, _TAKE]),
+    ])  # fmt: skip
+    return found
+
+
+def _ros_message(publisher: int, cdr: bytes) -> bytes:
+    """A MESSAGE operation of a RosPump input: its publisher, rcl tells of it, its CDR bytes."""
+    return bytes([_MESSAGE, 0x08 | publisher, 0x70]) + struct.pack("<H", len(cdr)) + cdr
+
+
+def loop_ros_seeds(encoders: Sequence[tuple[Pair, bytes]]) -> dict[str, bytes]:
+    """Seed inputs of fuzz/loop_fuzz.c's RosPump (the configuration's last byte 0x80 and up):
+    per encoder, messages sent in every spelling, one of the bridge's own, one refused."""
+    from rclpy.serialization import serialize_message  # noqa: PLC0415 - see encoder_seeds
+
+    found = {}
+    all_active, own, sends_fail, python_send = (
+        bytes([_FLOOD, 0xFF]), bytes([_FORGET, 0x02]), bytes([_WATCH, 0x49]),
+        bytes([_PUBLISH_FAILS, 0]),
+    )  # fmt: skip
+    for i, (pair, _words) in enumerate(encoders):
+        cdr = serialize_message(distinctive_ros(pair.ros_class))
+        found[f"loop-ros{i:02d}"] = bytes([i, 0x0B, 0x08, 0x80]) + b"".join([
+            all_active, own, _ros_message(0, cdr), _ros_message(1, cdr), _ros_message(2, b"\0\1"),
+            bytes([_TURN, _READ, _TAKE]), sends_fail, _ros_message(0, cdr) * 3,
+            bytes([_TURN, _READ, _BREAK, _TURN, _READ]), python_send, b"\x08\x01",
+        ])  # fmt: skip
+    return found
+
+
 def _write(out: Path, header: str, text: str, inputs: dict[str, bytes]) -> Path:
     corpus = out / "corpus"
     corpus.mkdir(parents=True, exist_ok=True)
@@ -350,8 +426,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", type=Path, help="directory for the header and corpus/")
     parser.add_argument(
-        "--target", choices=("transcode", "encode"), default="transcode",
-        help="the fuzz target: transcode (programs.h) or encode (encoders.h)",
+        "--target", choices=("transcode", "encode", "loop"), default="transcode",
+        help="the fuzz target: transcode or loop (programs.h), encode (encoders.h)",
     )  # fmt: skip
     args = parser.parse_args(argv)
     if args.target == "encode":
@@ -360,8 +436,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         header, count = "encoders.h", f"{len(encoders)} encoders"
     else:
         programs = compiled_pairs()
-        text, inputs = header_text(programs), seeds(programs)
+        text = header_text(programs)
+        inputs = loop_seeds(programs) if args.target == "loop" else seeds(programs)
         header, count = "programs.h", f"{len(programs)} programs"
+    if args.target == "loop":  # it runs a RosPump too, on the encoders
+        encoders = compiled_encoders()
+        (args.out / "encoders.h").write_text(encoders_header_text(encoders))
+        inputs |= loop_ros_seeds(encoders)
     corpus = _write(args.out, header, text, inputs)
     print(f"{count} into {args.out / header}, seeds into {corpus}")
     return 0

@@ -258,6 +258,7 @@ class NativeReader(_Driver):
     ) -> None:
         self._native = native
         self._native_dropped = 0
+        self._topic_frame = topic.fqn.encode()
         super().__init__(context, topic, **driver)
         native.watch(self._owner.watch)
         native.attach(self._owner.sock.underlying, self._owner.connections.monitor.underlying, self)
@@ -323,9 +324,19 @@ class NativeReader(_Driver):
 
     def _judge(self, frames: list[Frame]) -> None:
         """A message the native loop had no route for: judged by the owner (the Python
-        reference), the route told to the loop, and the message itself delivered here."""
+        reference), the route told to the loop, and the message itself delivered here.
+
+        A route names a sender and a type, and the loop follows it for the topic's own frames
+        only: it is learned from those alone. A topic the topic's name prefixes comes through
+        the socket too (ZeroMQ subscribes by prefix), often from the same publisher with the
+        same type (``/model/x/pose`` and ``/model/x/pose_static``): its verdict (None, not
+        ours) taught as a route would have the loop skip the topic's own messages."""
         verdict = self._owner.verdict(frames)
-        if len(frames) == DATA_FRAMES and (verdict is None or isinstance(verdict, MessageInfo)):
+        if (
+            len(frames) == DATA_FRAMES
+            and (verdict is None or isinstance(verdict, MessageInfo))
+            and bytes(frames[0]) == self._topic_frame
+        ):
             self._native.learn(bytes(frames[1]), bytes(frames[3]), take=verdict is not None)
         if isinstance(verdict, MessageInfo):
             self._keep(frames[2], verdict)

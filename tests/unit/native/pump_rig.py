@@ -7,6 +7,7 @@ Python (learning the routes of what the loop hands back) the rig does itself.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import zmq
@@ -28,7 +29,15 @@ BUDGET = (TURN_MESSAGES, round(TURN_SLICE * 1e9))
 class Rig:
     """A pump on a loop, reading a SUB socket that a PUB of the test sends to."""
 
-    def __init__(self, native: Any, publisher: Any, *, capacity: int, max_bytes: int) -> None:
+    def __init__(
+        self,
+        native: Any,
+        publisher: Any,
+        *,
+        capacity: int,
+        max_bytes: int,
+        judge: Callable[[list[Any]], None] | None = None,
+    ) -> None:
         functions = zmq_functions()
         program = program_of(default_registry().get("std_msgs/msg/String", "gz.msgs.StringMsg"))
         assert functions is not None
@@ -47,6 +56,8 @@ class Rig:
         self.sub.connect(f"tcp://127.0.0.1:{port}")
         self.pump.read_from(self.sub.underlying, 0)
         self.loop.add(self.pump)
+        #: What a socket owner does with the frames handed back: by default, learn the route.
+        self.judge = judge or (lambda frames: self.pump.learn(frames[1], frames[3], True))
         self.handed_senders: list[bytes] = []
         self.grown: list[int] = []  # what each hand-over said of payloads above the watched size
 
@@ -62,14 +73,14 @@ class Rig:
         assert self.handed_senders, "the SUB socket never connected"
 
     def turn(self, timeout_ms: int = 20) -> bool:
-        """One run of the loop, then what a socket owner does: learn the route of every message
-        handed back as unrouted. Whether the loop reported the pump."""
+        """One run of the loop, then what a socket owner does: judge every message handed back
+        as unrouted. Whether the loop reported the pump."""
         _woken, reported = self.loop.run(timeout_ms, [])
         for _pump, _events in reported:
             handover = self.pump.take_handed()
             for frames in handover.unrouted:
                 self.handed_senders.append(frames[1])
-                self.pump.learn(frames[1], frames[3], True)
+                self.judge(frames)
             if handover.grown:
                 self.grown.append(handover.grown)
         return bool(reported)

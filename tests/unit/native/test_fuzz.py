@@ -1,17 +1,20 @@
 """The native transcoders under libFuzzer, with AddressSanitizer and UndefinedBehaviorSanitizer,
 then with MemorySanitizer.
 
-Two targets: fuzz/transcode_fuzz.c links the transcoder (transcode.c, pb_read.c,
+Three targets: fuzz/transcode_fuzz.c links the transcoder (transcode.c, pb_read.c,
 transcode_load.c: Gazebo -> ROS) with every compiled pair's program, fuzz/encode_fuzz.c links
 the encoder (encode.c, encode_write.c, encode_load.c: ROS -> Gazebo) with every compiled pair's
 encoder, each from a header generated here (tools/native_fuzz_programs.py, which writes
-codes.h beside it). Each is built with
-clang-14 into ``.build/fuzz/<target>-<sanitizer>-<hash>/``, once per hash of its sources,
-header and flags; the builds share ``FUZZ_SECONDS`` (60 by default; ``make fuzz`` and
-``make soak`` run it longer). Each target's corpus is kept in ``.build/fuzz/`` between runs
-(``corpus``, ``encode-corpus``); inputs that crash are written beside it (``artifacts/``,
-``encode-artifacts/``), and every later run tries them first. Without clang-14
-(``tools/setup_fuzz.sh`` installs it) the test skips, and fails under CI=true.
+codes.h beside it), and fuzz/loop_fuzz.c links the whole extension and embeds this Python: a
+channel's pump of either direction (pump.c, pump_loop.c; ros_pump.c, ros_pump_loop.c) taking
+the messages of the input from fake ZeroMQ and rcl functions, a Gazebo -> ROS pump taught by the
+real Python reader (loop_fuzz_host.py). Each is built with clang-14 into
+``.build/fuzz/<target>-<sanitizer>-<hash>/``, once per hash of its sources, headers and flags;
+the builds share ``FUZZ_SECONDS`` (60 by default; ``make fuzz`` and ``make soak`` run it
+longer). Each target's corpus is kept in ``.build/fuzz/`` between runs (``corpus``,
+``encode-corpus``, ``loop-corpus``); inputs that crash are written beside it (``artifacts/``,
+``encode-artifacts/``, ``loop-artifacts/``), and every later run tries them first. Without
+clang-14 (``tools/setup_fuzz.sh`` installs it) the test skips, and fails under CI=true.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import os
 import shutil
 import subprocess
 import sys
+import sysconfig
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,7 +55,8 @@ FINDINGS = (
 class Target:
     """A fuzz target: its source, the native files it links or includes, the header
     tools/native_fuzz_programs.py writes for it, where its corpus and findings are kept, and
-    its share of the fuzzing time."""
+    its share of the fuzzing time; ``python``: it embeds Python (built with AddressSanitizer
+    only: MemorySanitizer would need an instrumented libpython)."""
 
     source: str
     native: tuple[str, ...]
@@ -59,9 +64,29 @@ class Target:
     corpus: str
     artifacts: str
     share: float
+    python: bool = False
+    #: Its other files in fuzz/ (C files and headers).
+    parts: tuple[str, ...] = ()
 
     def sources(self) -> list[Path]:
-        return [ROOT / "fuzz" / self.source, *(NATIVE / name for name in self.native)]
+        python = [Path(__file__).with_name("loop_fuzz_host.py")] if self.python else []
+        fuzz = [ROOT / "fuzz" / name for name in (self.source, *self.parts)]
+        return [*fuzz, *(NATIVE / name for name in self.native), *python]
+
+    def sanitizers(self) -> list[str]:
+        return ["asan-ubsan"] if self.python else list(SANITIZERS)
+
+    def flags(self) -> tuple[str, ...]:
+        """What embedding Python adds: its headers and library, and where the target finds
+        this venv's interpreter and the repository."""
+        if not self.python:
+            return ()
+        include, libdir = sysconfig.get_path("include"), sysconfig.get_config_var("LIBDIR")
+        version = sysconfig.get_config_var("LDVERSION")
+        return (
+            f"-I{include}", f'-DFUZZ_PYTHON="{sys.executable}"', f'-DFUZZ_ROOT="{ROOT}"',
+            f"-L{libdir}", f"-Wl,-rpath,{libdir}", f"-lpython{version}",
+        )  # fmt: skip
 
 
 TARGETS = {
@@ -69,13 +94,22 @@ TARGETS = {
         "transcode_fuzz.c",
         ("transcode.c", "pb_read.c", "transcode_load.c", "transcode.h", "transcode_ops.h",
          "wire.h", "codes.py"),
-        "programs.h", "corpus", "artifacts", 1 / 2,
+        "programs.h", "corpus", "artifacts", 3 / 8,
     ),
     "encode": Target(
         "encode_fuzz.c",
         ("encode.c", "encode_write.c", "encode_load.c", "encode.h", "encode_ops.h",
          "transcode.h", "wire.h", "codes.py"),
-        "encoders.h", "encode-corpus", "encode-artifacts", 1 / 2,
+        "encoders.h", "encode-corpus", "encode-artifacts", 3 / 8,
+    ),
+    "loop": Target(
+        "loop_fuzz.c",
+        ("_native.c", "encode.c", "encode_load.c", "encode_write.c", "loop.c", "pb_read.c",
+         "pump.c", "pump_loop.c", "ros_pump.c", "ros_pump_loop.c", "transcode.c",
+         "transcode_load.c", "transcoders.c", "_native.h", "encode.h", "encode_ops.h",
+         "transcode.h", "transcode_ops.h", "wire.h", "codes.py"),
+        "programs.h", "loop-corpus", "loop-artifacts", 1 / 4, python=True,
+        parts=("loop_fuzz.h", "loop_fuzz_pump.c", "loop_fuzz_ros_pump.c", "loop_fuzz_zmq.c"),
     ),
 }  # fmt: skip
 
@@ -104,7 +138,7 @@ def _generate(out: Path, name: str) -> None:
 
 def build(clang: str, name: str, sanitizer: str) -> tuple[Path, Path]:
     """Target ``name``'s binary and its seed corpus, built unless this hash was built already."""
-    flags = (*FLAGS, *SANITIZERS[sanitizer][0])
+    flags = (*FLAGS, *SANITIZERS[sanitizer][0], *TARGETS[name].flags())
     sources = TARGETS[name].sources()
     binary = f"{name}_fuzz"
     BUILD.mkdir(parents=True, exist_ok=True)
@@ -112,6 +146,8 @@ def build(clang: str, name: str, sanitizer: str) -> tuple[Path, Path]:
     try:
         _generate(work, name)
         digest = hashlib.sha256((work / TARGETS[name].header).read_bytes())
+        for header in sorted(work.glob("*.h")):  # the loop target's encoders.h too
+            digest.update(header.read_bytes())
         for source in sources:
             digest.update(source.read_bytes())
         digest.update(" ".join((CLANG, *flags)).encode())
@@ -131,12 +167,26 @@ def build(clang: str, name: str, sanitizer: str) -> tuple[Path, Path]:
         shutil.rmtree(work, ignore_errors=True)
 
 
+def _runs() -> list[tuple[str, str]]:
+    return [(name, s) for name, target in TARGETS.items() for s in target.sanitizers()]
+
+
+def _share(name: str, sanitizer: str) -> float:
+    """The run's share of FUZZ_SECONDS: its target's, split between the target's sanitizers."""
+    target = TARGETS[name]
+    weights = {s: SANITIZERS[s][1] for s in target.sanitizers()}
+    return target.share * weights[sanitizer] / sum(weights.values())
+
+
+def test_shares_sum_to_the_budget() -> None:
+    assert abs(sum(_share(name, sanitizer) for name, sanitizer in _runs()) - 1) < 1e-9
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("sanitizer", SANITIZERS)
-@pytest.mark.parametrize("name", TARGETS)
+@pytest.mark.parametrize(("name", "sanitizer"), _runs())
 def test_target_survives_fuzzing(name: str, sanitizer: str) -> None:
     binary, seeds = build(require_clang(), name, sanitizer)
-    share = TARGETS[name].share * SANITIZERS[sanitizer][1]
+    share = _share(name, sanitizer)
     seconds = max(1, round(fuzz_seconds() * share))
     corpus = BUILD / TARGETS[name].corpus
     artifacts = BUILD / TARGETS[name].artifacts

@@ -10,7 +10,8 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.msgs import message_class
-from tests.unit.native.pump_rig import BUDGET, LEGIT, PAYLOAD, TYPE, Rig
+from tests.unit.native.loop_fuzz_host import Host
+from tests.unit.native.pump_rig import BUDGET, LEGIT, PAYLOAD, TOPIC, TYPE, Rig
 
 pytestmark = pytest.mark.ros
 
@@ -175,3 +176,38 @@ def test_a_read_ends_at_a_payload_above_the_watched_size(native: Any, publisher:
         assert rig.pump.counts().bytes_read - read_before == 10 * len(larger)
     finally:
         rig.close()
+
+
+def test_a_topic_the_channel_prefixes_leaves_the_channels_route_alone(
+    native: Any, publisher: Any
+) -> None:
+    """ZeroMQ subscribes by prefix: a topic the channel's name prefixes (``/x/pose_static``
+    beside ``/x/pose``), sent by the channel's own publisher with the channel's type, comes
+    through the channel's socket. The real reader judges it not the channel's; that verdict
+    used to be taught to the pump as the route of (sender, type), and the pump skipped the
+    channel's own messages of that publisher from then on, without a word (found by
+    fuzz/loop_fuzz.c)."""
+    host = Host(TOPIC.decode())
+    rig = Rig(native, publisher, capacity=1000, max_bytes=1 << 26, judge=host.judge)
+    host.reset(rig.pump, [TYPE])
+    sender = b"tcp://127.0.0.1:40001"
+    try:
+        rig.connected()
+        # the other topic's message, then the channel's: each judged by the reader
+        for topic in (TOPIC + b"_static", TOPIC):
+            handed, deadline = len(rig.handed_senders), time.monotonic() + 10
+            rig.pub.send_multipart([topic, sender, PAYLOAD, TYPE])
+            while len(rig.handed_senders) == handed and time.monotonic() < deadline:
+                rig.turn(50)
+            assert len(rig.handed_senders) == handed + 1, f"{topic!r} was not handed back"
+        before = rig.pump.counts()
+        for _ in range(20):
+            rig.pub.send_multipart([TOPIC, sender, PAYLOAD, TYPE])
+        rig.settle()
+        after = rig.pump.counts()
+        assert after.skipped == before.skipped == 0
+        assert after.published - before.published == 20
+        assert rig.handed_senders.count(sender) == 2
+    finally:
+        rig.close()
+        host.close()
