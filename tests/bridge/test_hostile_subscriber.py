@@ -11,6 +11,7 @@ bridge's own (VmRSS from /proc); what it published, from its ``/diagnostics``.
 from __future__ import annotations
 
 import array
+import itertools
 import threading
 import time
 from collections.abc import Iterator
@@ -37,6 +38,12 @@ GZ_IMAGE = "gz.msgs.Image"
 SIDE = 1000
 #: Images published at 50 Hz, 3 MB each: 450 MB, were they all kept.
 COUNT = 150
+#: Images the bridge must have sent to both subscribers: 150 MB, past the memory bound were
+#: they all kept. A loaded machine's bridge takes fewer of the 150 (43, and 25 of 450, on 2
+#: cores busy with other work: its subscription keeps the newest 10), so publishing goes on
+#: until then, for at most PUBLISHING_LIMIT seconds.
+NEEDED = 50
+PUBLISHING_LIMIT = 60.0
 
 
 class OutboundBridge:
@@ -109,11 +116,11 @@ def outbound(
 def test_a_subscriber_that_never_reads_costs_about_two_images(
     outbound: OutboundBridge, gz_node: GzNode
 ) -> None:
-    """150 images of 3 MB to a subscriber that never reads, and to a healthy one: the bridge's
-    resident memory grows by less than 100 MB (its send queue for the rogue holds 2 images,
-    max_queued_bytes over the largest message the transport carries; the margin covers the
-    ROS side's own buffers of a few images and the kernel's socket buffers), and the healthy
-    subscriber receives most of them (more than half: what the bridge published)."""
+    """150 images of 3 MB (more until the bridge sent 50) to a subscriber that never reads, and
+    to a healthy one: the bridge's resident memory grows by less than 100 MB (its send queue
+    for the rogue holds 2 images, max_queued_bytes over the largest message the transport
+    carries; the margin covers the ROS side's own buffers of a few images and the kernel's
+    socket buffers), and the healthy subscriber receives most of what the bridge published."""
     healthy = Counter()
     subscription = gz_node.subscribe(outbound.topic, healthy, GZ_IMAGE, queue_size=10)
     rogue = RogueSubscriber(outbound.fqn, GZ_IMAGE)
@@ -131,9 +138,14 @@ def test_a_subscriber_that_never_reads_costs_about_two_images(
         start = usage(outbound.process.pid).rss_bytes
         peak = PeakRss(outbound.process.pid)
         before, received_before = outbound.published(), healthy.count
-        for _ in range(COUNT):
+        deadline = time.monotonic() + PUBLISHING_LIMIT
+        for index in itertools.count(1):
             outbound.publisher.publish(image)
             time.sleep(0.02)
+            if index >= COUNT and (
+                outbound.published() - before >= NEEDED or time.monotonic() > deadline
+            ):
+                break
         time.sleep(1.0)  # the last of them bridged, and the next /diagnostics
         highest = peak.stop()
         sent = outbound.published() - before
@@ -146,7 +158,7 @@ def test_a_subscriber_that_never_reads_costs_about_two_images(
         f"(+{(highest - start) / MB:.1f} MB); {sent} images of 3 MB published, "
         f"{received} received by the healthy subscriber"
     )
-    assert sent >= COUNT // 2, "the bridge published most of the images"
+    assert sent >= NEEDED, "the bridge kept publishing beside a subscriber that never reads"
     assert received >= sent // 2, "the healthy subscriber kept receiving"
     assert highest - start < 100 * MB
     assert outbound.values()["send_queue"] == "2"  # 64 MiB over 128 MiB, on /diagnostics
