@@ -192,12 +192,14 @@ class OwnPublications:
                 if window is not None and window[0] <= stamp <= window[1]:
                     matched.append(window[2])
             numbered = list(self._numbered)
-        if matched and (
-            received is None
-            or any(kept is None or _as_ends(kept) == _as_ends(received) for kept in matched)
-        ):
+        if matched and (received is None or any(kept is None for kept in matched)):
             return True
-        if not numbered:
+        if not matched and not numbered:
             return False
+        # The sample serialized once, for our windows and the numbered publishers alike.
         cdr = None if received is None else _as_cdr(received)
+        if matched and cdr is not None:
+            ends = _ends(cdr)
+            if any(_as_ends(kept) == ends for kept in matched):
+                return True
         return any(publisher.is_own(sequence, stamp, cdr) for publisher in numbered)
