@@ -455,6 +455,7 @@ void fuzz_pump(const uint8_t *data, size_t size) {
         case OP_FORGET:
             take(pump);
             Py_DECREF(call(pump, "forget", "()")); /* closes the queue's payloads */
+            model.dropped += model.count; /* counted dropped */
             model.count = model.head = 0;
             model.queued_bytes = 0;
             check_counts((PumpObject *)pump);

@@ -257,6 +257,7 @@ done:
 static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     (void)unused;
     if (out_of_loop(self, "forget") < 0) return NULL;
+    self->dropped += self->count + self->nhanded; /* their socket is gone: counted, not lost silently */
     clear_routes(self);
     pump_clear_ring(self);
     pump_clear_handover(self);
@@ -400,7 +401,7 @@ static PyMethodDef pump_methods[] = {
     {"learn", (PyCFunction)pump_learn, METH_VARARGS,
      "learn(sender, msg_type, take) -> bool: route messages of (sender, type) natively (take) "
      "or skip them; False where no program takes msg_type"},
-    {"forget", (PyCFunction)pump_forget, METH_NOARGS, "forget routes and queued messages"},
+    {"forget", (PyCFunction)pump_forget, METH_NOARGS, "forget routes and queued messages (counted dropped)"},
     {"take_handed", (PyCFunction)pump_take_handed, METH_NOARGS,
      "take_handed() -> Handover: what the loop left to Python since the last call"},
     {"watch", (PyCFunction)pump_watch, METH_O,

@@ -211,3 +211,29 @@ def test_a_topic_the_channel_prefixes_leaves_the_channels_route_alone(
     finally:
         rig.close()
         host.close()
+
+
+def test_messages_waiting_when_the_socket_is_replaced_are_counted_dropped(
+    native: Any, publisher: Any
+) -> None:
+    """``forget`` (the socket owner replaces the socket: a new receive mark) lets go of what
+    the old socket's reads left waiting; those count as dropped, not vanish (before: uncounted)."""
+    rig = Rig(native, publisher, capacity=1000, max_bytes=1 << 26)
+    try:
+        rig.connected()
+        rig.settle()
+        before = rig.pump.counts()
+        for _ in range(3):
+            rig.send(b"unknown-sender", PAYLOAD)  # copies for Python, waiting to be taken
+        time.sleep(0.2)
+        deadline = time.monotonic() + 5
+        while rig.pump.counts().received == before.received and time.monotonic() < deadline:
+            rig.loop.run(100, [])  # read, but nothing taken from the hand-over
+        assert rig.loop.remove(rig.pump)
+        rig.pump.forget()
+        after = rig.pump.counts()
+        assert after.dropped - before.dropped == 3
+        assert rig.pump.take_handed().unrouted == []
+        rig.loop.add(rig.pump)
+    finally:
+        rig.close()
