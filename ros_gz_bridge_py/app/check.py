@@ -22,7 +22,12 @@ from rclpy.qos import QoSProfile
 from ros_gz_bridge_py.config import BridgeSpec, Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Registry
 from ros_gz_bridge_py.core.diagnosis import Finding, RosEndpoint, Situation, findings
-from ros_gz_bridge_py.core.explain import gazebo_name, ros_endpoints, type_hints
+from ros_gz_bridge_py.core.explain import (
+    as_the_graph_shows,
+    gazebo_name,
+    ros_endpoints,
+    type_hints,
+)
 from ros_gz_bridge_py.errors import ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.qos import endpoint_qos, gz_to_ros_publisher_qos
@@ -153,7 +158,7 @@ def _topic_reports(
     reports = []
     for direction in directions:
         qos = _entry_qos(spec, direction, ros_topic)
-        ros_side = ros_endpoints(ros_node, direction, ros_topic, qos, own)
+        ros_side = ros_endpoints(ros_node, direction, ros_topic, as_the_graph_shows(qos), own)
         situation = Situation(
             direction=direction,
             ros_topic=ros_topic,

@@ -188,6 +188,8 @@ class SubConnections:
     # --- internals --------------------------------------------------------------------------
 
     def _read_events(self, now: float) -> None:
+        if not self.monitor.get(zmq.EVENTS) & zmq.POLLIN:
+            return  # mostly: an idle turn would otherwise raise and catch zmq.Again
         for _ in range(READ_BATCH):
             try:
                 frames = self.monitor.recv_multipart(zmq.NOBLOCK)

@@ -51,6 +51,9 @@ ACTIVITY_INTERVAL = 0.1
 SILENCE_INTERVAL = 3.0
 #: Discovery counts as initialised (listings are complete) after two heartbeat cycles.
 INIT_DELAY = 2 * HEARTBEAT_INTERVAL
+#: Distinct datagrams of at most DECODED_SIZE bytes remembered decoded (a peer's records and
+#: heartbeats repeat each second; a few hundred bytes each): at most about 4 MB held.
+DECODED_KEPT, DECODED_SIZE = 2048, 1024
 
 
 def _silent_after(seen: float) -> float:
@@ -92,6 +95,10 @@ class DiscoveryEngine:
         self.spellings = PeerSpellings(legacy_spelling)
         self._next_heartbeat = now
         self._next_activity = math.inf  # no peer yet
+        # HEARTBEAT and each record's ADVERTISE repeat every second: ours encoded once, what
+        # is heard decoded once (a 50-robot fleet repeats 300 a second: the bridge's rest CPU).
+        self._encoded: dict[tuple[DiscoveryType, PublisherRecord | None], bytes] = {}
+        self._decoded: dict[bytes, DiscoveryMessage] = {}
 
     # --- queries -------------------------------------------------------------------------
 
@@ -152,6 +159,7 @@ class DiscoveryEngine:
         if record not in self._local:
             return []
         self._local.remove(record)
+        self._encoded.pop((DiscoveryType.ADVERTISE, record), None)
         if not any(r.topic == record.topic for r in self._local):
             self._subscribers.pop(record.topic, None)
         if record.scope == Scope.PROCESS:
@@ -232,7 +240,7 @@ class DiscoveryEngine:
         """Handle one datagram from ``source_ip``; never raises on bad input."""
         self.counts["received"] += 1
         try:
-            message = decode_discovery(data)
+            message = self._decoded.get(data) or self._decode(data)
         except UnknownMessageTypeError as error:
             self.counts["unknown_type"] += 1
             _LOG.debug("discovery: dropped datagram from %s: %s", source_ip, error)
@@ -281,11 +289,27 @@ class DiscoveryEngine:
         topic: str | None = None,
     ) -> list[Outgoing]:
         message = DiscoveryMessage(kind, self.process_uuid, self.version, topic=topic, pub=pub)
-        out = [Outgoing(encode_discovery(message))]
+        if kind in (DiscoveryType.HEARTBEAT, DiscoveryType.ADVERTISE):
+            data = self._encoded.get((kind, pub)) or self._encoded.setdefault(
+                (kind, pub), encode_discovery(message)
+            )
+        else:
+            data = encode_discovery(message)
+        out = [Outgoing(data)]
         if self._relays:
             relayed = encode_discovery(replace(message, relay=True))
             out += [Outgoing(relayed, ip) for ip in self._relays]
         return out
+
+    def _decode(self, data: bytes) -> DiscoveryMessage:
+        """``data`` decoded (raises as :func:`decode_discovery`), kept for its next repeat; a
+        flood of distinct datagrams empties the memo, never grows it past DECODED_KEPT."""
+        message = decode_discovery(data)
+        if len(data) <= DECODED_SIZE:
+            if len(self._decoded) >= DECODED_KEPT:
+                self._decoded.clear()
+            self._decoded[data] = message
+        return message
 
     def _in_scope(self, record: PublisherRecord, source_ip: str) -> bool:
         if record.scope == Scope.PROCESS:

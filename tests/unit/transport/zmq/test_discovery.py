@@ -3,8 +3,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import replace
+from typing import Any
+
+import pytest
+
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber
+from ros_gz_bridge_py.transport.zmq import discovery
 from ros_gz_bridge_py.transport.zmq.discovery import (
     ACTIVITY_INTERVAL,
     HEARTBEAT_INTERVAL,
@@ -332,3 +339,58 @@ def test_fields_added_by_newer_lines_are_ignored() -> None:
     assert events == []
     assert [m.type for m in sent(out)] == [DiscoveryType.ADVERTISE]
     assert engine.counts["malformed"] == 0
+
+
+def test_repeated_datagrams_are_encoded_and_decoded_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every second brings the same HEARTBEAT and ADVERTISE bytes from each process: the engine
+    encodes its own once and decodes each it hears once; what it does with them is unchanged."""
+    calls = {"encode": 0, "decode": 0}
+
+    def counting(name: str, real: Callable[..., Any]) -> Callable[..., Any]:
+        def call(*args: Any) -> Any:
+            calls[name] += 1
+            return real(*args)
+
+        return call
+
+    monkeypatch.setattr(discovery, "encode_discovery", counting("encode", encode_discovery))
+    monkeypatch.setattr(discovery, "decode_discovery", counting("decode", decode_discovery))
+    engine = DiscoveryEngine(ME, 0.0)
+    engine.advertise(record(ME))
+    heard = datagram(DiscoveryType.ADVERTISE, pub=record())
+    firsts = []
+    for second in range(5):
+        out, _ = engine.tick(float(second))
+        firsts.append([o.data for o in out])
+        _, events = engine.datagram_received(heard, "127.0.0.1", second + 0.5)
+        assert [type(e) for e in events] == ([PublisherAdded] if second == 0 else [])
+        for own in out:  # the multicast loops our own datagrams back
+            assert engine.datagram_received(own.data, "127.0.0.1", second + 0.5) == ([], [])
+    assert all(first == firsts[0] for first in firsts)
+    assert [m.type for m in sent([Outgoing(d) for d in firsts[0]])] == [
+        DiscoveryType.HEARTBEAT,
+        DiscoveryType.ADVERTISE,
+    ]
+    assert calls == {"encode": 2, "decode": 1 + 2}  # ours: HEARTBEAT, ADVERTISE; and the peer's
+    assert engine.remote_publishers(TOPIC) == [record()]
+    # a record withdrawn and advertised anew under another address is sent as it now is
+    engine.unadvertise(record(ME))
+    moved = replace(record(ME), address="tcp://127.0.0.1:4")
+    engine.advertise(moved)
+    out, _ = engine.tick(5.0)
+    assert sent(out)[1].pub == moved
+
+
+def test_the_decoded_memo_is_bounded(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Distinct datagrams (a hostile sender varies each one) never grow the memo past its
+    bound, and large ones are not kept: each is still judged."""
+    monkeypatch.setattr(discovery, "DECODED_KEPT", 8)
+    engine = DiscoveryEngine(ME, 0.0)
+    for i in range(50):
+        engine.datagram_received(datagram(DiscoveryType.HEARTBEAT, f"peer-{i}"), "127.0.0.1", 0.0)
+        assert len(engine._decoded) <= 8
+    big = replace(record(), topic="@/p@/" + "x" * discovery.DECODED_SIZE)
+    engine.datagram_received(datagram(DiscoveryType.ADVERTISE, pub=big), "127.0.0.1", 0.0)
+    assert all(len(data) <= discovery.DECODED_SIZE for data in engine._decoded)
+    assert engine.remote_publishers(big.topic) == [big]
+    assert len(engine.processes()) == 51
