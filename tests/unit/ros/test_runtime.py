@@ -1,15 +1,19 @@
-"""batch_dds_event_threads: which threads it puts under SCHED_BATCH, and what it skips."""
+"""batch_dds_event_threads: which threads it puts under SCHED_BATCH, and what it skips;
+SignalWake: a signal ends a spin step."""
 
 from __future__ import annotations
 
 import os
+import signal
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
-from ros_gz_bridge_py.ros.runtime import batch_dds_event_threads
+from ros_gz_bridge_py.ros.runtime import SignalWake, batch_dds_event_threads
 
 
 @pytest.fixture
@@ -54,3 +58,36 @@ def test_no_such_threads_changes_nothing(tmp_path: Path) -> None:
     assert batch_dds_event_threads(tmp_path) == 0
     assert batch_dds_event_threads(tmp_path / "absent") == 0
     assert os.sched_getscheduler(os.getpid()) == os.SCHED_OTHER
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize("events", [True, False], ids=["EventsExecutor", "single"])
+def test_a_signal_ends_a_spin_step_at_once(ros_context: Any, events: bool) -> None:
+    """The bridge spins in long steps; a signal (here SIGUSR2, as SIGINT would) ends the step
+    it arrives in and its Python handler runs right after, on the main thread."""
+    import rclpy  # noqa: PLC0415 - only the tests that ask for a context load it
+    from rclpy.executors import SingleThreadedExecutor  # noqa: PLC0415
+    from rclpy.experimental import EventsExecutor  # noqa: PLC0415
+
+    node = rclpy.create_node("signal_wake_test", context=ros_context)
+    kind = EventsExecutor if events else SingleThreadedExecutor
+    executor = kind(context=ros_context)
+    executor.add_node(node)
+    handled: list[str] = []
+    previous = signal.signal(
+        signal.SIGUSR2, lambda *_: handled.append(threading.current_thread().name)
+    )
+    try:
+        with SignalWake(node):
+            for _ in range(2):  # the wake is ready again after it fired
+                threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGUSR2)).start()
+                started = time.monotonic()
+                executor.spin_once(timeout_sec=60)
+                assert time.monotonic() - started < 30, "the signal did not end the step"
+                executor.spin_once(timeout_sec=0)  # the handler runs between steps
+        assert handled == ["MainThread", "MainThread"]
+        assert not any(t.name == "signal-wake" for t in threading.enumerate())
+    finally:
+        signal.signal(signal.SIGUSR2, previous)
+        executor.shutdown()
+        node.destroy_node()
