@@ -6,6 +6,7 @@ publisher the C loop publishes on and a real subscription that takes the sample 
 
 from __future__ import annotations
 
+import random
 import time
 from typing import Any
 
@@ -13,6 +14,7 @@ from rclpy.node import Node
 from rclpy.serialization import serialize_message
 from std_msgs.msg import String
 
+from ros_gz_bridge_py.core.loop_guard import OwnPublications
 from tests.unit.native.pump_rig import LEGIT, PAYLOAD, Rig
 
 
@@ -80,5 +82,68 @@ def test_a_python_publication_keeps_the_cdr_it_wrote(native: Any, publisher: Any
         declared = ours[:3] + bytes([ours[3] | pad]) + ours[4:] + b"\xff" * pad
         assert rig.pump.is_own(known, during_known, declared)
         assert rig.pump.is_own(known, during_known, ours + bytes(pad))
+    finally:
+        rig.close()
+
+
+class _Writer:
+    """Publishes CDR bytes as they are, numbering and stamping each as rmw would."""
+
+    def __init__(self) -> None:
+        self.info: dict[str, int] = {}
+
+    def publish(self, cdr: bytes) -> bytes:
+        sequence = self.info.get("publication_sequence_number", 0) + 1
+        self.info = {"publication_sequence_number": sequence, "source_timestamp": time.time_ns()}
+        return cdr
+
+
+def _variant(rng: random.Random, cdr: bytes) -> bytes:
+    """What a subscription may receive: our sample as a middleware passed it on, or another
+    writer's close to it."""
+    pad = -len(cdr) % 4
+    body = bytearray(cdr)
+    where = rng.randrange(len(cdr))
+    choices = [
+        lambda: cdr,
+        lambda: cdr[:3] + bytes([cdr[3] | pad]) + cdr[4:] + b"\xff" * pad,  # XTypes padding
+        lambda: cdr + bytes(pad or 4),  # zeros, said nowhere
+        lambda: cdr[:-1],
+        lambda: cdr + bytes([rng.randrange(1, 256)]),
+        lambda: (
+            bytes(body[:where]) + bytes([body[where] ^ 1 << rng.randrange(8)]) + cdr[where + 1 :]
+        ),
+    ]
+    return rng.choice(choices)()
+
+
+def test_the_pump_and_the_python_guard_judge_content_alike(native: Any, publisher: Any) -> None:
+    """The body rule is written twice, in Python (core/loop_guard.py ``_ends``) and in C
+    (``rgb_cdr_digest``): over CDR of every size around the ends they keep (odd lengths,
+    zeros at the end, declared padding, one bit flipped anywhere), both judge each received
+    sample alike."""
+    rng = random.Random(35)
+    own = OwnPublications()
+    own.guard()
+    writer = _Writer()
+    publish = own.wrap(writer)
+    rig = Rig(native, publisher, capacity=100, max_bytes=1 << 20)
+    verdicts = []
+    try:
+        for _ in range(600):
+            size = rng.choice([4, 5, 8, 13, 255, 260, 512, 515, 516, 517, 600, 1500])
+            body = bytes(rng.randrange(256) for _ in range(size - 4))
+            if rng.random() < 0.3:
+                body = body[: len(body) // 2] + bytes(len(body) - len(body) // 2)
+            written = b"\x00\x01\x00\x00" + body
+            received = _variant(rng, written)
+            sequence = rig.pump.begin_publication()
+            during = time.time_ns()
+            rig.pump.end_publication(sequence, True, written)
+            publish(written)
+            native_verdict = rig.pump.is_own(sequence, during, received)
+            assert own.is_own(writer.info, received) == native_verdict, (written, received)
+            verdicts.append(native_verdict)
+        assert 0.2 < sum(verdicts) / len(verdicts) < 0.8  # both kinds were judged
     finally:
         rig.close()
