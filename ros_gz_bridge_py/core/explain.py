@@ -200,8 +200,7 @@ class Explainer:
         """A channel's first evaluation; what does not change is worked out once (at rest, a
         fleet's 201 channels every 2 s made this a third of the bridge's CPU)."""
         name = gazebo_name(self._gz, channel.spec.gz_topic)
-        seen = _Seen(now, name, as_the_graph_shows(channel.qos))
-        seen.count = channel.stats.received
+        seen = _Seen(now, name, as_the_graph_shows(channel.qos), channel.stats.received)
         self._seen[id(channel)] = seen
         return seen
 

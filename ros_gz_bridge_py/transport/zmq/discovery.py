@@ -289,12 +289,12 @@ class DiscoveryEngine:
         topic: str | None = None,
     ) -> list[Outgoing]:
         message = DiscoveryMessage(kind, self.process_uuid, self.version, topic=topic, pub=pub)
-        if kind in (DiscoveryType.HEARTBEAT, DiscoveryType.ADVERTISE):
-            data = self._encoded.get((kind, pub)) or self._encoded.setdefault(
-                (kind, pub), encode_discovery(message)
-            )
-        else:
+        repeated = kind in (DiscoveryType.HEARTBEAT, DiscoveryType.ADVERTISE)
+        data = self._encoded.get((kind, pub)) if repeated else None
+        if data is None:
             data = encode_discovery(message)
+            if repeated:
+                self._encoded[kind, pub] = data
         out = [Outgoing(data)]
         if self._relays:
             relayed = encode_discovery(replace(message, relay=True))
