@@ -29,8 +29,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
-from rclpy.clock import Clock, ClockType
-
 from ros_gz_bridge_py.config import (
     BridgeSpec,
     Direction,
@@ -47,6 +45,7 @@ from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
 from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.ros.quick_log import quick_logger
+from ros_gz_bridge_py.ros.runtime import steady_clock
 from ros_gz_bridge_py.ros.side_node import (
     SideNode,
     native_node_name,
@@ -108,7 +107,7 @@ class Bridge:
         self._lock = threading.RLock()
         self._handles: list[BridgeHandle] = []
         self._closed = False
-        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        steady = steady_clock()
         self._timer = ros_node.create_timer(self.options.heartbeat, self.heartbeat, clock=steady)
         self._explainer: Explainer | None = None
         self._explain_timer: Any = None

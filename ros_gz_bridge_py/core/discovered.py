@@ -16,8 +16,6 @@ import time
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from rclpy.clock import Clock, ClockType
-
 from ros_gz_bridge_py.config import TopicBridgeSpec
 from ros_gz_bridge_py.config.discovered import AutoBridgeRules
 from ros_gz_bridge_py.config.patterns import TopicPattern
@@ -35,6 +33,7 @@ from ros_gz_bridge_py.core.discovery_plan import (
 from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.ros.quick_log import quick_logger
+from ros_gz_bridge_py.ros.runtime import steady_clock
 from ros_gz_bridge_py.transport.api import PUBLISHER, GraphEndpoint
 
 #: Seconds between two scans of the graph (a new topic is bridged within about this long
@@ -70,8 +69,7 @@ class DiscoveredBridges:
         self._seen: tuple[dict[str, Sighting], RosPublishers, int] | None = None
         self._explicit: tuple[int, frozenset[str]] = (-1, frozenset())
         self._asked = (float("-inf"), -1)  # (when, how many peer processes then)
-        steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self._timer: Any = bridge.ros_node.create_timer(period, self.scan, clock=steady)
+        self._timer: Any = bridge.ros_node.create_timer(period, self.scan, clock=steady_clock())
 
     def scan(self) -> None:
         """Follow the graph once (the timer's callback); never raises."""

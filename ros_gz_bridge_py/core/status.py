@@ -37,7 +37,6 @@ from types import FrameType
 from typing import Any, TextIO
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from rclpy.clock import Clock, ClockType
 
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.channel import Channel, ChannelState
@@ -48,6 +47,7 @@ from ros_gz_bridge_py.ros.runtime import (
     batch_dds_event_threads,
     make_executor,
     spin_until_stopped,
+    steady_clock,
 )
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
@@ -318,9 +318,7 @@ class DiagnosticsPublisher:
         self._tracker = StatusTracker(bridge)
         self._hardware_id = str(ros_node.get_fully_qualified_name())
         self._publisher = ros_node.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, 10)
-        self._timer = ros_node.create_timer(
-            period, self.publish, clock=Clock(clock_type=ClockType.STEADY_TIME)
-        )
+        self._timer = ros_node.create_timer(period, self.publish, clock=steady_clock())
 
     def publish(self) -> None:
         stamp = self._node.get_clock().now().to_msg()

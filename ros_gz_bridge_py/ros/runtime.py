@@ -20,14 +20,13 @@ measured on the project machines):
 
 from __future__ import annotations
 
-import contextlib
+import functools
 import os
-import signal
 import sys
-import threading
 from pathlib import Path
 from typing import Any
 
+from rclpy.clock import Clock, ClockType
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import get_default_context
 
@@ -105,19 +104,25 @@ def make_executor(*, events: bool) -> Any:
     return EventsExecutor()
 
 
-#: Longest time one spin step blocks. A signal ends a step at once (:class:`SignalWake`);
-#: without that (not the main thread) steps are :data:`SHORT_SPIN_STEP`, which bounds how
-#: long a stop request waits. Each step costs: 0.1 s steps were 0.4% of a core at rest.
-SPIN_STEP = 2.0
-SHORT_SPIN_STEP = 0.1
+#: Longest time one spin step blocks; bounds how long a stop request waits. Each step costs
+#: the EventsExecutor some CPU: 0.1 s steps were 0.24-0.50% of a core for an idle node, 0.5 s
+#: steps 0.08%. (Ending a step at a signal would take a thread: issue 28's thread budget.)
+SPIN_STEP = 0.5
+
+
+@functools.cache
+def steady_clock() -> Clock:
+    """The one clock every timer of the bridge's node runs on: the EventsExecutor keeps a
+    thread for each clock object its timers use (a steady clock per timer was a thread each)."""
+    return Clock(clock_type=ClockType.STEADY_TIME)
 
 
 def spin_until_stopped(executor: Any, stop: StopSignal | None = None) -> None:
     """Spin ``executor`` until a stop signal or rclpy shutdown; return without a traceback.
 
     Spinning is a loop of ``spin_once`` steps on the calling (main) thread, so the Python
-    signal handlers run between steps; a signal ends the step it arrives in. With ``stop``
-    None, handlers are installed for the duration of the call.
+    signal handlers run between steps, at most :data:`SPIN_STEP` after the signal. With
+    ``stop`` None, handlers are installed for the duration of the call.
     """
     if stop is None:
         with StopSignal() as own:
@@ -125,48 +130,8 @@ def spin_until_stopped(executor: Any, stop: StopSignal | None = None) -> None:
         return
     spin_once = executor.spin_once
     context = get_default_context()
-    nodes = executor.get_nodes()
-    woken = bool(nodes) and threading.current_thread() is threading.main_thread()
-    with SignalWake(nodes[0]) if woken else contextlib.nullcontext():
-        step = SPIN_STEP if woken else SHORT_SPIN_STEP
-        try:
-            while context.ok() and not stop.requested:
-                spin_once(timeout_sec=step)
-        except (KeyboardInterrupt, ExternalShutdownException):
-            pass
-
-
-class SignalWake:
-    """While entered, a signal ends the executor's wait at once. CPython's own handler writes
-    each signal to the wakeup fd in whatever thread it lands; the ``signal-wake`` thread reads
-    it and resets a cancelled timer of ``node``, whose firing returns ``spin_once`` (the
-    EventsExecutor takes no guard conditions and its ``wake`` does not end a wait); the main
-    thread then runs the Python handlers. Enter it on the main thread only."""
-
-    def __init__(self, node: Any) -> None:
-        self._node = node
-        self._read, self._write = os.pipe()
-        os.set_blocking(self._write, False)
-        self._timer = node.create_timer(0.0, self._fired)
-        self._timer.cancel()
-        self._thread = threading.Thread(target=self._watch, name="signal-wake", daemon=True)
-        self._previous = -1
-
-    def __enter__(self) -> SignalWake:
-        self._previous = signal.set_wakeup_fd(self._write, warn_on_full_buffer=False)
-        self._thread.start()
-        return self
-
-    def __exit__(self, *_exc: object) -> None:
-        signal.set_wakeup_fd(self._previous)
-        os.close(self._write)  # the thread reads the end of the pipe and returns
-        self._thread.join()
-        os.close(self._read)
-        self._node.destroy_timer(self._timer)
-
-    def _watch(self) -> None:
-        while os.read(self._read, 64):
-            self._timer.reset()
-
-    def _fired(self) -> None:
-        self._timer.cancel()
+    try:
+        while context.ok() and not stop.requested:
+            spin_once(timeout_sec=SPIN_STEP)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass

@@ -1,19 +1,15 @@
-"""batch_dds_event_threads: which threads it puts under SCHED_BATCH, and what it skips;
-SignalWake: a signal ends a spin step."""
+"""batch_dds_event_threads: which threads it puts under SCHED_BATCH, and what it skips."""
 
 from __future__ import annotations
 
 import os
-import signal
 import threading
-import time
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
 
 import pytest
 
-from ros_gz_bridge_py.ros.runtime import SignalWake, batch_dds_event_threads
+from ros_gz_bridge_py.ros.runtime import batch_dds_event_threads, steady_clock
 
 
 @pytest.fixture
@@ -60,34 +56,11 @@ def test_no_such_threads_changes_nothing(tmp_path: Path) -> None:
     assert os.sched_getscheduler(os.getpid()) == os.SCHED_OTHER
 
 
-@pytest.mark.ros
-@pytest.mark.parametrize("events", [True, False], ids=["EventsExecutor", "single"])
-def test_a_signal_ends_a_spin_step_at_once(ros_context: Any, events: bool) -> None:
-    """The bridge spins in long steps; a signal (here SIGUSR2, as SIGINT would) ends the step
-    it arrives in and its Python handler runs right after, on the main thread."""
-    import rclpy  # noqa: PLC0415 - only the tests that ask for a context load it
-    from rclpy.executors import SingleThreadedExecutor  # noqa: PLC0415
-    from rclpy.experimental import EventsExecutor  # noqa: PLC0415
+def test_the_bridges_timers_share_one_steady_clock() -> None:
+    """The EventsExecutor keeps a thread for each clock object its timers use: every timer of
+    the bridge's node (heartbeat, explanations, discovered bridging, /diagnostics) takes this
+    one, so turning those on adds no thread (issue 28: no more threads than the C++ bridge)."""
+    from rclpy.clock import ClockType  # noqa: PLC0415 - rclpy only for the tests that use it
 
-    node = rclpy.create_node("signal_wake_test", context=ros_context)
-    kind = EventsExecutor if events else SingleThreadedExecutor
-    executor = kind(context=ros_context)
-    executor.add_node(node)
-    handled: list[str] = []
-    previous = signal.signal(
-        signal.SIGUSR2, lambda *_: handled.append(threading.current_thread().name)
-    )
-    try:
-        with SignalWake(node):
-            for _ in range(2):  # the wake is ready again after it fired
-                threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGUSR2)).start()
-                started = time.monotonic()
-                executor.spin_once(timeout_sec=60)
-                assert time.monotonic() - started < 30, "the signal did not end the step"
-                executor.spin_once(timeout_sec=0)  # the handler runs between steps
-        assert handled == ["MainThread", "MainThread"]
-        assert not any(t.name == "signal-wake" for t in threading.enumerate())
-    finally:
-        signal.signal(signal.SIGUSR2, previous)
-        executor.shutdown()
-        node.destroy_node()
+    assert steady_clock() is steady_clock()
+    assert steady_clock().clock_type == ClockType.STEADY_TIME
