@@ -21,6 +21,8 @@ reports it lists, ``benchmarks/reports/`` (``make bench``: ``run.py``), and SOAK
   candidate, beside the same run's ceiling (not in ``make bench``; ``fleet_cpu_figures`` holds
   what it found, ``fleet_cpu_report`` writes it; it reads the bridge from outside through
   ``bridge_threads``, ``perf_syscalls`` and ``perf_profile``);
+- ``socket_sharing``: what one SUB socket for a fleet's topics would save in libzmq against one
+  per topic (not in ``make bench``);
 - ``memory``: the bridge's memory under a long flood and beside a slow subscriber;
 - ``profile_images``: where the time goes on the 1080p image path (not in ``make bench``);
 - ``soak``, ``attacks``: SOAK.md from the runs of ``testing.soak`` and ``testing.attacks``.
