@@ -301,3 +301,31 @@ def test_a_ros_reader_with_incompatible_qos_is_explained(rig: Rig, world: RosWor
         "to what it uses",
         text,
     ), text
+
+
+def test_a_graph_of_the_bridges_nodes_alone_asks_no_topics_endpoints(
+    rig: Rig, world: RosWorld, other_process: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    topic = unique("alone")
+    channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS)))
+    rig.gazebo().advertise(topic, STRING)
+    other_process.create_subscription(Int32, topic, lambda _m: None, 10)
+    wait_until(lambda: len(world.subscribers(topic)) == 1, "the other type's reader in the graph")
+    asked: list[str] = []
+    ask = rig.node.get_subscriptions_info_by_topic
+
+    def spy(name: str) -> Any:
+        asked.append(name)
+        return ask(name)
+
+    monkeypatch.setattr(rig.node, "get_subscriptions_info_by_topic", spy)
+    judge = Judge(rig)
+    judge.evaluate()  # another process's node is in the graph: its reader is found
+    assert asked == [topic]
+    assert [f.key.split(":")[0] for f in channel.findings] == ["ros-type"]
+    # The same graph, every node in it taken for the bridge's: nothing is asked, nothing found.
+    every = set(rig.node.get_node_names_and_namespaces())
+    alone = Explainer(rig.gz, rig.bridge.registry, every, judge.logged.append, now=lambda: 0.0)
+    rig.world.run(lambda: alone.evaluate(rig.bridge.channels))
+    assert asked == [topic]
+    assert channel.findings == []
