@@ -15,7 +15,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import replace
 
 from ros_gz_bridge_py.errors import RemoteProtocolError
-from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling
+from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling, spelling_of
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.wire_types import PeerSpellings, RemoteSubscriber
 from ros_gz_bridge_py.transport.zmq.discovery_events import (
@@ -27,6 +27,7 @@ from ros_gz_bridge_py.transport.zmq.discovery_events import (
     SubscriberAdded,
     SubscriberRemoved,
 )
+from ros_gz_bridge_py.transport.zmq.discovery_memo import DatagramMemo
 from ros_gz_bridge_py.transport.zmq.wire import (
     WIRE_VERSION,
     DiscoveryMessage,
@@ -34,7 +35,6 @@ from ros_gz_bridge_py.transport.zmq.wire import (
     MessagePublisher,
     PublisherRecord,
     UnknownMessageTypeError,
-    decode_discovery,
     encode_discovery,
     is_tcp_endpoint,
 )
@@ -51,9 +51,6 @@ ACTIVITY_INTERVAL = 0.1
 SILENCE_INTERVAL = 3.0
 #: Discovery counts as initialised (listings are complete) after two heartbeat cycles.
 INIT_DELAY = 2 * HEARTBEAT_INTERVAL
-#: Distinct datagrams of at most DECODED_SIZE bytes remembered decoded (a peer's records and
-#: heartbeats repeat each second; a few hundred bytes each): at most about 4 MB held.
-DECODED_KEPT, DECODED_SIZE = 2048, 1024
 
 
 def _silent_after(seen: float) -> float:
@@ -73,6 +70,7 @@ class DiscoveryEngine:
         relays: Iterable[str] = (),
         version: int = WIRE_VERSION,
         legacy_spelling: Spelling = Spelling.IGNITION,
+        respelled_nodes: Iterable[str] = (),
     ) -> None:
         self.process_uuid = process_uuid
         self.version = version
@@ -95,10 +93,10 @@ class DiscoveryEngine:
         self.spellings = PeerSpellings(legacy_spelling)
         self._next_heartbeat = now
         self._next_activity = math.inf  # no peer yet
-        # HEARTBEAT and each record's ADVERTISE repeat every second: ours encoded once, what
-        # is heard decoded once (a 50-robot fleet repeats 300 a second: the bridge's rest CPU).
-        self._encoded: dict[tuple[DiscoveryType, PublisherRecord | None], bytes] = {}
-        self._decoded: dict[bytes, DiscoveryMessage] = {}
+        self.memo = DatagramMemo()
+        #: The node ids of the records that announce our publishers under their second
+        #: spelling (docs/protocol-lines.md §9.2), repeated only while a peer may use it.
+        self._respelled_nodes = frozenset(respelled_nodes)
 
     # --- queries -------------------------------------------------------------------------
 
@@ -159,7 +157,7 @@ class DiscoveryEngine:
         if record not in self._local:
             return []
         self._local.remove(record)
-        self._encoded.pop((DiscoveryType.ADVERTISE, record), None)
+        self.memo.forget(record)
         if not any(r.topic == record.topic for r in self._local):
             self._subscribers.pop(record.topic, None)
         if record.scope == Scope.PROCESS:
@@ -218,8 +216,9 @@ class DiscoveryEngine:
         events: list[Event] = []
         if now >= self._next_heartbeat:
             out += self._send(DiscoveryType.HEARTBEAT)
+            spoken = {self.spellings.of(process) for process in self._activity}
             for record in self._local:
-                if record.scope != Scope.PROCESS:
+                if record.scope != Scope.PROCESS and self._repeats(record, spoken):
                     out += self._send(DiscoveryType.ADVERTISE, pub=record)
             self._next_heartbeat = max(self._next_heartbeat + HEARTBEAT_INTERVAL, now)
         if now >= self._next_activity:
@@ -231,6 +230,15 @@ class DiscoveryEngine:
             self._next_activity = self._first_silence()
         return out, events
 
+    def _repeats(self, record: PublisherRecord, spoken: set[Spelling | None]) -> bool:
+        """Whether ``record`` is advertised again this second. The announcement of one of our
+        publishers under its second spelling is, only while a live peer uses that spelling or
+        has not shown its own yet (None in ``spoken``): it was sent when the publisher was made
+        and answers every SUBSCRIBE, and in a simulation of one line nobody reads it."""
+        if record.node_uuid not in self._respelled_nodes:
+            return True
+        return None in spoken or spelling_of(record.msg_type) in spoken
+
     def _first_silence(self) -> float:
         """When the peer heard from longest ago will have been silent too long (an idle I/O
         thread then wakes for heartbeats only, not ten times a second)."""
@@ -240,7 +248,7 @@ class DiscoveryEngine:
         """Handle one datagram from ``source_ip``; never raises on bad input."""
         self.counts["received"] += 1
         try:
-            message = self._decoded.get(data) or self._decode(data)
+            message = self.memo.decode(data)
         except UnknownMessageTypeError as error:
             self.counts["unknown_type"] += 1
             _LOG.debug("discovery: dropped datagram from %s: %s", source_ip, error)
@@ -289,27 +297,11 @@ class DiscoveryEngine:
         topic: str | None = None,
     ) -> list[Outgoing]:
         message = DiscoveryMessage(kind, self.process_uuid, self.version, topic=topic, pub=pub)
-        repeated = kind in (DiscoveryType.HEARTBEAT, DiscoveryType.ADVERTISE)
-        data = self._encoded.get((kind, pub)) if repeated else None
-        if data is None:
-            data = encode_discovery(message)
-            if repeated:
-                self._encoded[kind, pub] = data
-        out = [Outgoing(data)]
+        out = [Outgoing(self.memo.encode(message))]
         if self._relays:
             relayed = encode_discovery(replace(message, relay=True))
             out += [Outgoing(relayed, ip) for ip in self._relays]
         return out
-
-    def _decode(self, data: bytes) -> DiscoveryMessage:
-        """``data`` decoded (raises as :func:`decode_discovery`), kept for its next repeat; a
-        flood of distinct datagrams empties the memo, never grows it past DECODED_KEPT."""
-        message = decode_discovery(data)
-        if len(data) <= DECODED_SIZE:
-            if len(self._decoded) >= DECODED_KEPT:
-                self._decoded.clear()
-            self._decoded[data] = message
-        return message
 
     def _in_scope(self, record: PublisherRecord, source_ip: str) -> bool:
         if record.scope == Scope.PROCESS:

@@ -108,7 +108,9 @@ class ZmqGzNode(ZmqGraphView):
             "relays": self.settings.relays,
             "legacy_spelling": self.settings.legacy_spelling,
         }
-        self._msg = DiscoveryEngine(self.process_uuid, now, **engine_args)
+        self._msg = DiscoveryEngine(
+            self.process_uuid, now, respelled_nodes=(self.respelled_node_uuid,), **engine_args
+        )
         self._srv = DiscoveryEngine(self.process_uuid, now, **engine_args)
         sockets = RouterSockets(
             self._srv, lambda out: self._datagrams(self._io.srv_udp, out), self._io.requester,

@@ -11,7 +11,7 @@ import pytest
 
 from ros_gz_bridge_py.transport.api import Scope
 from ros_gz_bridge_py.transport.wire_types import RemoteSubscriber
-from ros_gz_bridge_py.transport.zmq import discovery
+from ros_gz_bridge_py.transport.zmq import discovery_memo
 from ros_gz_bridge_py.transport.zmq.discovery import (
     ACTIVITY_INTERVAL,
     HEARTBEAT_INTERVAL,
@@ -353,8 +353,8 @@ def test_repeated_datagrams_are_encoded_and_decoded_once(monkeypatch: pytest.Mon
 
         return call
 
-    monkeypatch.setattr(discovery, "encode_discovery", counting("encode", encode_discovery))
-    monkeypatch.setattr(discovery, "decode_discovery", counting("decode", decode_discovery))
+    monkeypatch.setattr(discovery_memo, "encode_discovery", counting("encode", encode_discovery))
+    monkeypatch.setattr(discovery_memo, "decode_discovery", counting("decode", decode_discovery))
     engine = DiscoveryEngine(ME, 0.0)
     engine.advertise(record(ME))
     heard = datagram(DiscoveryType.ADVERTISE, pub=record())
@@ -384,13 +384,46 @@ def test_repeated_datagrams_are_encoded_and_decoded_once(monkeypatch: pytest.Mon
 def test_the_decoded_memo_is_bounded(monkeypatch: pytest.MonkeyPatch) -> None:
     """Distinct datagrams (a hostile sender varies each one) never grow the memo past its
     bound, and large ones are not kept: each is still judged."""
-    monkeypatch.setattr(discovery, "DECODED_KEPT", 8)
+    monkeypatch.setattr(discovery_memo, "DECODED_KEPT", 8)
     engine = DiscoveryEngine(ME, 0.0)
     for i in range(50):
         engine.datagram_received(datagram(DiscoveryType.HEARTBEAT, f"peer-{i}"), "127.0.0.1", 0.0)
-        assert len(engine._decoded) <= 8
-    big = replace(record(), topic="@/p@/" + "x" * discovery.DECODED_SIZE)
+        assert len(engine.memo.decoded()) <= 8
+    big = replace(record(), topic="@/p@/" + "x" * discovery_memo.DECODED_SIZE)
     engine.datagram_received(datagram(DiscoveryType.ADVERTISE, pub=big), "127.0.0.1", 0.0)
-    assert all(len(data) <= discovery.DECODED_SIZE for data in engine._decoded)
+    assert all(len(data) <= discovery_memo.DECODED_SIZE for data in engine.memo.decoded())
     assert engine.remote_publishers(big.topic) == [big]
     assert len(engine.processes()) == 51
+
+
+def test_a_second_spelling_is_repeated_only_while_a_peer_may_use_it() -> None:
+    """Our publisher is announced under both spellings when made and in answer to a SUBSCRIBE;
+    the second announcement is repeated each second only while a live peer uses its spelling
+    or has not shown its line yet."""
+    respelled = "55555555-5555-5555-5555-555555555555"
+    ours = record(ME)  # gz.msgs.StringMsg
+    second = replace(ours, node_uuid=respelled, msg=MessagePublisher("ignition.msgs.StringMsg"))
+    engine = DiscoveryEngine(ME, 0.0, respelled_nodes=[respelled])
+    assert [m.pub for m in sent(engine.advertise(ours) + engine.advertise(second))] == [
+        ours,
+        second,
+    ]
+
+    def repeated(now: float) -> list[PublisherRecord | None]:
+        out, _ = engine.tick(now)
+        return [m.pub for m in sent(out) if m.type == DiscoveryType.ADVERTISE]
+
+    assert repeated(0.0) == [ours]  # no peer
+    subscribe = datagram(DiscoveryType.SUBSCRIBE, topic=TOPIC)
+    answer, _ = engine.datagram_received(subscribe, "127.0.0.1", 0.5)
+    assert [m.pub for m in sent(answer)] == [ours, second]
+    assert repeated(1.0) == [ours, second]  # a peer whose line is not known yet
+    modern = datagram(DiscoveryType.HEARTBEAT, pub=record())  # gz-transport 13+: gz.msgs
+    engine.datagram_received(modern, "127.0.0.1", 1.5)
+    assert repeated(2.0) == [ours]
+    fortress = datagram(DiscoveryType.HEARTBEAT, "66666666-6666-6666-6666-666666666666")
+    engine.datagram_received(fortress, "127.0.0.1", 2.5)  # no record: ignition.msgs
+    assert repeated(3.0) == [ours, second]
+    repeated(6.0)  # both peers silent for over 3 s: forgotten after this second's repeats
+    assert engine.processes() == []
+    assert repeated(7.0) == [ours]
