@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.msgs.names import spellings
+from ros_gz_bridge_py.msgs.names import Spelling, respell, spellings
 from testing.gzpeer import (
     IGN_TOPIC,
     Inbox,
@@ -129,9 +129,14 @@ def test_cpp_echo_receives_our_publisher(ign_peer: Path, gz_node: Any) -> None:
     assert_consecutive(received, sent)
 
 
-def test_cli_lists_our_publisher_with_type_and_address(ign_peer: Path, gz_node: Any) -> None:
+@pytest.mark.parametrize("advertised", [STRING, respell(STRING, Spelling.GZ)])
+def test_cli_lists_our_publisher_with_type_and_address(
+    ign_peer: Path, gz_node: Any, advertised: str
+) -> None:
+    """Advertised as gz.msgs, the ignition.msgs announcement is the second one: the CLI, which
+    only listens for two heartbeats, hears it repeated once our node heard its heartbeat."""
     topic = unique_name("listed")
-    gz_node.advertise(topic, STRING)
+    gz_node.advertise(topic, advertised)
 
     listing = ign_topic("-l", timeout=10)
     info = ign_topic("-i", "-t", topic, timeout=10)
