@@ -33,7 +33,6 @@ on its own context, which is not measured.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import select
 import statistics
@@ -135,8 +134,9 @@ def _use(
     return cpu / 1e9, woke
 
 
-def measure(reader: Reader, io_tids: set[int], seconds: float, syscall_seconds: float) -> Figures:
+def measure(reader: Reader, io_tids: set[int], mode: str, args: argparse.Namespace) -> Figures:
     """The clean window, then the system calls' (see the module docstring)."""
+    seconds, syscall_seconds = args.seconds, args.syscall_seconds
     pid = os.getpid()
     before, taken, began = read_threads(pid), reader.messages, time.monotonic()
     time.sleep(seconds)
@@ -157,7 +157,7 @@ def measure(reader: Reader, io_tids: set[int], seconds: float, syscall_seconds: 
                         totals[name] = totals.get(name, 0) + n
             calls[role] = {name: n / counted_taken for name, n in totals.items()}
     return Figures(
-        "",
+        mode,
         taken / elapsed,
         reader_cpu / per * 1e6,
         reader_woke / per,
@@ -205,10 +205,9 @@ def one_round(address: str, fqns: list[str], mode: str, args: argparse.Namespace
     now = read_threads(os.getpid())
     io_tids = {tid for tid in set(now) - before if now[tid].comm.startswith("ZMQbg/IO")}
     try:
-        figures = measure(reader, io_tids, args.seconds, args.syscall_seconds)
+        return measure(reader, io_tids, mode, args)
     finally:
         reader.close()
-    return dataclasses.replace(figures, mode=mode)
 
 
 def _offered(robots: int) -> float:

@@ -14,28 +14,27 @@ TOPICS = ["@p@/robot_1/odom", "@p@/robot_1/imu"]
 
 def _publish_until_read(shared: bool) -> tuple[int, int]:
     """Messages the reader took of 50 per subscribed topic (and 50 of a topic it does not
-    subscribe), once subscriptions are through; and how many sockets it read."""
+    subscribe, sent first), once the publisher holds every subscription; and how many sockets
+    it read."""
     context = zmq.Context(1)
-    pub = context.socket(zmq.PUB)
+    pub = context.socket(zmq.XPUB)  # it tells each new subscription
     pub.bind("tcp://127.0.0.1:*")
     reader = Reader(pub.getsockopt_string(zmq.LAST_ENDPOINT), TOPICS, shared=shared)
     reader.start()
     try:
+        subscribed: set[str] = set()
+        while not set(TOPICS) <= subscribed:
+            assert pub.poll(10_000), f"subscriptions after 10 s: {sorted(subscribed)}"
+            subscription = pub.recv()
+            if subscription[:1] == b"\x01":
+                subscribed.add(subscription[1:].decode())
+        for topic in ["@p@/robot_2/odom", *TOPICS]:
+            for _ in range(50):
+                pub.send_multipart([topic.encode(), b"sender", b"payload", b"type"])
         deadline = time.monotonic() + 10
-        while reader.messages < len(TOPICS) and time.monotonic() < deadline:
-            for topic in TOPICS:  # until each topic's subscription reached the publisher
-                pub.send_multipart([topic.encode(), b"sender", b"payload", b"type"])
-            time.sleep(0.05)
-        time.sleep(0.2)
-        start = reader.messages
-        for _ in range(50):
-            for topic in [*TOPICS, "@p@/robot_2/odom"]:
-                pub.send_multipart([topic.encode(), b"sender", b"payload", b"type"])
-        expected = start + 50 * len(TOPICS)
-        while reader.messages < expected and time.monotonic() < deadline:
+        while reader.messages < 50 * len(TOPICS) and time.monotonic() < deadline:
             time.sleep(0.01)
-        time.sleep(0.2)  # a message of the topic not subscribed would be counted by now
-        return reader.messages - start, len(reader.sockets)
+        return reader.messages, len(reader.sockets)
     finally:
         reader.close()
         pub.close(0)
