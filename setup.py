@@ -25,6 +25,7 @@ NATIVE_SOURCES = [
     "ros_gz_bridge_py/native/pb_read.c",
     "ros_gz_bridge_py/native/pump.c",
     "ros_gz_bridge_py/native/pump_loop.c",
+    "ros_gz_bridge_py/native/pump_share.c",
     "ros_gz_bridge_py/native/ros_pump.c",
     "ros_gz_bridge_py/native/ros_pump_loop.c",
     "ros_gz_bridge_py/native/transcode.c",

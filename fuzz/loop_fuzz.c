@@ -10,15 +10,17 @@
  * is given are this file's, reading the messages of the input. The frames a Pump hands back are
  * judged by the real Python reader (tests/unit/native/loop_fuzz_host.py: NativeReader and its
  * socket owner), which teaches the pump its routes, as in the bridge. This file embeds Python
- * and reads the configuration; loop_fuzz_pump.c (with loop_fuzz_zmq.c, its fake socket) runs
- * a Pump, loop_fuzz_ros_pump.c a RosPump.
+ * and reads the configuration; loop_fuzz_pump.c (with loop_fuzz_zmq.c, its fake socket, and
+ * loop_fuzz_reference.c, the Python reader's verdicts) runs a Pump, loop_fuzz_ros_pump.c a
+ * RosPump.
  *
  * Input: 4 bytes of configuration, then operations, each an opcode byte (modulo 8). A literal
  * below is a byte below 0x70 (that many bytes follow) or from 0x70 on (a 2-byte little-endian
  * length follows, then the bytes). The configuration's last byte below 0x80: a Pump (its
  * program, the queue's capacity and byte bound, max_rate, the monitor, the watched size, the
  * loop guard's digests; after each turn that published, the guard's is_own is asked of the
- * last publication's bytes, and of other bytes):
+ * last publication's bytes, and of other bytes; and 0x20, whether the pump is the peer of a
+ * reader pump (Pump.share) that reads the socket and is turned instead):
  *   0 MESSAGE  a frame count (1-18), then each frame: a literal, or from 0x80 on a frame of the
  *              dictionary (the topic, topics it prefixes, senders, the program's spellings,
  *              other types, a valid payload, a flood sender, a large payload). The fake SUB

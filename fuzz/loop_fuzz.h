@@ -59,6 +59,11 @@ extern PyObject *module, *host, *host_module;
 PyObject *call(PyObject *object, const char *name, const char *format, ...);
 int bytes_equal(PyObject *object, const struct frame *f);
 
+/* The routes `pump` holds, checked whole; whether the Python reader delivers message `m`, the
+ * reference (loop_fuzz_reference.c). */
+void check_routes(PumpObject *pump);
+int python_takes(const struct message *m);
+
 /* One input whose 4 bytes of configuration are not a RosPump's (loop_fuzz_pump.c). */
 void fuzz_pump(const uint8_t *data, size_t size);
 /* One input whose configuration's last byte is 0x80 or more (loop_fuzz_ros_pump.c). */

@@ -61,47 +61,19 @@ static struct frame dictionary_frame(int p, unsigned index, const uint8_t **data
     return (struct frame){large, (size_t)arg << 10};
 }
 
-/* The routes as the pump holds them: checked whole, and read for the model. */
-static void check_routes(PumpObject *pump) {
-    CHECK(pump->nroutes >= 0 && pump->nroutes <= 1024);
-    for (int i = 0; i < pump->nroutes; i++) {
-        const struct route *r = &pump->routes[i];
-        CHECK(r->program >= -1 && r->program < pump->nprograms);
-        /* found under its own index: no route twice (the newest few: a full check is slow) */
-        if (i + 16 >= pump->nroutes)
-            CHECK(pump_find_route(pump, r->sender, r->sender_len, r->type, r->type_len) == i);
-        if (r->program >= 0)
-            CHECK(pump->programs[r->program].type_len == r->type_len &&
-                  !memcmp(pump->programs[r->program].type, r->type, r->type_len));
-    }
-}
-
-static PyObject *frames_list(const struct message *m, int n) {
-    PyObject *list = PyList_New(n);
-    CHECK(list != NULL);
-    for (int k = 0; k < n; k++)
-        PyList_SET_ITEM(list, k, PyBytes_FromStringAndSize((char *)m->frames[k].data,
-                                                            (Py_ssize_t)m->frames[k].size));
-    return list;
-}
-
-static int python_takes(const struct message *m) {
-    PyObject *frames = frames_list(m, m->n);
-    PyObject *takes = call(host, "takes", "(O)", frames);
-    int result = PyObject_IsTrue(takes);
-    Py_DECREF(takes);
-    Py_DECREF(frames);
-    return result;
-}
-
 /* What the model expects the pump to have done, since the last take_handed or turn. */
 struct expected_handed {
     int kind, message, status;
     size_t items, least;
 };
 
+/* In a shared input (the configuration's 0x20), the pump is a peer of this reader, which the
+ * turns turn: it reads the socket and puts the pump's messages in its queue. */
+static PyObject *reader;
+
 static struct model {
     int p, capacity, rate_limited_all, guarded;
+    unsigned long long read, foreign; /* by the reader: all messages, those of no peer */
     size_t max_bytes, watch_above;
     int ring[MAX_MESSAGES], head, count; /* message indices */
     size_t queued_bytes;
@@ -122,6 +94,10 @@ static void check_counts(PumpObject *pump) {
     CHECK(pump->count == (size_t)model.count && pump->queued_bytes == model.queued_bytes);
     CHECK(pump->nhanded == (size_t)model.nhanded && pump->grown == model.grown);
     CHECK(live == model.count); /* only the queued payloads are open */
+    if (reader == NULL) return;
+    PumpObject *r = (PumpObject *)reader;
+    CHECK(r->taken == model.read && r->skipped == model.foreign && r->nhanded == 0);
+    CHECK(r->count == 0 && r->bytes_read == model.bytes_read && r->published == 0);
 }
 
 static size_t payload_size(int index) { return messages[index].frames[2].size; }
@@ -130,6 +106,12 @@ static size_t payload_size(int index) { return messages[index].frames[2].size; }
 static void model_read(PumpObject *pump, int index) {
     struct message *m = &messages[index];
     int n = m->n < PUMP_FRAMES ? m->n : PUMP_FRAMES;
+    model.read++;
+    if (reader != NULL && !(m->frames[0].size == pump->topic_len &&
+                            !memcmp(m->frames[0].data, pump->topic, pump->topic_len))) {
+        model.foreign++; /* the reader's, skipped: a topic the pump's prefixes */
+        return;
+    }
     model.taken++;
     if (n > 2) {
         model.bytes_read += m->frames[2].size;
@@ -237,15 +219,16 @@ static void check_own(PyObject *pump) {
 /* One turn of the pump, as the loop makes it, and the model's account of it. */
 static void turn(PyObject *object, uint8_t arg) {
     PumpObject *pump = (PumpObject *)object;
+    PumpObject *turned = reader != NULL ? (PumpObject *)reader : pump;
     check_routes(pump);
-    unsigned fired = (arg >> 3) & (pump->monitor != NULL ? 3u : 1u);
+    unsigned fired = (arg >> 3) & (turned->monitor != NULL ? 3u : 1u);
     if ((arg & 0xc0) == 0xc0) fired = RGB_FIRED_ERROR;
     struct rgb_budget budget = {1 + (arg & 7), INT64_MAX / 4}; /* the slice never ends a turn */
     monitor_events = arg & 0x20 ? 1 : 0;
     int first = next_read, handed_before = model.nhanded, was_breaking = breaking;
     int published_before = npublished;
     unsigned long long dropped_before = model.dropped;
-    int result = rgb_pump_hooks.turn(&pump->member, fired, &budget);
+    int result = rgb_pump_hooks.turn(&turned->member, fired, &budget);
     for (int i = first; i < next_read; i++) model_read(pump, i);
     CHECK(next_read - first <= budget.messages);
     int deliveries = model.count < budget.messages ? model.count : budget.messages;
@@ -291,7 +274,7 @@ static void turn(PyObject *object, uint8_t arg) {
     CHECK(!!(result & RGB_EVENT_MONITOR) == ((fired & 2) && monitor_events));
     CHECK(!!(result & RGB_EVENT_HANDED) == (model.nhanded > 0 || model.grown > 0));
     if (was_breaking && !breaking && next_read == first) CHECK(result & RGB_EVENT_BROKEN);
-    CHECK(!(result & RGB_AGAIN) == (!pump->readable && !model.count));
+    CHECK(!(result & RGB_AGAIN) == (!turned->readable && !model.count));
 }
 
 /* take_handed, checked against the model; then the unrouted frames judged by the reader. */
@@ -373,7 +356,13 @@ static PyObject *make_pump(const uint8_t *config) {
     PyObject *pump = call(module, "Pump", "(yOKOndn)", "@/loopfuzz@/model/x/pose", addresses,
                           (unsigned long long)1, programs, (Py_ssize_t)model.capacity,
                           model.rate_limited_all ? 1e-3 : 0.0, (Py_ssize_t)model.max_bytes);
-    Py_DECREF(call(pump, "read_from", "(KK)", (unsigned long long)1,
+    reader = NULL;
+    if (config[3] & 0x20) { /* no publisher, no program: it reads for the pump */
+        reader = call(module, "Pump", "(yOKNndn)", "", addresses, (unsigned long long)0,
+                      PyDict_New(), (Py_ssize_t)1, 0.0, (Py_ssize_t)1);
+        Py_DECREF(call(reader, "share", "([O])", pump));
+    }
+    Py_DECREF(call(reader != NULL ? reader : pump, "read_from", "(KK)", (unsigned long long)1,
                    (unsigned long long)(config[3] & 2 ? 2 : 0)));
     Py_DECREF(call(pump, "watch", "(L)", watch));
     model.guarded = config[3] >> 4 & 1;
@@ -454,7 +443,9 @@ void fuzz_pump(const uint8_t *data, size_t size) {
             break;
         case OP_FORGET:
             take(pump);
+            if (reader != NULL) Py_DECREF(call(reader, "share", "([])")); /* a peer forgets nothing */
             Py_DECREF(call(pump, "forget", "()")); /* closes the queue's payloads */
+            if (reader != NULL) Py_DECREF(call(reader, "share", "([O])", pump));
             model.dropped += model.count; /* counted dropped */
             model.count = model.head = 0;
             model.queued_bytes = 0;
@@ -477,6 +468,8 @@ void fuzz_pump(const uint8_t *data, size_t size) {
     }
     take(pump);
     check_counts((PumpObject *)pump);
+    Py_XDECREF(reader); /* the pump's last reference is the test's */
+    reader = NULL;
     Py_DECREF(pump); /* the queue's payloads are closed with it */
     CHECK(live == 0);
     for (int i = 0; i < nmessages; i++)

@@ -1,4 +1,5 @@
-"""Readings of a running process from ``/proc`` (Linux): CPU time, resident memory, threads."""
+"""Readings of a running process from ``/proc`` (Linux): CPU time, resident memory, threads,
+TCP sockets."""
 
 from __future__ import annotations
 
@@ -44,6 +45,40 @@ def threads_of(process: subprocess.Popen[str]) -> int:
     """The number of threads of a running process."""
     status = Path(f"/proc/{process.pid}/status").read_text(encoding="ascii")
     return int(next(line for line in status.splitlines() if line.startswith("Threads:")).split()[1])
+
+
+@dataclass(frozen=True)
+class TcpSocket:
+    """One IPv4 TCP socket of a process: its ports, and its state."""
+
+    local_port: int
+    remote_port: int
+    listening: bool
+    established: bool
+
+
+#: ``/proc/net/tcp``'s states (include/net/tcp_states.h).
+_ESTABLISHED, _LISTEN = "01", "0A"
+
+
+def tcp_sockets(pid: int) -> list[TcpSocket]:
+    """The IPv4 TCP sockets process ``pid`` holds (its descriptors' sockets, found in its
+    network namespace's ``/proc/net/tcp``)."""
+    inodes = set()
+    for fd in Path(f"/proc/{pid}/fd").iterdir():
+        try:
+            target = os.readlink(fd)
+        except OSError:  # closed meanwhile
+            continue
+        if target.startswith("socket:["):
+            inodes.add(target.removeprefix("socket:[").removesuffix("]"))
+    found = []
+    for line in Path(f"/proc/{pid}/net/tcp").read_text(encoding="ascii").splitlines()[1:]:
+        fields = line.split()
+        if fields[9] in inodes:
+            local, remote = (int(address.rpartition(":")[2], 16) for address in fields[1:3])
+            found.append(TcpSocket(local, remote, fields[3] == _LISTEN, fields[3] == _ESTABLISHED))
+    return found
 
 
 @dataclass(frozen=True)

@@ -335,8 +335,9 @@ def build_bridge(
     ):
         logger.info(
             f"{gz_options.planned_subscriptions} Gazebo topics: the ZeroMQ receive queue of each "
-            f"holds {settings.rcvhwm} messages (GZ_TRANSPORT_RCVHWM sets it; "
-            'docs/many-topics.md, "A fleet\'s memory")'
+            f"topic with a socket of its own holds {settings.rcvhwm} messages, that of the "
+            f"socket the native channels of small messages share {settings.shared_rcvhwm} per "
+            'publisher (GZ_TRANSPORT_RCVHWM sets both; docs/many-topics.md, "A fleet\'s memory")'
         )
     bridge.add_all(spec for source in sources for spec in source.specs)
     patterns: list[TopicPattern] = [p for source in sources for p in source.patterns]

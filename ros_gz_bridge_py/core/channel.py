@@ -9,8 +9,9 @@ closes exactly those (never "everything on this topic").
 
 Threads: Gazebo->ROS messages are decoded, converted and published on the channel's own
 delivery thread (a bounded, drop-oldest queue in the transport; over ZeroMQ the same thread
-reads the topic's own socket), so a heavy topic never delays a light one and never touches
-the ROS executor. ROS->Gazebo messages arrive on the executor.
+reads the topic's own socket), or, for a native channel, on the process's one Gazebo->ROS loop
+within a fairness budget (docs/native.md §5), so a heavy topic never starves a light one and
+never touches the ROS executor. ROS->Gazebo messages arrive on the executor.
 The queue holds at least :data:`MIN_DELIVERY_QUEUE` messages (more if the publisher depth is
 larger) within the transport's byte budget (64 MiB): a burst, or the bridge's threads losing
 the CPU for tens of milliseconds at kilohertz rates, is absorbed instead of dropped, and a flood

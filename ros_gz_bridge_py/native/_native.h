@@ -158,11 +158,11 @@ struct window {
     uint64_t digest; /* rgb_cdr_digest of what was published; 0: not known */
 };
 
-typedef struct {
+typedef struct PumpObject {
     PyObject_HEAD
     struct rgb_member member;
     struct zmq_foreign f;
-    void *publisher;
+    void *publisher; /* NULL: a pump that only reads for its peers (no programs) */
     void *sock, *monitor; /* what the loop reads (read_from), the monitor may be NULL */
     int readable;         /* not known to be empty: read it again before sleeping */
     uint8_t *topic;
@@ -197,6 +197,15 @@ typedef struct {
     uint64_t sequence;
     int guarded; /* (atomic) a subscription of the bridge reads the topic: keep digests */
     struct window windows[PUMP_HISTORY];
+    /* One socket for several topics (`share`): this pump reads the messages of its peers'
+     * topics into their queues and delivers them in its own turns. The peers, by topic hash
+     * (open addressing, `peer_slots` a power of two at least twice their number; NULL: free),
+     * kept alive by `peer_objects`; those with messages queued or handed, in `due`. A peer names
+     * the pump that reads for it (`reader`, borrowed) and reads nothing itself. */
+    PyObject *peer_objects;
+    struct PumpObject **peers, **due, *reader;
+    size_t peer_slots, npeers, ndue;
+    int is_due;
 } PumpObject;
 
 extern const struct rgb_hooks rgb_pump_hooks;
@@ -207,6 +216,15 @@ uint64_t rgb_cdr_digest(const uint8_t *cdr, size_t len);
 uint64_t pump_begin_publication(PumpObject *self, uint64_t digest);
 void pump_end_publication(PumpObject *self, uint64_t sequence, int ok, uint64_t digest);
 void pump_clear_ring(PumpObject *self);
+/* 0, or -1 with a RuntimeError where the pump (or, for a peer, its reader) was never
+ * initialised or (`idle`) its loop runs it; out of a loop and read for by no other. */
+int pump_usable(PumpObject *self, int idle);
+int pump_out_of_loop(PumpObject *self, const char *what);
+/* Reading for peers (pump_share.c): share(peers), and letting them go; where a topic's peer
+ * is looked for first. */
+PyObject *pump_share(PumpObject *self, PyObject *peers);
+void pump_release_peers(PumpObject *self);
+size_t pump_topic_hash(const uint8_t *topic, size_t len);
 void pump_clear_handover(PumpObject *self);
 
 /* ---- a ROS -> Gazebo channel (ros_pump.c, ros_pump_loop.c) --------------------------------- */

@@ -154,6 +154,11 @@ class NativeLoop:
             self._forget(member)
         self._loop.wake()  # the thread ends with the last member
 
+    def exclusive(self) -> threading.RLock:
+        """Held, no member's Python share runs but the holder's (re-entrant: a member's turn
+        may take it, and attach and detach within it)."""
+        return self._turning
+
     def ask(self, member: LoopMember) -> None:
         """Turn ``member`` soon (quick)."""
         with self._lock:

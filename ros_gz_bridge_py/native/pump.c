@@ -17,14 +17,18 @@ _Static_assert(sizeof(struct zmq_foreign) == 9 * sizeof(void *), "the functions,
 /* Routes a full table keeps: the most recently used (and those a waiting message names). */
 #define KEEP_ROUTES (MAX_ROUTES / 2)
 
-static int usable(PumpObject *self, int idle) {
-    return rgb_member_usable(&self->member, idle, "Pump", "the Pump is not initialised");
+/* A peer is as usable as the pump that reads for it (its loop runs both). */
+int pump_usable(PumpObject *self, int idle) {
+    if (rgb_member_usable(&self->member, idle, "Pump", "the Pump is not initialised") < 0)
+        return -1;
+    return self->reader == NULL ? 0 : pump_usable(self->reader, idle);
 }
 
-static int out_of_loop(PumpObject *self, const char *what) {
-    if (usable(self, 0) < 0) return -1;
-    if (self->member.running == NULL) return 0;
-    PyErr_Format(PyExc_RuntimeError, "%s while a loop runs the pump", what);
+int pump_out_of_loop(PumpObject *self, const char *what) {
+    if (pump_usable(self, 0) < 0) return -1;
+    if (self->member.running == NULL && self->reader == NULL) return 0;
+    PyErr_Format(PyExc_RuntimeError, "%s while a loop runs the pump, or another reads for it",
+                 what);
     return -1;
 }
 
@@ -97,6 +101,7 @@ static void evict_routes(PumpObject *self) {
 /* ---- the type ------------------------------------------------------------------------------ */
 
 static void pump_dealloc(PumpObject *self) {
+    pump_release_peers(self);
     if (self->ring != NULL) pump_clear_ring(self);
     free(self->ring);
     pump_clear_handover(self);
@@ -142,8 +147,8 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     int result = -1;
     void *addresses[9];
     if (rgb_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0) goto done;
-    if (publisher == 0 || capacity < 1 || capacity > (1 << 24) || !(max_rate >= 0) ||
-        max_bytes < 1) {
+    if ((publisher == 0 && PyDict_Size(programs) > 0) || capacity < 1 ||
+        capacity > (1 << 24) || !(max_rate >= 0) || max_bytes < 1) {
         PyErr_SetString(PyExc_ValueError, "publisher, capacity, max_rate or max_bytes out of range");
         goto done;
     }
@@ -198,7 +203,8 @@ done:
  * (an address, or 0); only out of a loop. */
 static PyObject *pump_read_from(PumpObject *self, PyObject *args) {
     unsigned long long sock, monitor;
-    if (out_of_loop(self, "read_from") < 0 || !PyArg_ParseTuple(args, "KK", &sock, &monitor))
+    if (pump_out_of_loop(self, "read_from") < 0 ||
+        !PyArg_ParseTuple(args, "KK", &sock, &monitor))
         return NULL;
     self->sock = (void *)(uintptr_t)sock;
     self->monitor = (void *)(uintptr_t)monitor;
@@ -209,7 +215,7 @@ static PyObject *pump_read_from(PumpObject *self, PyObject *args) {
 static PyObject *pump_learn(PumpObject *self, PyObject *args) {
     Py_buffer sender, type;
     int take;
-    if (usable(self, 1) < 0 || !PyArg_ParseTuple(args, "y*y*p", &sender, &type, &take))
+    if (pump_usable(self, 1) < 0 || !PyArg_ParseTuple(args, "y*y*p", &sender, &type, &take))
         return NULL;
     PyObject *result = NULL;
     int program = -1;
@@ -256,7 +262,7 @@ done:
 
 static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     (void)unused;
-    if (out_of_loop(self, "forget") < 0) return NULL;
+    if (pump_out_of_loop(self, "forget") < 0) return NULL;
     self->dropped += self->count + self->nhanded; /* their socket is gone: counted, not lost silently */
     clear_routes(self);
     pump_clear_ring(self);
@@ -294,7 +300,7 @@ static PyObject *handed_item(PumpObject *self, const struct handed *h) {
  * have held is lost and MemoryError raised. */
 static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
     (void)unused;
-    if (usable(self, 1) < 0) return NULL;
+    if (pump_usable(self, 1) < 0) return NULL;
     PyObject *lists[3] = {PyList_New(0), PyList_New(0), PyList_New(0)};
     int failed = lists[0] == NULL || lists[1] == NULL || lists[2] == NULL;
     if (failed) self->lost += self->nhanded;
@@ -327,7 +333,7 @@ static PyObject *pump_take_handed(PumpObject *self, PyObject *unused) {
 
 /* watch(size): payloads larger than `size` are told (Handover.grown); a negative size: none. */
 static PyObject *pump_watch(PumpObject *self, PyObject *arg) {
-    if (usable(self, 1) < 0) return NULL;
+    if (pump_usable(self, 1) < 0) return NULL;
     long long size = PyLong_AsLongLong(arg);
     if (size == -1 && PyErr_Occurred()) return NULL;
     self->watch_above = size < 0 ? SIZE_MAX : (size_t)size;
@@ -398,6 +404,9 @@ static PyObject *pump_guard(PumpObject *self, PyObject *unused) {
 static PyMethodDef pump_methods[] = {
     {"read_from", (PyCFunction)pump_read_from, METH_VARARGS,
      "read_from(sock, monitor): the socket a loop reads (addresses; monitor may be 0)"},
+    {"share", (PyCFunction)pump_share, METH_O,
+     "share(peers): the socket read_from names carries the peers' topics (Pumps), and no "
+     "message of this pump's own"},
     {"learn", (PyCFunction)pump_learn, METH_VARARGS,
      "learn(sender, msg_type, take) -> bool: route messages of (sender, type) natively (take) "
      "or skip them; False where no program takes msg_type"},
@@ -419,7 +428,14 @@ static PyMethodDef pump_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
+static PyObject *pump_handing(PumpObject *self, void *closure) {
+    (void)closure;
+    return PyBool_FromLong(self->nhanded || self->grown);
+}
+
 static PyGetSetDef pump_getset[] = {
+    {"handing", (getter)pump_handing, NULL,
+     "whether take_handed has something (its reader's turns report it for every peer)", NULL},
     {"dropped_sender", (getter)pump_dropped_sender, NULL,
      "the sender of the last payload dropped (b'' before any)", NULL},
     {NULL, NULL, NULL, NULL, NULL},

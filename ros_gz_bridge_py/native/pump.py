@@ -24,8 +24,9 @@ from ros_gz_bridge_py.native import extension
 from ros_gz_bridge_py.native.abi import zmq_functions
 from ros_gz_bridge_py.native.fallback import fallback_worker
 from ros_gz_bridge_py.native.loop import GZ_TO_ROS, PumpMember, shared_loop
+from ros_gz_bridge_py.native.socket_reader import SocketReader
 from ros_gz_bridge_py.transport import MessageInfo
-from ros_gz_bridge_py.transport.api import NativeHost
+from ros_gz_bridge_py.transport.api import NativeHost, NativeSocketReader
 
 if TYPE_CHECKING:
     from ros_gz_bridge_py.native._native import Program, Pump
@@ -71,6 +72,7 @@ class ChannelPump(PumpMember):
         )
         self._loop = shared_loop(GZ_TO_ROS)
         self._host: NativeHost | None = None
+        self._reader: SocketReader | None = None  # while another reads the channel's topic
         self._holding = False  # the publisher's handle, while the loop publishes on it
         self._failed = failed
         self._counted = counted
@@ -99,14 +101,41 @@ class ChannelPump(PumpMember):
             self._holding = True
         self._join()
 
+    def socket_reader(self, sock: int, monitor: int, host: NativeHost) -> SocketReader:
+        """A reader of ``sock`` (with its connection ``monitor``) on this channel's loop, for
+        the channels :meth:`attach_shared` gives it; ``host`` is the socket's owner."""
+        return SocketReader(sock, monitor, host)
+
+    def attach_shared(self, reader: NativeSocketReader, host: NativeHost) -> None:
+        """Take the topic's messages from ``reader``'s socket (made by :meth:`socket_reader`),
+        no route known yet; ``host`` does the topic's share on the loop's thread."""
+        if not isinstance(reader, SocketReader):
+            msg = f"not a native socket reader: {reader!r}"
+            raise TypeError(msg)
+        self._host = host
+        self.pump.forget()
+        if not self._holding:
+            self._handle.__enter__()  # the publisher stays while the loop publishes on it
+            self._holding = True
+        self._reader = reader
+        reader.add(self)
+
     def detach(self) -> None:
-        """Returns once the loop no longer reads the socket."""
+        """Returns once the loop no longer reads the socket, nor a reader for the channel."""
+        if self._reader is not None:
+            self._reader.remove(self)
+            self._reader = None
         self._loop.detach(self)
         self._release()
 
     def wake(self) -> None:
-        """The host wants a turn soon (any thread)."""
-        self._loop.ask(self)
+        """The host wants a turn soon (any thread): the loop turns the channel, or the
+        reader that reads for it."""
+        reader = self._reader
+        if reader is not None:
+            reader.wake()
+        else:
+            self._loop.ask(self)
 
     def watch(self, size: int | None) -> None:
         """Payloads larger than ``size`` are told to the host (None: none); on the loop's

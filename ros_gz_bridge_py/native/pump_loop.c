@@ -35,6 +35,10 @@ static uint64_t fnv1a(uint64_t hash, const uint8_t *data, size_t len) {
     return hash;
 }
 
+size_t pump_topic_hash(const uint8_t *topic, size_t len) {
+    return (size_t)fnv1a(0xcbf29ce484222325ULL, topic, len);
+}
+
 uint64_t rgb_cdr_digest(const uint8_t *cdr, size_t len) {
     if (len >= 4) {
         size_t pad = cdr[3] & 3u;
@@ -166,9 +170,30 @@ static void keep(PumpObject *self, zmq_msg *payload, int route) {
 
 /* ---- reading ------------------------------------------------------------------------------- */
 
+/* The pump a message of topic frame `topic` is for. A pump that reads for no peer takes
+ * every message its socket brings (Python judges what is not its topic's); one that reads
+ * for peers, only its peers' topics' (a frame no peer takes is nobody's: ZeroMQ filters by
+ * prefix, and lets through other topics that one of ours prefixes). */
+static PumpObject *pump_for(PumpObject *self, const uint8_t *topic, size_t len) {
+    if (self->peer_slots == 0) return self;
+    size_t mask = self->peer_slots - 1;
+    for (size_t i = pump_topic_hash(topic, len) & mask;; i = (i + 1) & mask) {
+        PumpObject *peer = self->peers[i];
+        if (peer == NULL) return NULL;
+        if (peer->topic_len == len && !memcmp(peer->topic, topic, len)) return peer;
+    }
+}
+
+static void make_due(PumpObject *self, PumpObject *peer) {
+    if (peer != self && !peer->is_due) {
+        peer->is_due = 1;
+        self->due[self->ndue++] = peer;
+    }
+}
+
 /* Reads one message: 1 when one was read, 0 when none was waiting, -1 when the socket cannot
- * be read (its context terminated, or it is closed). */
-static int read_message(PumpObject *self) {
+ * be read (its context terminated, or it is closed). `*to` is the pump it was for. */
+static int read_message(PumpObject *self, PumpObject **to) {
     zmq_msg frames[PUMP_FRAMES];
     int n = 0, more = 1, extra = 0;
     while (more) {
@@ -189,29 +214,42 @@ static int read_message(PumpObject *self) {
         }
     }
     self->taken++;
+    PumpObject *pump = pump_for(self, self->f.msg_data(&frames[0]), self->f.msg_size(&frames[0]));
+    *to = pump;
+    if (pump == NULL) { /* another topic's */
+        self->skipped++;
+        for (int i = 0; i < n; i++) self->f.msg_close(&frames[i]);
+        return 1;
+    }
+    if (pump != self) {
+        pump->taken++;
+        make_due(self, pump);
+    }
     if (n > 2) {
         size_t size = self->f.msg_size(&frames[2]);
         self->bytes_read += size;
-        if (size > self->watch_above && size > self->grown) self->grown = size;
+        if (pump != self) pump->bytes_read += size;
+        if (size > pump->watch_above && size > pump->grown) pump->grown = size;
     }
     int route = -1;
-    if (n == 4 && !extra && self->f.msg_size(&frames[0]) == self->topic_len &&
-        !memcmp(self->f.msg_data(&frames[0]), self->topic, self->topic_len)) {
-        route = pump_find_route(self, self->f.msg_data(&frames[1]), self->f.msg_size(&frames[1]),
+    if (n == 4 && !extra && self->f.msg_size(&frames[0]) == pump->topic_len &&
+        !memcmp(self->f.msg_data(&frames[0]), pump->topic, pump->topic_len)) {
+        route = pump_find_route(pump, self->f.msg_data(&frames[1]), self->f.msg_size(&frames[1]),
                                 self->f.msg_data(&frames[3]), self->f.msg_size(&frames[3]));
-        if (route >= 0) self->routes[route].used = self->taken;
+        if (route >= 0) pump->routes[route].used = pump->taken;
     }
-    if (route >= 0 && self->routes[route].program >= 0) {
-        keep(self, &frames[2], route);
+    if (route >= 0 && pump->routes[route].program >= 0) {
+        keep(pump, &frames[2], route);
         self->f.msg_close(&frames[0]);
         self->f.msg_close(&frames[1]);
         self->f.msg_close(&frames[3]);
         return 1;
     }
-    if (route >= 0) /* a spelling already taken from this publisher: not ours */
-        self->skipped++;
-    else
-        hand_frames(self, HANDED_UNROUTED, -1, 0, frames, n);
+    if (route >= 0) { /* a spelling already taken from this publisher: not ours */
+        pump->skipped++;
+    } else {
+        hand_frames(pump, HANDED_UNROUTED, -1, 0, frames, n);
+    }
     for (int i = 0; i < n; i++) self->f.msg_close(&frames[i]);
     return 1;
 }
@@ -293,6 +331,46 @@ static int monitor_ready(PumpObject *self) {
            (events & ZMQ_POLLIN_);
 }
 
+/* Delivers `pump`'s queue: at most the budget's messages, and none after `slice_end`. */
+static void deliver_queue(PumpObject *pump, const struct rgb_budget *budget, int64_t slice_end) {
+    for (int i = 0; i < budget->messages && pump->count; i++) {
+        struct queued *q = &pump->ring[pump->head];
+        pump->head = (pump->head + 1) % pump->capacity;
+        pump->count--;
+        pump->queued_bytes -= pump->f.msg_size(&q->payload);
+        deliver(pump, q);
+        pump->f.msg_close(&q->payload);
+        if (rgb_now_ns(CLOCK_MONOTONIC) >= slice_end) break;
+    }
+}
+
+/* Delivers the queues of the peers that took messages, each within the budget, until the
+ * slice ends; the next turn begins with the first not reached. A peer stays due while it has
+ * messages queued (RGB_AGAIN) or something for Python (RGB_EVENT_HANDED, at every turn until
+ * Python takes it, as a pump's own turns say). */
+static int deliver_peers(PumpObject *self, const struct rgb_budget *budget, int64_t slice_end) {
+    int events = 0;
+    size_t reached = 0, kept = 0;
+    if (self->ndue == 0) return 0;
+    while (reached < self->ndue && (reached == 0 || rgb_now_ns(CLOCK_MONOTONIC) < slice_end)) {
+        PumpObject *peer = self->due[reached++];
+        deliver_queue(peer, budget, slice_end);
+        if (peer->nhanded || peer->grown) events |= RGB_EVENT_HANDED;
+        if (peer->count) events |= RGB_AGAIN;
+        if (peer->count || peer->nhanded || peer->grown) self->due[kept++] = peer;
+        else peer->is_due = 0;
+    }
+    if (reached < self->ndue) events |= RGB_AGAIN;
+    /* not reached first, then those turned that still have messages */
+    size_t rest = self->ndue - reached;
+    PumpObject **turned = self->due + self->npeers; /* scratch beyond the live entries */
+    memcpy(turned, self->due, kept * sizeof *turned);
+    memmove(self->due, self->due + reached, rest * sizeof *self->due);
+    memcpy(self->due + rest, turned, kept * sizeof *turned);
+    self->ndue = rest + kept;
+    return events;
+}
+
 /* Reads until the socket is empty or the budget is spent, then delivers. The read also ends
  * early once a payload outgrew the watched size, so the socket's owner replaces the socket
  * before a budget more of them arrive, and once the copies handed to Python hold max_bytes, so
@@ -305,21 +383,15 @@ static int turn(struct rgb_member *m, unsigned fired, const struct rgb_budget *b
     if ((fired & 2) && monitor_ready(self)) events |= RGB_EVENT_MONITOR;
     if (fired & 1) self->readable = 1;
     for (int i = 0; self->readable && i < budget->messages; i++) {
-        int read = read_message(self);
+        PumpObject *to = self;
+        int read = read_message(self, &to);
         if (read <= 0) self->readable = 0;
         if (read < 0) events |= RGB_EVENT_BROKEN;
-        if (self->grown || self->handed_bytes >= self->max_bytes) break;
+        if (to != NULL && (to->grown || to->handed_bytes >= to->max_bytes)) break;
     }
     int64_t slice_end = rgb_now_ns(CLOCK_MONOTONIC) + budget->slice_ns;
-    for (int i = 0; i < budget->messages && self->count; i++) {
-        struct queued *q = &self->ring[self->head];
-        self->head = (self->head + 1) % self->capacity;
-        self->count--;
-        self->queued_bytes -= self->f.msg_size(&q->payload);
-        deliver(self, q);
-        self->f.msg_close(&q->payload);
-        if (rgb_now_ns(CLOCK_MONOTONIC) >= slice_end) break;
-    }
+    deliver_queue(self, budget, slice_end);
+    events |= deliver_peers(self, budget, slice_end);
     if (self->nhanded || self->grown) events |= RGB_EVENT_HANDED;
     return events | (self->readable || self->count ? RGB_AGAIN : 0);
 }

@@ -173,6 +173,17 @@ class NativeHost(Protocol):
         ...
 
 
+class NativeSocketReader(Protocol):
+    """A socket a :class:`NativeLoop` reads for several subscriptions of one node (their
+    topics' small messages through one connection per publisher, docs/native.md §5)."""
+
+    def wake(self) -> None:
+        """Calls its host's ``native_turn`` soon (from any thread)."""
+
+    def close(self) -> None:
+        """Returns once the loop no longer reads the socket."""
+
+
 class NativeLoop(Protocol):
     """A per-message loop that reads a subscription's ZeroMQ socket outside Python
     (``native/pump.py``, on the process's one loop thread, ``native/loop.py``); the ZeroMQ
@@ -186,8 +197,19 @@ class NativeLoop(Protocol):
         """Read ``sock`` (a socket's address, with its connection ``monitor``) from now on;
         ``host.native_turn`` runs on the loop's thread. No route is known at first."""
 
+    def socket_reader(self, sock: int, monitor: int, host: NativeHost) -> NativeSocketReader:
+        """A reader of ``sock`` (with its connection ``monitor``) on this loop for several
+        subscriptions (:meth:`attach_shared`); ``host.native_turn`` runs on the loop's thread
+        for the socket's own share (its connections, posted commands)."""
+        ...
+
+    def attach_shared(self, reader: NativeSocketReader, host: NativeHost) -> None:
+        """Take this subscription's messages from ``reader``'s socket from now on;
+        ``host.native_turn`` runs on the loop's thread. No route is known at first."""
+
     def detach(self) -> None:
-        """Returns once the loop no longer touches the sockets."""
+        """Returns once the loop no longer touches the sockets, nor a reader the
+        subscription."""
 
     def wake(self) -> None:
         """Calls ``host.native_turn`` soon (from any thread)."""

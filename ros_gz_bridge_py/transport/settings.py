@@ -134,6 +134,11 @@ class TransportSettings:
     srv_port: int = DEFAULT_SRV_PORT
     relays: tuple[str, ...] = ()
     rcvhwm: int = DEFAULT_HWM
+    #: The receive HWM of the socket the native channels of small messages share
+    #: (``zmq/shared_sub.py``): one pipe per publisher carries all their topics, as in a
+    #: gz-transport node, so gz-transport's own mark (GZ_TRANSPORT_RCVHWM, else 1000) rather
+    #: than :func:`planned_rcvhwm`'s share of one topic.
+    shared_rcvhwm: int = DEFAULT_HWM
     sndhwm: int = DEFAULT_HWM
     #: GZ_TRANSPORT_MAX_MESSAGE_SIZE: larger messages are refused before they are buffered.
     max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE
@@ -159,6 +164,7 @@ class TransportSettings:
         if srv_port == msg_port:
             srv_port = msg_port - 1 if msg_port == MAX_PORT else msg_port + 1
         relays = tuple(ip for ip in (lookup(env, "RELAY") or "").split(":") if ip)
+        rcvhwm = _positive(env, "TRANSPORT_RCVHWM", -1)  # -1: not set
         return cls(
             partition=default_partition(env) if partition is None else partition,
             ip=lookup(env, "IP") or None,
@@ -166,7 +172,8 @@ class TransportSettings:
             msg_port=msg_port,
             srv_port=srv_port,
             relays=relays,
-            rcvhwm=_positive(env, "TRANSPORT_RCVHWM", planned_rcvhwm(planned_subscriptions)),
+            rcvhwm=planned_rcvhwm(planned_subscriptions) if rcvhwm < 0 else rcvhwm,
+            shared_rcvhwm=DEFAULT_HWM if rcvhwm < 0 else rcvhwm,
             sndhwm=_positive(env, "TRANSPORT_SNDHWM", DEFAULT_HWM),
             max_message_size=_max_message_size(env),
             credentials=_credentials(env),

@@ -2,7 +2,9 @@
 
 A fleet in one process: the bridge's thread count must not grow with its native channels, nor
 with those whose payloads fall back to Python, every channel's messages must flow, and a flooded
-channel must not starve a light one. The Gazebo side
+channel must not starve a light one. The channels of small messages share one SUB socket: one
+TCP connection per publisher carries all their topics, and a topic whose messages outgrow it
+moves to a socket of its own. The Gazebo side
 is the C++ Fortress peer (one process publishing many topics, as a simulator does); the ROS side
 an rclpy node of this process; the bridge a real ``parameter_bridge`` process.
 """
@@ -11,6 +13,7 @@ from __future__ import annotations
 
 import os
 import time
+from pathlib import Path
 
 import pytest
 from std_msgs.msg import String
@@ -18,7 +21,7 @@ from std_msgs.msg import String
 from ros_gz_bridge_py.native import extension
 from testing.behaviour_harness import STRING, WAIT, RosSide, ros_side, start_bridge, started
 from testing.gzpeer import PeerProcess, require_peer, start_peer, unique_name, wait_until
-from testing.procstat import threads_of
+from testing.procstat import tcp_sockets, threads_of
 
 __all__ = ["ros_side", "started"]
 
@@ -47,6 +50,9 @@ NUL_TEXT = 'data: "fell\\000back"'
 FELL = 3
 #: Seconds a thread count must hold to count as settled.
 THREADS_SETTLE = 1.0
+#: The bridge's byte budget per queue in the growth test: the shared socket's 1000-message
+#: queue then holds payloads of 1 kB within it, and the flood's 2 kB outgrow it.
+SMALL_BUDGET = 1_000_000
 
 
 def require_native() -> None:
@@ -58,9 +64,13 @@ def require_native() -> None:
         pytest.skip("ROS_GZ_BRIDGE_NATIVE=off: every channel takes the Python path")
 
 
-def bridge_of(topics: list[str], started: list[PeerProcess]) -> PeerProcess:
+def bridge_of(
+    topics: list[str], started: list[PeerProcess], ros_args: tuple[str, ...] = ()
+) -> PeerProcess:
     bridge = start_bridge(
-        *(f"{topic}@std_msgs/msg/String[{STRING}" for topic in topics), creating=len(topics)
+        *(f"{topic}@std_msgs/msg/String[{STRING}" for topic in topics),
+        ros_args=ros_args,
+        creating=len(topics),
     )
     started.append(bridge)
     return bridge
@@ -102,6 +112,60 @@ def test_the_thread_count_does_not_grow_with_native_channels(
     # One native loop for all: 30 channels cost no thread of their own (a thread per channel
     # gave the large bridge 30 more).
     assert large_threads <= small_threads + 2, (small_threads, large_threads)
+
+
+def test_one_connection_carries_the_small_topics_of_a_publisher(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    """A socket per topic had a TCP connection per topic to the simulator's PUB socket, each
+    message a wake-up of libzmq's I/O thread and of the loop of its own; one socket for the
+    channels of small messages has one connection per publishing process, as a Gazebo
+    subscriber has."""
+    require_peer()
+    require_native()
+    base = unique_name("shared")
+    topics = [f"{base}_{i}" for i in range(SMALL * 4)]
+    publisher = start_peer("pub-many", STRING, "50", 'data: "fleet"', *topics)
+    started.append(publisher)
+    bridge = bridge_of(topics, started)
+    flowing(ros_side, topics)
+    listening = {s.local_port for s in tcp_sockets(publisher.pid) if s.listening}
+    connected = [s for s in tcp_sockets(bridge.pid) if s.established]
+    assert len([s for s in connected if s.remote_port in listening]) == 1, connected
+
+
+def test_a_topic_whose_messages_outgrow_the_shared_socket_takes_one_of_its_own(
+    ros_side: RosSide, started: list[PeerProcess], tmp_path: Path
+) -> None:
+    """Within a budget of 1 MB a queue, the shared socket holds 1000 messages of 1 kB from a
+    publisher: a topic whose messages are 2 kB takes a socket of its own (its receive queue
+    holds what fits the budget), so the bridge holds a second connection to their publisher,
+    and both topics keep flowing."""
+    require_peer()
+    require_native()
+    grows, stays = unique_name("grows"), unique_name("stays")
+    spec = tmp_path / "two.spec"
+    spec.write_text(
+        f'pub {STRING} 20 {stays} data: "fleet"\npub {STRING} 20 {grows} data: "{FLOOD_TEXT}"\n',
+        encoding="utf-8",
+    )
+    publisher = start_peer("pub-fleet", str(spec), "0")
+    started.append(publisher)
+    bridge = bridge_of([grows, stays], started, ("-p", f"max_queued_bytes:={SMALL_BUDGET}"))
+    flowing(ros_side, [stays])
+    inbox = ros_side.subscribe(String, grows, 1000)[0]
+    inbox.wait_for_count(10, WAIT * 2)
+    assert {message.data for message, _ in inbox.items()} == {FLOOD_TEXT}
+    listening = {s.local_port for s in tcp_sockets(publisher.pid) if s.listening}
+
+    def connections() -> int:
+        connected = tcp_sockets(bridge.pid)
+        return len([s for s in connected if s.established and s.remote_port in listening])
+
+    wait_until(lambda: connections() == 2, WAIT, "a socket of its own for the grown topic")
+    count = len(inbox.items())
+    inbox.wait_for_count(count + 10, WAIT)
+    flowing(ros_side, [stays])
 
 
 def test_a_flooded_channel_does_not_starve_a_light_one(

@@ -1,5 +1,7 @@
 """Where a ZeroMQ node's data comes in: the shared SUB socket and the queued subscriptions'
-readers, connected to publishers as discovery learns them and disconnected when they go.
+readers (the native channels of small messages through a SUB socket of their own, which they
+share: ``shared_sub.py``), connected to publishers as discovery learns them and disconnected
+when they go.
 
 §2.8.1 step 4 connects a SUB socket once per publisher address. We also disconnect: when
 the last remote record at an address goes away for a topic (UNADVERTISE, BYE, a process
@@ -17,10 +19,12 @@ import logging
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, cast
 
+from ros_gz_bridge_py.transport.api import NativeLoop
 from ros_gz_bridge_py.transport.handles import Subscription
 from ros_gz_bridge_py.transport.throttle import Throttle
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
 from ros_gz_bridge_py.transport.zmq.reader import NativeReader, SubscriptionReader
+from ros_gz_bridge_py.transport.zmq.shared_sub import SharedSub
 from ros_gz_bridge_py.transport.zmq.socket_owner import Topic
 from ros_gz_bridge_py.transport.zmq.sockets import NodeSockets
 from ros_gz_bridge_py.transport.zmq.wire import PublisherRecord
@@ -52,6 +56,7 @@ class DataIntake:
             what="the node's SUB socket",
         )
         self._warning = Throttle(WARN_PERIOD)
+        self._native_sub: SharedSub | None = None
 
     @property
     def received(self) -> int:
@@ -61,20 +66,38 @@ class DataIntake:
     def open_reader(
         self, sub: Subscription, size: int, on_start: Callable[[], None] | None, max_bytes: int
     ) -> Reader:
-        """A queued subscription's own SUB socket, read on a thread of its own or, where a
-        native loop reads it (``sub.native``), on that loop's (``reader.py``)."""
+        """A queued subscription's reader: its own SUB socket, read on a thread of its own
+        or, where a native loop reads it (``sub.native``), on that loop's, shared with the
+        node's other native channels unless its messages are large by nature (``reader.py``)."""
         node = self._node
         topic = Topic(
             sub.fqn, node.partition, sub.accepts_from, sub.accepts, sub.reject, node.settings,
             node.count, max_bytes, sub.large_messages,
         )  # fmt: skip
-        reader: Reader = (
-            SubscriptionReader(self._context, topic, deliver=sub.run, size=size, on_start=on_start)
-            if sub.native is None
-            else NativeReader(self._context, topic, deliver=sub.run, size=size, native=sub.native)
-        )
+        native = sub.native
+        if native is None:
+            reader: Reader = SubscriptionReader(
+                self._context, topic, deliver=sub.run, size=size, on_start=on_start
+            )
+        else:
+            shared = None if sub.large_messages else self._shared_sub(native)
+            reader = NativeReader(
+                self._context, topic, deliver=sub.run, size=size, native=native, shared=shared
+            )
         self.readers.append(reader)
         return reader
+
+    def _shared_sub(self, native: NativeLoop) -> SharedSub:
+        """The socket the native channels of small messages share, made with the first."""
+        if self._native_sub is None:
+            node = self._node
+            self._native_sub = SharedSub(self._context, node.settings, node.count, native)
+        return self._native_sub
+
+    def close(self) -> None:
+        """The native channels' shared socket goes (before the node's context)."""
+        if self._native_sub is not None:
+            self._native_sub.close()
 
     def close_reader(self, reader: Reader) -> None:
         if reader in self.readers:

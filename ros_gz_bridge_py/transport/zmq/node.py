@@ -7,12 +7,14 @@ services, :mod:`~.discovery`) and the sockets of docs/protocol-zmq-discovery.md 
 by :mod:`~.routes`, and what discovery knows is answered by :class:`~.node_graph.ZmqGraphView`.
 
 Threading model: one I/O thread (``gz-io``) owns the discovery engines and every socket
-except PUB and the queued subscriptions' own SUB sockets; other threads post commands to it
+except PUB, the queued subscriptions' own SUB sockets and the one the native channels of small
+messages share (:mod:`~.shared_sub`); other threads post commands to it
 (and wait for a result where there is one). Publishing threads use PUB under a lock. Callbacks
 of subscriptions without a queue, service handlers and ``request_async`` callbacks run on the
 I/O thread, so they must be quick; a queued subscription reads its own SUB socket on its own
-thread (:mod:`~.reader`). Bad network input never raises out of the I/O thread: it is counted
-in ``stats`` and logged at debug level; a raising callback is logged and counted.
+thread, or the native Gazebo -> ROS loop reads it, or the shared one, on its (:mod:`~.reader`).
+Bad network input never raises out of the I/O thread: it is counted in ``stats`` and logged at
+debug level; a raising callback is logged and counted.
 """
 
 from __future__ import annotations
@@ -142,6 +144,7 @@ class ZmqGzNode(ZmqGraphView):
         # context (and every socket with it) goes.
         for publisher in list(self._own_socket_publishers):
             publisher.stop_senders()
+        self._intake.close()
         self._io.release()
 
     def _post(self, command: Callable[[], None]) -> None:

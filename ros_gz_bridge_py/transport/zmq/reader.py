@@ -12,7 +12,9 @@ read and delivered by one thread, the one its driver gives it:
 - :class:`NativeReader`: the process's one native Gazebo -> ROS loop (``native/loop.py``)
   reads and publishes the messages itself, so that a fleet of robots costs no thread per topic,
   and runs :meth:`NativeReader.native_turn` only for what it hands back and for the owner's own
-  share (connections, posted commands, intra-process messages).
+  share (connections, posted commands, intra-process messages). A topic of small messages is
+  read through the socket the node's native channels share (``shared_sub.py``), until its
+  payloads outgrow it; the others through a socket owner of their own.
 
 Either way, the newest ``size`` messages (and at most ``max_bytes`` of them) the driver delivers
 itself wait in the transport's one :class:`~ros_gz_bridge_py.transport.delivery.DropOldestQueue`;
@@ -47,7 +49,8 @@ from ros_gz_bridge_py.transport.delivery import (
     payload_size,
 )
 from ros_gz_bridge_py.transport.heap import BurstTrimmer
-from ros_gz_bridge_py.transport.zmq.socket_owner import SocketOwner, Topic
+from ros_gz_bridge_py.transport.zmq.shared_sub import SharedSub
+from ros_gz_bridge_py.transport.zmq.socket_owner import SocketOwner, Topic, Verdicts, watch_size
 from ros_gz_bridge_py.transport.zmq.wire import DATA_FRAMES, Frame
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
@@ -72,8 +75,13 @@ class _Driver:
     """What both drivers share: the owner, the queue of the messages the driver delivers, and
     closing (see the module docstring)."""
 
+    #: The topic's own socket (None: none, the topic is read through a shared one).
+    _owner: SocketOwner | None
+
     def __init__(self, context: Any, topic: Topic, *, deliver: Deliver, size: int) -> None:
         self.fqn = topic.fqn
+        self._context = context
+        self._topic = topic
         self._received = 0
         self._deliver = deliver
         self._reject = topic.reject
@@ -84,27 +92,33 @@ class _Driver:
         self._warning = DropWarning(topic.fqn, size, topic.max_bytes)
         self._trimmer = BurstTrimmer()
         self._closed = False
-        self._owner = SocketOwner(
-            context,
-            topic,
+
+    def _own_socket(self, largest: int = 0) -> SocketOwner:
+        """A socket of the topic's own (``largest``: a payload size its queue must hold)."""
+        return SocketOwner(
+            self._context,
+            self._topic,
             keep=self._keep,
             wake=self._wake,
             replacing=self._replacing,
             replaced=self._replaced,
+            largest=largest,
         )
 
     # --- from any thread --------------------------------------------------------------------
 
     def connect(self, address: str) -> None:
         """Connect to a publisher of the topic (once per address)."""
-        if not self._closed:
-            self._owner.post(lambda: self._owner.connections.connect(address))
+        owner = self._owner
+        if not self._closed and owner is not None:
+            owner.post(lambda: owner.connections.connect(address))
 
     def leave(self, address: str) -> None:
         """Stop connecting to ``address`` soon: no publisher of the topic is there any more
         (``SubConnections.leave``)."""
-        if not self._closed:
-            self._owner.post(lambda: self._owner.connections.leave(address))
+        owner = self._owner
+        if not self._closed and owner is not None:
+            owner.post(lambda: owner.connections.leave(address))
 
     @property
     def received(self) -> int:
@@ -176,6 +190,7 @@ class SubscriptionReader(_Driver):
         self._wake_w.setblocking(False)
         self._wake_fd = self._wake_r.fileno()
         super().__init__(context, topic, **driver)
+        self._owner: SocketOwner = self._own_socket()
         self._on_start = on_start
         name = f"gz-sub {self._owner.name}"
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
@@ -250,18 +265,32 @@ class SubscriptionReader(_Driver):
 
 
 class NativeReader(_Driver):
-    """A socket owner read by a native loop (``NativeLoop``, the process's Gazebo -> ROS loop):
-    its share runs on the loop's thread (``NativeHost``)."""
+    """A subscription read by a native loop (``NativeLoop``, the process's Gazebo -> ROS loop),
+    its share run on the loop's thread (``NativeHost``): through the node's shared socket
+    (``shared``: ``shared_sub.py``) until its payloads outgrow the shared queue's byte budget,
+    then, as a topic large by nature from the start, through a socket owner of its own."""
 
     def __init__(
-        self, context: Any, topic: Topic, *, native: NativeLoop, **driver: Unpack[Driven]
+        self,
+        context: Any,
+        topic: Topic,
+        *,
+        native: NativeLoop,
+        shared: SharedSub | None,
+        **driver: Unpack[Driven],
     ) -> None:
         self._native = native
         self._native_dropped = 0
-        self._topic_frame = topic.fqn.encode()
+        self.topic_frame = topic.fqn.encode()
         super().__init__(context, topic, **driver)
-        native.watch(self._owner.watch)
-        native.attach(self._owner.sock.underlying, self._owner.connections.monitor.underlying, self)
+        self._verdicts = Verdicts(topic)
+        self._shared = shared
+        self._owner: SocketOwner | None = None
+        if shared is not None:
+            native.watch(watch_size(shared.settings.shared_rcvhwm, topic.max_bytes))
+            shared.add(self, native)
+        else:
+            self._attach(self._own_socket())
 
     @property
     def received(self) -> int:
@@ -273,13 +302,48 @@ class NativeReader(_Driver):
         """Messages dropped so far, oldest first, by the native loop too."""
         return self._pending.dropped + self._native_dropped
 
+    def connect(self, address: str) -> None:
+        shared = self._shared
+        if shared is None:
+            super().connect(address)
+        elif not self._closed:
+            shared.connect(address, self)
+
+    def leave(self, address: str) -> None:
+        shared = self._shared
+        if shared is None:
+            super().leave(address)
+        elif not self._closed:
+            shared.leave(address, self)
+
     def close(self) -> None:
-        """Off the loop, then the socket goes; pending messages are discarded. Idempotent."""
+        """Off the loop, then the socket or the topic's subscription goes; pending messages
+        are discarded. Idempotent."""
         if self._closed:
             return
         self._closed = True
         self._native.detach()
-        self._owner.release()
+        if self._owner is not None:
+            self._owner.release()
+        if self._shared is not None:
+            self._shared.remove(self)
+
+    # --- the shared socket's (shared_sub.py), on the loop's thread ---------------------------
+
+    def take(self, frames: list[Frame]) -> None:
+        """A message of the topic read from the shared socket by Python (before a
+        disconnect)."""
+        verdict = self._verdicts.verdict(frames)
+        if isinstance(verdict, MessageInfo):
+            self._keep(frames[2], verdict)
+        elif verdict is not None:
+            self._reject(*verdict)
+
+    def refused(self, address: str) -> None:
+        """libzmq refused a message from ``address`` for its size (perhaps another topic's)."""
+        self._reject(*self._verdicts.refused(address))
+
+    # --- the driver's hooks -----------------------------------------------------------------
 
     def _wake(self) -> None:
         self._native.wake()
@@ -288,15 +352,44 @@ class NativeReader(_Driver):
         self._native.detach()  # on the loop's thread: at once (its queue is dropped)
 
     def _replaced(self) -> None:
-        owner = self._owner
+        if self._owner is not None:
+            self._attach(self._owner)
+
+    def _attach(self, owner: SocketOwner) -> None:
+        self._owner = owner
         self._native.watch(owner.watch)
         self._native.attach(owner.sock.underlying, owner.connections.monitor.underlying, self)
+
+    def _move_out(self, size: int) -> None:
+        """A payload of ``size`` bytes: the shared socket's queue (RCVHWM messages of any size
+        per publisher) would hold more than ``max_bytes`` of them, so the topic moves to a socket
+        of its own whose receive HWM fits it (``SocketOwner.grew``), connected where the topic's
+        publishers are. What is still on its way through the shared socket is lost, once."""
+        shared = self._shared
+        if shared is None:
+            return
+        addresses = shared.addresses(self)
+        self._native.detach()
+        self._shared = None
+        shared.remove(self)
+        owner = self._own_socket(largest=size)
+        for address in addresses:
+            owner.connections.connect(address)
+        self._attach(owner)
+        _LOG.info(
+            "%s: a payload of %d bytes: the topic leaves the shared socket for one of its own "
+            "(parameter max_queued_bytes, %d bytes); connected to %d publisher(s)",
+            self.fqn, size, self._topic.max_bytes, len(addresses),
+        )  # fmt: skip
+
+    # --- the loop's thread --------------------------------------------------------------------
 
     def native_turn(
         self, unrouted: list[list[Frame]], *, monitor: bool, broken: bool, grown: int = 0
     ) -> float | None:
-        """The owner's share of a native channel's work (``NativeHost``): posted commands,
-        the frames the loop had no route for, the connections, the messages queued here."""
+        """The topic's share of a native channel's work (``NativeHost``): posted commands,
+        the frames the loop had no route for, the connections of its own socket, the messages
+        queued here."""
         native, owner = self._native, self._owner
         if self._closed:
             return None
@@ -305,7 +398,8 @@ class NativeReader(_Driver):
             _LOG.warning("the socket of %s cannot be read any more; it is closed", self.fqn)
             self.close()
             return None
-        owner.run_posted()
+        if owner is not None:
+            owner.run_posted()
         for frames in unrouted:
             self._judge(frames)
         dropped = native.dropped - self._native_dropped
@@ -313,29 +407,33 @@ class NativeReader(_Driver):
             self._native_dropped += dropped
             self._count("messages_dropped", dropped)
             self._warning.dropped(self.dropped, native.dropped_sender)
-        if grown:
+        if grown and owner is None:
+            self._move_out(grown)
+        elif grown and owner is not None:
             owner.grew(grown)
         now = time.monotonic()
-        owner.turn_connections(now, monitor=monitor)
+        owner = self._owner
+        if owner is not None:
+            owner.turn_connections(now, monitor=monitor)
         self._deliver_pending()
         if len(self._pending):
             return now  # more to deliver: again at once
-        return owner.connections.next_deadline()
+        return owner.connections.next_deadline() if owner is not None else None
 
     def _judge(self, frames: list[Frame]) -> None:
-        """A message the native loop had no route for: judged by the owner (the Python
-        reference), the route told to the loop, and the message itself delivered here.
+        """A message the native loop had no route for: judged here (the Python reference),
+        the route told to the loop, and the message itself delivered here.
 
         A route names a sender and a type, and the loop follows it for the topic's own frames
         only: it is learned from those alone. A topic the topic's name prefixes comes through
         the socket too (ZeroMQ subscribes by prefix), often from the same publisher with the
         same type (``/model/x/pose`` and ``/model/x/pose_static``): its verdict (None, not
         ours) taught as a route would have the loop skip the topic's own messages."""
-        verdict = self._owner.verdict(frames)
+        verdict = self._verdicts.verdict(frames)
         if (
             len(frames) == DATA_FRAMES
             and (verdict is None or isinstance(verdict, MessageInfo))
-            and bytes(frames[0]) == self._topic_frame
+            and bytes(frames[0]) == self.topic_frame
         ):
             self._native.learn(bytes(frames[1]), bytes(frames[3]), take=verdict is not None)
         if isinstance(verdict, MessageInfo):

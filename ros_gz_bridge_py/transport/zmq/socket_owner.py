@@ -71,6 +71,66 @@ class Topic:
     large_messages: bool = False
 
 
+class Verdicts:
+    """What a topic's messages are, judged once per (topic, sender, type) frames: what the
+    subscription's callback is told, a rejection, or None (another topic's, or the other
+    spelling of a type taken)."""
+
+    def __init__(self, topic: Topic) -> None:
+        self.fqn = fqn = topic.fqn
+        self._partition = topic.partition
+        self.name = (decompose(fqn) or ("", fqn))[1]
+        self._topic_frame = fqn.encode()
+        self._accepts = topic.accepts
+        self._takes = topic.takes
+        self._count = topic.count
+        self._limit = topic.settings.max_message_size
+        self._infos: dict[tuple[Frame, Frame, Frame], Verdict] = {}
+
+    def verdict(self, frames: list[Frame]) -> Verdict:
+        """What to do with a message (see :data:`Verdict`); cached per topic, sender, type."""
+        key = (frames[0], frames[1], frames[3]) if len(frames) == DATA_FRAMES else None
+        if key is not None and key in self._infos:
+            return self._infos[key]
+        verdict = self._judge(frames)
+        if key is not None and all(isinstance(frame, bytes) for frame in key):
+            if len(self._infos) >= INFO_CACHE_SIZE:
+                self._infos.clear()
+            self._infos[key] = verdict
+        return verdict
+
+    def refused(self, address: str) -> tuple[Rejection, str]:
+        """The rejection of a message libzmq refused for its size (connections.py)."""
+        return (
+            Rejection.OVERSIZE,
+            f"a message from {address} was larger than {self._limit} bytes "
+            "(GZ_TRANSPORT_MAX_MESSAGE_SIZE), or not in ZeroMQ framing: libzmq dropped the "
+            "connection before buffering it; reconnecting",
+        )
+
+    def _judge(self, frames: list[Frame]) -> Verdict:
+        try:
+            message = decode_data(frames)
+        except RemoteProtocolError as error:
+            if bytes(frames[0]) != self._topic_frame:
+                self._count("frames_malformed")  # another topic's: not ours to report
+                return None
+            return Rejection.MALFORMED, f"{error} (from a process that is not Gazebo Transport?)"
+        if message.topic != self.fqn:
+            return None
+        if not self._accepts(message.sender, message.msg_type):
+            if self._takes(message.msg_type):
+                # the other spelling of a message already taken (docs/protocol-lines.md §9)
+                return None
+            return (
+                Rejection.WRONG_TYPE,
+                f"the publisher at {message.sender} sends {message.msg_type}",
+            )
+        return MessageInfo(
+            self.name, message.msg_type, self._partition, message.sender, intra_process=False
+        )
+
+
 class SocketOwner:
     """One topic's SUB socket, its connections, verdicts and receive HWM (see the module
     docstring). ``keep(payload, info)`` takes each accepted message :meth:`read` reads;
@@ -86,31 +146,29 @@ class SocketOwner:
         wake: Callable[[], None],
         replacing: Callable[[], None],
         replaced: Callable[[], None],
+        largest: int = 0,
     ) -> None:
-        self.fqn = fqn = topic.fqn
-        self._partition = topic.partition
-        self._name = (decompose(fqn) or ("", fqn))[1]
-        self._topic_frame = fqn.encode()
-        self._accepts = topic.accepts
-        self._takes = topic.takes
+        self.fqn = topic.fqn
+        self._topic_frame = topic.fqn.encode()
+        self._verdicts = Verdicts(topic)
+        self.verdict = self._verdicts.verdict
         self._keep = keep
         self._reject = topic.reject
         settings = topic.settings
-        self._limit = settings.max_message_size
         self._max_bytes = topic.max_bytes
         self._configured_hwm = settings.rcvhwm
         #: The socket's receive HWM now (for the largest message taken, where messages are
-        #: large by nature), and the largest payload it holds within max_bytes.
-        self._hwm = (
-            hwm_for_bytes(settings.max_message_size, topic.max_bytes, settings.rcvhwm)
-            if topic.large_messages
-            else settings.rcvhwm
-        )
+        #: large by nature, or for ``largest``), and the largest payload it holds within
+        #: max_bytes.
+        self._hwm = settings.rcvhwm
+        if topic.large_messages:
+            self._hwm = hwm_for_bytes(settings.max_message_size, topic.max_bytes, settings.rcvhwm)
+        elif largest:
+            self._hwm = hwm_for_bytes(GROWTH_ROOM * largest, topic.max_bytes, settings.rcvhwm)
         self.watch: int | None = self._watch_size()
         self._count = topic.count
         self._wake = wake
         self._replacing, self._replaced = replacing, replaced
-        self._infos: dict[tuple[Frame, Frame, Frame], Verdict] = {}
         self._posted: collections.deque[Callable[[], object]] = collections.deque()
         self._context = context
         self._settings = settings
@@ -119,7 +177,7 @@ class SocketOwner:
     @property
     def name(self) -> str:
         """The topic's name without its partition."""
-        return self._name
+        return self._verdicts.name
 
     # --- from any thread --------------------------------------------------------------------
 
@@ -189,18 +247,6 @@ class SocketOwner:
         )  # fmt: skip
         self._replaced()
 
-    def verdict(self, frames: list[Frame]) -> Verdict:
-        """What to do with a message (see :data:`Verdict`); cached per topic, sender, type."""
-        key = (frames[0], frames[1], frames[3]) if len(frames) == DATA_FRAMES else None
-        if key is not None and key in self._infos:
-            return self._infos[key]
-        verdict = self._judge(frames)
-        if key is not None and all(isinstance(frame, bytes) for frame in key):
-            if len(self._infos) >= INFO_CACHE_SIZE:
-                self._infos.clear()
-            self._infos[key] = verdict
-        return verdict
-
     def release(self) -> None:
         """Closes the socket and its connections."""
         self.connections.close()
@@ -209,11 +255,7 @@ class SocketOwner:
     # --- internals --------------------------------------------------------------------------
 
     def _watch_size(self) -> int | None:
-        """The largest payload the socket's receive HWM holds within ``max_bytes``; None
-        where the HWM is as low as it goes."""
-        if 0 < self._hwm <= MIN_HWM:
-            return None
-        return self._max_bytes // (self._hwm if self._hwm > 0 else DEFAULT_HWM)
+        return watch_size(self._hwm, self._max_bytes)
 
     def _open_socket(self) -> tuple[Any, SubConnections]:
         """A SUB socket of the topic with the receive HWM as it is now, and its connections."""
@@ -225,34 +267,15 @@ class SocketOwner:
         return sock, connections
 
     def _refused(self, address: str) -> None:
-        self._reject(
-            Rejection.OVERSIZE,
-            f"a message from {address} was larger than {self._limit} bytes "
-            "(GZ_TRANSPORT_MAX_MESSAGE_SIZE), or not in ZeroMQ framing: libzmq dropped the "
-            "connection before buffering it; reconnecting",
-        )
+        self._reject(*self._verdicts.refused(address))
 
-    def _judge(self, frames: list[Frame]) -> Verdict:
-        try:
-            message = decode_data(frames)
-        except RemoteProtocolError as error:
-            if bytes(frames[0]) != self._topic_frame:
-                self._count("frames_malformed")  # another topic's: not ours to report
-                return None
-            return Rejection.MALFORMED, f"{error} (from a process that is not Gazebo Transport?)"
-        if message.topic != self.fqn:
-            return None
-        if not self._accepts(message.sender, message.msg_type):
-            if self._takes(message.msg_type):
-                # the other spelling of a message already taken (docs/protocol-lines.md §9)
-                return None
-            return (
-                Rejection.WRONG_TYPE,
-                f"the publisher at {message.sender} sends {message.msg_type}",
-            )
-        return MessageInfo(
-            self._name, message.msg_type, self._partition, message.sender, intra_process=False
-        )
+
+def watch_size(hwm: int, max_bytes: int) -> int | None:
+    """The largest payload a receive HWM of ``hwm`` messages holds within ``max_bytes``;
+    None where the HWM is as low as it goes."""
+    if 0 < hwm <= MIN_HWM:
+        return None
+    return max_bytes // (hwm if hwm > 0 else DEFAULT_HWM)
 
 
 def receive_message(sock: Any) -> list[Frame]:

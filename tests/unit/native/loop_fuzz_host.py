@@ -16,7 +16,7 @@ from typing import Any
 import zmq
 
 from ros_gz_bridge_py.transport import MessageInfo
-from ros_gz_bridge_py.transport.api import NativeHost, Rejection
+from ros_gz_bridge_py.transport.api import NativeHost, NativeSocketReader, Rejection
 from ros_gz_bridge_py.transport.names import decompose
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zmq.reader import NativeReader
@@ -55,14 +55,14 @@ class Host:
             count=lambda *_args: None,
         )
         self.reader = NativeReader(
-            self._context, topic, native=self, deliver=lambda *_args: None, size=4
+            self._context, topic, native=self, shared=None, deliver=lambda *_args: None, size=4
         )
 
     def reset(self, pump: Any, types: list[bytes]) -> None:
         """A new input: its pump, and the spellings the topic takes (and one no program takes)."""
         self.pump = pump
         self.types = frozenset({*(t.decode() for t in types), UNPROGRAMMED})
-        self.reader._owner._infos.clear()
+        self.reader._verdicts._infos.clear()
 
     def judge(self, frames: list[Frame]) -> None:
         """The reader's judgement of frames the loop handed back (it teaches the pump)."""
@@ -70,7 +70,7 @@ class Host:
 
     def takes(self, frames: list[Frame]) -> bool:
         """Whether the socket owner (the Python path's reference) delivers these frames."""
-        return isinstance(self.reader._owner.verdict(frames), MessageInfo)
+        return isinstance(self.reader._verdicts.verdict(frames), MessageInfo)
 
     def close(self) -> None:
         self.reader.close()
@@ -86,6 +86,14 @@ class Host:
 
     def attach(self, sock: int, monitor: int, host: NativeHost) -> None:
         """Not read by a loop here: the target turns the pump itself."""
+
+    def socket_reader(self, sock: int, monitor: int, host: NativeHost) -> NativeSocketReader:
+        """The host's reader has a socket of its own (``shared=None``): never asked."""
+        raise NotImplementedError
+
+    def attach_shared(self, reader: NativeSocketReader, host: NativeHost) -> None:
+        """Never asked, as :meth:`socket_reader`."""
+        raise NotImplementedError
 
     def detach(self) -> None:
         """Nothing attached."""

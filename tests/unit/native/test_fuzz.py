@@ -105,11 +105,12 @@ TARGETS = {
     "loop": Target(
         "loop_fuzz.c",
         ("_native.c", "encode.c", "encode_load.c", "encode_write.c", "loop.c", "pb_read.c",
-         "pump.c", "pump_loop.c", "ros_pump.c", "ros_pump_loop.c", "transcode.c",
+         "pump.c", "pump_loop.c", "pump_share.c", "ros_pump.c", "ros_pump_loop.c", "transcode.c",
          "transcode_load.c", "transcoders.c", "_native.h", "encode.h", "encode_ops.h",
          "transcode.h", "transcode_ops.h", "wire.h", "codes.py"),
         "programs.h", "loop-corpus", "loop-artifacts", 1 / 4, python=True,
-        parts=("loop_fuzz.h", "loop_fuzz_pump.c", "loop_fuzz_ros_pump.c", "loop_fuzz_zmq.c"),
+        parts=("loop_fuzz.h", "loop_fuzz_pump.c", "loop_fuzz_reference.c", "loop_fuzz_ros_pump.c",
+               "loop_fuzz_zmq.c"),
     ),
 }  # fmt: skip
 
