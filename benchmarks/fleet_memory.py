@@ -193,13 +193,7 @@ def report(
         "| --- | --- |",
         *(f"| {how} | {cost:,.0f} bytes |" for how, cost in costs.items()),
         "",
-        f"### The fleet of {robots} robots, each window about {rounds[0].seconds:.0f} s",
-        "",
-        "| round | RCVHWM | peak MB (VmHWM) | RSS median MB | RSS max MB | RssAnon median MB "
-        "| RssAnon max MB | bridge CPU | µs per message taken | /clock delivered | 1-min load |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
-        *(f"| {index} | {r.cells()} |" for index, r in enumerate(rounds, 1)),
-        "",
+        *_fleet_section(robots, rounds),
         f"### One topic flooded: Odometry at {FLOOD_HZ / 1000:g} kHz for {FLOOD_SECONDS:g} s, "
         "a busy loop beside the bridge",
         "",
@@ -208,6 +202,21 @@ def report(
         *(f"| {index} | {flood_cells(*f)} |" for index, f in enumerate(floods, 1)),
     ]
     return "\n".join(lines)
+
+
+def _fleet_section(robots: int, rounds: list[MemoryRound]) -> list[str]:
+    """The fleet part's lines; none but a word when it ran no round (``--rounds 0``)."""
+    if not rounds:
+        return [f"### The fleet of {robots} robots: no round (`--rounds 0`)", ""]
+    return [
+        f"### The fleet of {robots} robots, each window about {rounds[0].seconds:.0f} s",
+        "",
+        "| round | RCVHWM | peak MB (VmHWM) | RSS median MB | RSS max MB | RssAnon median MB "
+        "| RssAnon max MB | bridge CPU | µs per message taken | /clock delivered | 1-min load |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        *(f"| {index} | {r.cells()} |" for index, r in enumerate(rounds, 1)),
+        "",
+    ]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

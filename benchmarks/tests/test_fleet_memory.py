@@ -49,3 +49,11 @@ def test_each_round_says_its_receive_queue_its_memory_and_its_clock() -> None:
     assert "| 1 | 1000 (default) | 79565/80000 (99.5%) | 41% | 79.4 ms |" in text
     assert "| 2 | 50 | 75967/80001 (95.0%) | 51% | 84.1 ms |" in text
     assert "| 3 | 50 | failed: bridge did not start | | |" in text
+
+
+def test_a_run_of_floods_alone_still_writes_its_report() -> None:
+    """``--rounds 0`` (the flooded topic alone) failed on the fleet part's first round."""
+    floods = [("", FlowResult(80000, 80000, 20000.0, 70.0, 24600.0, 35.8))]
+    text = report({"paced": 8980.0}, 10, [], floods, "command")
+    assert "### The fleet of 10 robots: no round (`--rounds 0`)" in text
+    assert "| 1 | 1000 (default) | 80000/80000 (100.0%) | 36% | 24.6 ms |" in text
