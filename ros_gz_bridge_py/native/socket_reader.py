@@ -47,7 +47,6 @@ class SocketReader(PumpMember):
         #: When each channel wants its next turn at the latest (its last turn said).
         self._deadlines: dict[ChannelPump, float | None] = {}
         self._closed = False
-        self._seen = self.pump.counts()
         self._join()
 
     def add(self, channel: ChannelPump) -> None:

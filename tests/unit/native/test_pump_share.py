@@ -97,9 +97,13 @@ def test_each_topic_goes_to_its_own_pump(native: Any, publisher: Any) -> None:
         for _ in range(100):
             rig.send(CLOCK)
         odom, clock = rig.peers[ODOM], rig.peers[CLOCK]
-        rig.until(lambda: odom.counts().published >= 300 and clock.counts().published >= 100)
-        time.sleep(0.2)
-        rig.turn()
+        rig.until(
+            lambda: (
+                odom.counts().published >= 300
+                and clock.counts().published >= 100
+                and rig.reader.counts().skipped >= 300
+            )
+        )
         # each topic's frames were judged once, by its own socket owner: the routes hold
         assert [len(frames) for frames in rig.handed.values()] == [1, 1]
         assert [rig.handed[t][0][0] for t in (ODOM, CLOCK)] == [ODOM, CLOCK]

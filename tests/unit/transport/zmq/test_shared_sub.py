@@ -9,7 +9,7 @@ of it against a C++ Gazebo peer: tests/bridge/test_native_shared_loop.py.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
@@ -17,7 +17,6 @@ import zmq
 
 from ros_gz_bridge_py.transport.api import NativeHost
 from ros_gz_bridge_py.transport.settings import TransportSettings
-from ros_gz_bridge_py.transport.zmq.connections import LEAVE_AFTER
 from ros_gz_bridge_py.transport.zmq.shared_sub import SharedSub
 from ros_gz_bridge_py.transport.zmq.wire import Frame
 
@@ -86,6 +85,14 @@ def shared_sub(context: Any) -> tuple[SharedSub, Loop]:
     return SharedSub(context, settings, lambda *_: None, loop), loop  # type: ignore[arg-type]
 
 
+def until(done: Callable[[], bool], seconds: float = 10.0) -> None:
+    """Polls ``done`` until it holds; fails after ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while not done():
+        assert time.monotonic() < deadline, "not within the time"
+        time.sleep(0.01)
+
+
 def turn(shared: SharedSub) -> None:
     shared.native_turn([], monitor=True, broken=False)
 
@@ -107,15 +114,16 @@ def test_an_address_is_connected_once_and_left_with_its_last_topic(context: Any)
     turn(shared)
     deadline = shared.connections.next_deadline()
     assert deadline is not None  # left a moment later (what was sent last still arrives)
-    shared.native_turn([], monitor=False, broken=False)
-    time.sleep(LEAVE_AFTER + 0.05)
-    shared.native_turn([], monitor=False, broken=False)
+    until(lambda: shared.native_turn([], monitor=False, broken=False) is None)
     assert shared.connections.connected == set()
     shared.close()
     assert loop.closed
 
 
-def test_what_waits_is_read_for_its_topic_before_a_disconnect(context: Any) -> None:
+def test_what_the_socket_holds_is_read_for_its_topic_before_a_disconnect(context: Any) -> None:
+    """``SubConnections.disconnect`` drains the socket first (connections.py); the shared
+    socket's drain gives each message to its topic's reader, and one of a topic no reader
+    takes (let through by prefix) to none."""
     pub = context.socket(zmq.PUB)
     port = pub.bind_to_random_port("tcp://127.0.0.1")
     address = f"tcp://127.0.0.1:{port}"
@@ -125,16 +133,24 @@ def test_what_waits_is_read_for_its_topic_before_a_disconnect(context: Any) -> N
         shared.add(reader, loop)  # type: ignore[arg-type]
         shared.connect(address, reader)
     turn(shared)
-    deadline = time.monotonic() + 10
-    while not shared.sock.getsockopt(zmq.EVENTS) & zmq.POLLIN and time.monotonic() < deadline:
+
+    def arrived() -> bool:  # the subscription is up once a message waits
         pub.send_multipart([b"@/p@/odom", b"sender", b"payload", b"gz.msgs.Odometry"])
-        time.sleep(0.01)
+        return bool(shared.sock.getsockopt(zmq.EVENTS) & zmq.POLLIN)
+
+    until(arrived)
     pub.send_multipart([b"@/p@/odom_static", b"sender", b"payload", b"gz.msgs.Odometry"])
-    time.sleep(0.1)
-    shared.connections.disconnect(address)  # reads what waits first
-    assert odom.taken
+    pub.send_multipart([b"@/p@/odom", b"sender", b"last", b"gz.msgs.Odometry"])
+
+    def drained_to_the_last() -> bool:  # one connection: the prefixed one came before it
+        shared._drain()
+        return any(bytes(frames[2]) == b"last" for frames in odom.taken)
+
+    until(drained_to_the_last)
     assert {bytes(frames[0]) for frames in odom.taken} == {b"@/p@/odom"}
-    assert other.taken == []  # a topic of no reader (by prefix) is nobody's
+    assert other.taken == []
+    shared.connections.disconnect(address)
+    assert shared.connections.connected == set()
     shared.close()
     pub.close(linger=0)
 
