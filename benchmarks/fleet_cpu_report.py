@@ -344,9 +344,9 @@ def section(maps: Sequence[CpuMap], args: argparse.Namespace, loads: tuple[float
         f"{args.profile_seconds:g} --hz {args.hz}`. 1-minute load average {loads[0]:.2f} "
         f"before and {loads[1]:.2f} after; 2 cores shared with other work.",
         "",
-        f"**Measured on {' and '.join(kinds)}.** Issue 36's optimisations are to be made on "
-        "issue 35's unified loop: run this module there again; it reads the bridge from "
-        "outside only (thread names, `/proc`, perf), so it needs no change.",
+        f"**Measured on {' and '.join(kinds)}.** The module reads the bridge from outside "
+        "only (thread names, `/proc`, perf), so it runs unchanged on any arrangement of the "
+        "bridge's threads and sockets.",
         "",
         "The fleet of `benchmarks.fleet` as users run it (the C++ simulator, one "
         "`parameter_bridge`, `/clock` and every ten robots in subscriber processes of their "

@@ -36,7 +36,10 @@ def missing() -> str | None:
     if shutil.which("perf") is None:
         return "perf is not installed"
     if not any(path.is_dir() for path in TRACEFS):
-        return "the kernel's syscall tracepoints are not visible (tracefs)"
+        return (
+            "the kernel's syscall tracepoints are not visible (tracefs; as root: "
+            "mount -t tracefs nodev /sys/kernel/tracing)"
+        )
     return None
 
 
