@@ -212,7 +212,9 @@ class GzNode(ServiceEnds, GraphView):
         backend can hand it its socket (ZeroMQ); other backends deliver through ``callback``.
         ``large_messages``: payloads of megabytes are the topic's normal traffic (images):
         a queue that libzmq bounds in messages is sized for the largest message from the
-        start (``zmq/reader.py``), not when the first large one comes.
+        start (``zmq/reader.py``), not when the first large one comes, and, read on a thread
+        of its own, its connections are read by a libzmq I/O thread of the large topics' own,
+        at that thread's priority (``zmq/bulk_context.py``).
 
         Raises:
             ValueError: a queue of no messages, or ``on_delivery_start`` without a queue.

@@ -28,6 +28,7 @@ from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import GzNode
+from ros_gz_bridge_py.transport.zmq.bulk_context import THREAD_NAME_PREFIX
 from testing.behaviour_harness import (
     WAIT,
     RosSide,
@@ -235,10 +236,11 @@ def test_gazebo_to_ros_image_from_the_real_peer(
     assert (msg.encoding, msg.is_bigendian, msg.header.frame_id) == ("rgb8", 0, "a/b")
     assert bytes(msg.data) == pattern_bytes(size)
     # The delivery threads of the two bulk channels (image, cloud) lowered their own priority
-    # when they started, by the default BULK_THREAD_NICE; no other thread did.
+    # when they started, by the default BULK_THREAD_NICE, and the libzmq I/O thread that reads
+    # their frames follows them (bulk_context.py); no other thread did.
     bulk = VARIANTS[bridge.variant].get(BULK_ENV) != "off"
-    expected = [BULK_THREAD_NICE, BULK_THREAD_NICE] if bulk else []
-    assert thread_nice_values(bridge.process.pid) == expected
+    lowered = [f"{THREAD_NAME_PREFIX}/ZMQbg/IO/0", "gz-sub", "gz-sub"] if bulk else []
+    assert lowered_threads(bridge.process.pid) == [(name, BULK_THREAD_NICE) for name in lowered]
 
 
 def test_only_fast_dds_event_threads_are_batched(bridge: RunningBridge) -> None:
@@ -263,15 +265,17 @@ def batched_thread_names(pid: int) -> set[str]:
     return names
 
 
-def thread_nice_values(pid: int) -> list[int]:
-    """The nice values of ``pid``'s threads that are not 0 (field 19 of /proc/.../stat)."""
-    values = []
+def lowered_threads(pid: int) -> list[tuple[str, int]]:
+    """The names (up to a space: ``gz-sub <topic>`` is ``gz-sub``) and nice values of
+    ``pid``'s threads whose nice value is not 0 (field 19 of /proc/.../stat), sorted."""
+    found = []
     for tid in os.listdir(f"/proc/{pid}/task"):
         with open(f"/proc/{pid}/task/{tid}/stat", encoding="ascii") as stat:
-            nice = int(stat.read().rsplit(")", 1)[1].split()[16])
+            name, rest = stat.read().split("(", 1)[1].rsplit(")", 1)
+        nice = int(rest.split()[16])
         if nice:
-            values.append(nice)
-    return values
+            found.append((name.split(" ")[0], nice))
+    return sorted(found)
 
 
 def test_gazebo_to_ros_cloud(bridge: RunningBridge, ros_side: RosSide, gz_node: GzNode) -> None:

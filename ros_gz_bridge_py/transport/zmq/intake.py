@@ -10,7 +10,8 @@ and the shared socket does once no record at all is left there, each a moment la
 (``connections.LEAVE_AFTER``), so that what the publisher sent last still arrives. gz never
 disconnects; without it, addresses of a peer that is gone are retried for ever
 (docs/protocol-zmq-data.md §2.8.7). Everything here runs on the I/O thread; readers do their part on
-their own threads.
+their own threads. The readers of large messages on threads of their own have a ZeroMQ context
+of their own (``bulk_context.py``).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING, cast
 from ros_gz_bridge_py.transport.api import NativeLoop
 from ros_gz_bridge_py.transport.handles import Subscription
 from ros_gz_bridge_py.transport.throttle import Throttle
+from ros_gz_bridge_py.transport.zmq.bulk_context import BulkContext
 from ros_gz_bridge_py.transport.zmq.connections import SubConnections
 from ros_gz_bridge_py.transport.zmq.reader import NativeReader, SubscriptionReader
 from ros_gz_bridge_py.transport.zmq.shared_sub import SharedSub
@@ -57,6 +59,7 @@ class DataIntake:
         )
         self._warning = Throttle(WARN_PERIOD)
         self._native_sub: SharedSub | None = None
+        self._bulk: BulkContext | None = None
 
     @property
     def received(self) -> int:
@@ -75,8 +78,13 @@ class DataIntake:
             node.count, max_bytes, sub.large_messages,
         )  # fmt: skip
         native = sub.native
-        if native is None:
+        if native is None and sub.large_messages:
+            bulk = self._bulk_context()
             reader: Reader = SubscriptionReader(
+                bulk.context, topic, deliver=sub.run, size=size, on_start=bulk.following(on_start)
+            )
+        elif native is None:
+            reader = SubscriptionReader(
                 self._context, topic, deliver=sub.run, size=size, on_start=on_start
             )
         else:
@@ -87,6 +95,12 @@ class DataIntake:
         self.readers.append(reader)
         return reader
 
+    def _bulk_context(self) -> BulkContext:
+        """The context of the large-message readers, made with the first."""
+        if self._bulk is None:
+            self._bulk = BulkContext()
+        return self._bulk
+
     def _shared_sub(self, native: NativeLoop) -> SharedSub:
         """The socket the native channels of small messages share, made with the first."""
         if self._native_sub is None:
@@ -95,9 +109,12 @@ class DataIntake:
         return self._native_sub
 
     def close(self) -> None:
-        """The native channels' shared socket goes (before the node's context)."""
+        """The native channels' shared socket and the large-message readers' context go
+        (before the node's context)."""
         if self._native_sub is not None:
             self._native_sub.close()
+        if self._bulk is not None:
+            self._bulk.close()
 
     def close_reader(self, reader: Reader) -> None:
         if reader in self.readers:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 import uuid
@@ -14,6 +15,7 @@ import zmq
 from ros_gz_bridge_py.errors import TransportError, TransportTimeoutError
 from ros_gz_bridge_py.msgs import GENERIC_TYPE, message_class
 from ros_gz_bridge_py.transport import MessageInfo, create_gz_node
+from ros_gz_bridge_py.transport.zmq.bulk_context import io_threads
 from ros_gz_bridge_py.transport.zmq.node import ZmqGzNode
 from testing.polling import wait_until
 
@@ -397,3 +399,53 @@ def test_a_publisher_of_large_messages_has_a_send_queue_sized_in_bytes(
     small = a.advertise(unique("small"), "gz.msgs.StringMsg")
     assert small.sock is None  # type: ignore[attr-defined]
     assert small.send_queue() == a.settings.sndhwm
+
+
+#: How much a large topic's delivery thread lowers its priority (bulk_context.py).
+LOWER_BY = 3
+
+
+def _nice(tid: int) -> int:
+    return os.getpriority(os.PRIO_PROCESS, tid)
+
+
+def test_a_large_topic_is_read_by_an_io_thread_of_its_own_at_its_delivery_priority(
+    nodes: tuple[ZmqGzNode, ZmqGzNode],
+) -> None:
+    a, b = nodes
+    before = set(io_threads())
+    topic = unique("bulk")
+    delivered: list[int] = []
+
+    def lower_own_priority() -> None:
+        tid = threading.get_native_id()
+        os.setpriority(os.PRIO_PROCESS, tid, _nice(tid) + LOWER_BY)
+
+    a.subscribe(
+        topic,
+        lambda _p, _i: delivered.append(threading.get_native_id()),
+        "gz.msgs.StringMsg",
+        queue_size=4,
+        on_delivery_start=lower_own_priority,
+        large_messages=True,
+    )
+    publisher = b.advertise(topic, "gz.msgs.StringMsg")
+    assert publish_until(lambda: publisher.publish(StringMsg(data="x")), lambda: bool(delivered))
+    ours = set(io_threads()) - before
+    assert len(ours) == 1  # made with the node's first large-message subscription
+    delivery_nice = _nice(delivered[0])
+    assert delivery_nice == _nice(threading.get_native_id()) + LOWER_BY
+    assert [_nice(tid) for tid in ours] == [delivery_nice]
+    a.close()
+    assert wait_until(lambda: not ours & set(io_threads()))
+
+
+def test_small_topics_make_no_io_thread_of_their_own(nodes: tuple[ZmqGzNode, ZmqGzNode]) -> None:
+    a, b = nodes
+    before = set(io_threads())
+    topic = unique("small")
+    delivered: list[bytes] = []
+    a.subscribe(topic, lambda p, _i: delivered.append(bytes(p)), "gz.msgs.StringMsg", queue_size=4)
+    publisher = b.advertise(topic, "gz.msgs.StringMsg")
+    assert publish_until(lambda: publisher.publish(StringMsg(data="x")), lambda: bool(delivered))
+    assert set(io_threads()) == before
