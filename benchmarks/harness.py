@@ -49,8 +49,9 @@ def topic_name(stem: str) -> str:
 
 
 #: Thread groups of a bridge process, by the start of the thread's name (``comm``): the
-#: threads libzmq and Fast DDS start name themselves; Python's threads keep the process name.
-THREAD_GROUPS = (("libzmq I/O", "ZMQbg/"), ("Fast DDS", "dds."))
+#: threads libzmq and Fast DDS start name themselves (libzmq's after a number where the
+#: context has one: ``6/ZMQbg/IO/0``, the bulk path's); Python's threads keep the process name.
+THREAD_GROUPS = (("libzmq I/O", re.compile(r"(\d+/)?ZMQbg/")), ("Fast DDS", re.compile(r"dds\.")))
 PYTHON_THREADS = "Python"
 
 
@@ -66,7 +67,7 @@ def thread_group_seconds(pid: int) -> dict[str, float]:
                 run_ns = int(schedstat.read().split()[0])
         except (OSError, ValueError, IndexError):  # the thread ended meanwhile
             continue
-        group = next((g for g, prefix in THREAD_GROUPS if name.startswith(prefix)), None)
+        group = next((g for g, start in THREAD_GROUPS if start.match(name)), None)
         seconds[group or PYTHON_THREADS] += run_ns / 1e9
     return seconds
 

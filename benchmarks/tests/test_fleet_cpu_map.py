@@ -26,6 +26,7 @@ def test_roles_come_from_the_os_names_of_either_data_plane() -> None:
     assert role_of("gz-fallback", 1003, PID) == role_of("native-fallback", 1003, PID)
     assert role_of("gz-sub /clock", 1004, PID) == "topic readers (Python, gz-sub)"
     assert role_of("ZMQbg/IO/0", 1005, PID) == "libzmq I/O"
+    assert role_of("6/ZMQbg/IO/0", 1013, PID) == "libzmq I/O"  # the bulk path's context
     assert role_of("ZMQbg/Reaper", 1006, PID) == "libzmq other"
     assert role_of("dds.ev.0", 1007, PID) == "Fast DDS events"
     assert role_of("dds.shm.13913", 1008, PID) == "Fast DDS shared-memory receive"

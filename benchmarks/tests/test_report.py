@@ -85,7 +85,8 @@ def test_thread_cpu_is_grouped_by_the_names_libzmq_and_fast_dds_give_their_threa
 
     def named_burner() -> None:
         tid = threading.get_native_id()
-        Path(f"/proc/self/task/{tid}/comm").write_text("ZMQbg/IO/9", encoding="utf-8")
+        # named as libzmq names the threads of a numbered context (the bulk path's)
+        Path(f"/proc/self/task/{tid}/comm").write_text("6/ZMQbg/IO/9", encoding="utf-8")
         _burn(0.3)
         burnt.set()
         read.wait(10)  # a thread's run time is read while it exists
