@@ -8,8 +8,7 @@ of it against a C++ Gazebo peer: tests/bridge/test_native_shared_loop.py.
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -19,6 +18,7 @@ from ros_gz_bridge_py.transport.api import NativeHost
 from ros_gz_bridge_py.transport.settings import TransportSettings
 from ros_gz_bridge_py.transport.zmq.shared_sub import SharedSub
 from ros_gz_bridge_py.transport.zmq.wire import Frame
+from testing.polling import wait_until
 
 
 class Reader:
@@ -85,14 +85,6 @@ def shared_sub(context: Any) -> tuple[SharedSub, Loop]:
     return SharedSub(context, settings, lambda *_: None, loop), loop  # type: ignore[arg-type]
 
 
-def until(done: Callable[[], bool], seconds: float = 10.0) -> None:
-    """Polls ``done`` until it holds; fails after ``seconds``."""
-    deadline = time.monotonic() + seconds
-    while not done():
-        assert time.monotonic() < deadline, "not within the time"
-        time.sleep(0.01)
-
-
 def turn(shared: SharedSub) -> None:
     shared.native_turn([], monitor=True, broken=False)
 
@@ -114,7 +106,7 @@ def test_an_address_is_connected_once_and_left_with_its_last_topic(context: Any)
     turn(shared)
     deadline = shared.connections.next_deadline()
     assert deadline is not None  # left a moment later (what was sent last still arrives)
-    until(lambda: shared.native_turn([], monitor=False, broken=False) is None)
+    assert wait_until(lambda: shared.native_turn([], monitor=False, broken=False) is None)
     assert shared.connections.connected == set()
     shared.close()
     assert loop.closed
@@ -138,7 +130,7 @@ def test_what_the_socket_holds_is_read_for_its_topic_before_a_disconnect(context
         pub.send_multipart([b"@/p@/odom", b"sender", b"payload", b"gz.msgs.Odometry"])
         return bool(shared.sock.getsockopt(zmq.EVENTS) & zmq.POLLIN)
 
-    until(arrived)
+    assert wait_until(arrived)
     pub.send_multipart([b"@/p@/odom_static", b"sender", b"payload", b"gz.msgs.Odometry"])
     pub.send_multipart([b"@/p@/odom", b"sender", b"last", b"gz.msgs.Odometry"])
 
@@ -146,7 +138,7 @@ def test_what_the_socket_holds_is_read_for_its_topic_before_a_disconnect(context
         shared._drain()
         return any(bytes(frames[2]) == b"last" for frames in odom.taken)
 
-    until(drained_to_the_last)
+    assert wait_until(drained_to_the_last)
     assert {bytes(frames[0]) for frames in odom.taken} == {b"@/p@/odom"}
     assert other.taken == []
     shared.connections.disconnect(address)
