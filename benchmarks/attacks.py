@@ -75,15 +75,16 @@ def report(runs: list[AttackRun], seconds: float, after: float, command: str, bu
 def write_section(path: Path, section: str) -> None:
     """Replace ``section`` (its heading: the first line) where it is in ``path``, up to the
     next heading of its level, or add it at the end."""
-    text = path.read_text() if path.exists() else ""
+    text = "\n" + (path.read_text() if path.exists() else "")  # a heading on the first line
     heading = section.split("\n", 1)[0]
     start = text.find(f"\n{heading}\n")
     if start < 0:
-        path.write_text(f"{text.rstrip()}\n\n{section}" if text.strip() else section)
+        path.write_text(f"{text.strip()}\n\n{section}" if text.strip() else section)
         return
     end = text.find("\n## ", start + 1)
     rest = text[end:] if end >= 0 else ""
-    path.write_text(f"{text[:start].rstrip()}\n\n{section.rstrip()}\n{rest}")
+    before = text[:start].strip()
+    path.write_text(f"{before}\n\n{section.rstrip()}\n{rest}".lstrip())
 
 
 def main(argv: list[str] | None = None) -> int:

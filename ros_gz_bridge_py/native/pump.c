@@ -260,11 +260,13 @@ done:
     return result;
 }
 
+/* The socket read for the pump is replaced: what its reads left waiting goes. A route names a
+ * sender and a type of the pump's topic, whichever socket brings them, so the routes stay: the
+ * new socket's messages go natively at once, not copied for Python first. */
 static PyObject *pump_forget(PumpObject *self, PyObject *unused) {
     (void)unused;
     if (pump_out_of_loop(self, "forget") < 0) return NULL;
     self->dropped += self->count + self->nhanded; /* their socket is gone: counted, not lost silently */
-    clear_routes(self);
     pump_clear_ring(self);
     pump_clear_handover(self);
     Py_RETURN_NONE;
@@ -410,7 +412,8 @@ static PyMethodDef pump_methods[] = {
     {"learn", (PyCFunction)pump_learn, METH_VARARGS,
      "learn(sender, msg_type, take) -> bool: route messages of (sender, type) natively (take) "
      "or skip them; False where no program takes msg_type"},
-    {"forget", (PyCFunction)pump_forget, METH_NOARGS, "forget routes and queued messages (counted dropped)"},
+    {"forget", (PyCFunction)pump_forget, METH_NOARGS,
+     "forget the queued and handed messages (counted dropped); the routes stay"},
     {"take_handed", (PyCFunction)pump_take_handed, METH_NOARGS,
      "take_handed() -> Handover: what the loop left to Python since the last call"},
     {"watch", (PyCFunction)pump_watch, METH_O,

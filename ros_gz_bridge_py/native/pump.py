@@ -91,8 +91,8 @@ class ChannelPump(PumpMember):
         self.pump.learn(sender, msg_type, take)
 
     def attach(self, sock: int, monitor: int, host: NativeHost) -> None:
-        """Read ``sock`` (with its connection ``monitor``) on the process's loop, no route
-        known yet; ``host`` does the socket owner's share on the loop's thread."""
+        """Read ``sock`` (with its connection ``monitor``) on the process's loop, with the
+        routes learned so far; ``host`` does the socket owner's share on the loop's thread."""
         self._host = host
         self.pump.read_from(sock, monitor)
         self.pump.forget()
@@ -108,7 +108,7 @@ class ChannelPump(PumpMember):
 
     def attach_shared(self, reader: NativeSocketReader, host: NativeHost) -> None:
         """Take the topic's messages from ``reader``'s socket (made by :meth:`socket_reader`),
-        no route known yet; ``host`` does the topic's share on the loop's thread."""
+        with the routes learned so far; ``host`` does the topic's share on the loop's thread."""
         if not isinstance(reader, SocketReader):
             msg = f"not a native socket reader: {reader!r}"
             raise TypeError(msg)
