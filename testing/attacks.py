@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 import time
 import uuid
@@ -56,6 +57,8 @@ from testing.soak import soak_env
 ROOT = Path(__file__).resolve().parent.parent
 ROS_SIDE = Path(__file__).resolve().parent / "attack_ros.py"
 CLOCK, ODOM, TF = "/amp_clock", "/amp_odom", "/amp_tf"
+#: A ROS log line ("[WARN] [1795988267.179061441] [ros_gz_bridge]: ...").
+LOG_LINE = re.compile(r"\[(DEBUG|INFO|WARN|ERROR|FATAL)\] \[")
 CLOCK_HZ, ODOM_HZ = 500, 50
 ODOM_TEXT = (
     'header { stamp { sec: 7 } data { key: "child_frame_id" value: "real" } } '
@@ -345,6 +348,13 @@ class AttackRun:
             return
         self.bridge.send_signal(10)  # SIGUSR1
         time.sleep(1.0)
-        output = self.bridge.output().splitlines()
-        heads = [i for i, line in enumerate(output) if line.startswith("LEVEL ")]
-        self.status_table = "\n".join(output[heads[-1] :]) if heads else ""
+        self.status_table = status_table(self.bridge.output())
+
+
+def status_table(output: str) -> str:
+    """The last status table in a bridge's ``output``, without the log lines printed while it
+    was (they would read as rows of it)."""
+    lines = output.splitlines()
+    heads = [i for i, line in enumerate(lines) if line.startswith("LEVEL ")]
+    table = lines[heads[-1] :] if heads else []
+    return "\n".join(line for line in table if not LOG_LINE.match(line))

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import pytest
 
-from testing.attacks import AttackRun, attacks
+from testing.attacks import AttackRun, attacks, status_table
 from testing.gzpeer import require_peer
 
 pytestmark = [pytest.mark.peer, pytest.mark.ros, pytest.mark.slow]
@@ -50,3 +50,19 @@ def test_the_bridge_rides_out_each_attack(native: bool) -> None:
         assert outcome.odom_percent > 20, outcome
         if outcome.attack == "empty_poses":
             assert outcome.peak_above_mb < EMPTY_POSES_PEAK_MB, outcome
+
+
+def test_the_status_table_is_the_last_one_without_log_lines() -> None:
+    """The report's status table (SIGUSR1 output) stops at no log line: one printed while the
+    table was read stood in SOAK.md as one of its rows."""
+    output = (
+        "LEVEL  DIR  ROS  GZ\nOK     GZ->ROS  /old  /old\n"
+        "[INFO] [1795988267.1] [ros_gz_bridge]: between\n"
+        "LEVEL  DIR  ROS  GZ\nOK     GZ->ROS  /clock  /clock\n"
+        "[WARN] [1795988267.179061441] [ros_gz_bridge]: GZ->ROS [/amp_tf]: waiting for Gazebo\n"
+        "why GZ->ROS /amp_tf: no Gazebo publisher\n"
+    )
+    assert status_table(output) == (
+        "LEVEL  DIR  ROS  GZ\nOK     GZ->ROS  /clock  /clock\n"
+        "why GZ->ROS /amp_tf: no Gazebo publisher"
+    )
