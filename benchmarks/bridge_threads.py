@@ -17,14 +17,17 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+#: The start of a libzmq thread's name: after a number where its context has one
+#: (``6/ZMQbg/IO/0``, the bulk path's; ``transport/zmq/bulk_context.py``).
+LIBZMQ_THREAD = r"(\d+/)?ZMQbg/"
 #: Roles by OS thread name, first match wins; the order is the order of the tables.
 ROLES = (
     ("Gazebo -> ROS loop", re.compile(r"^(gz-native|native-gz)$")),
     ("ROS -> Gazebo loop", re.compile(r"^(ros-loop|native-ros)$")),
     ("fallback (Python)", re.compile(r"^(gz-fallback|native-fallback|ros-fallback)$")),
     ("topic readers (Python, gz-sub)", re.compile(r"^gz-sub")),
-    ("libzmq I/O", re.compile(r"^(\d+/)?ZMQbg/IO")),
-    ("libzmq other", re.compile(r"^(\d+/)?ZMQbg/")),
+    ("libzmq I/O", re.compile(rf"^{LIBZMQ_THREAD}IO")),
+    ("libzmq other", re.compile(rf"^{LIBZMQ_THREAD}")),
     ("Fast DDS events", re.compile(r"^dds\.ev")),
     ("Fast DDS shared-memory receive", re.compile(r"^dds\.shm\.\d")),
     ("Fast DDS UDP receive", re.compile(r"^dds\.udp")),

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 
+from benchmarks.bridge_threads import LIBZMQ_THREAD
 from benchmarks.payloads import KINDS
 from benchmarks.transport import STATS_LINE
 from benchmarks.workers import MATCH_WAIT
@@ -49,9 +50,8 @@ def topic_name(stem: str) -> str:
 
 
 #: Thread groups of a bridge process, by the start of the thread's name (``comm``): the
-#: threads libzmq and Fast DDS start name themselves (libzmq's after a number where the
-#: context has one: ``6/ZMQbg/IO/0``, the bulk path's); Python's threads keep the process name.
-THREAD_GROUPS = (("libzmq I/O", re.compile(r"(\d+/)?ZMQbg/")), ("Fast DDS", re.compile(r"dds\.")))
+#: threads libzmq and Fast DDS start name themselves; Python's threads keep the process name.
+THREAD_GROUPS = (("libzmq I/O", re.compile(LIBZMQ_THREAD)), ("Fast DDS", re.compile(r"dds\.")))
 PYTHON_THREADS = "Python"
 
 

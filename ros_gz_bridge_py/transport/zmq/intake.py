@@ -78,20 +78,17 @@ class DataIntake:
             node.count, max_bytes, sub.large_messages,
         )  # fmt: skip
         native = sub.native
-        if native is None and sub.large_messages:
-            bulk = self._bulk_context()
-            reader: Reader = SubscriptionReader(
-                bulk.context, topic, deliver=sub.run, size=size, on_start=bulk.following(on_start)
-            )
-        elif native is None:
-            reader = SubscriptionReader(
-                self._context, topic, deliver=sub.run, size=size, on_start=on_start
-            )
-        else:
+        if native is not None:
             shared = None if sub.large_messages else self._shared_sub(native)
-            reader = NativeReader(
+            reader: Reader = NativeReader(
                 self._context, topic, deliver=sub.run, size=size, native=native, shared=shared
             )
+        else:
+            context, start = self._context, on_start
+            if sub.large_messages:  # its frames read by an I/O thread of their own
+                bulk = self._bulk_context()
+                context, start = bulk.context, bulk.following(on_start)
+            reader = SubscriptionReader(context, topic, deliver=sub.run, size=size, on_start=start)
         self.readers.append(reader)
         return reader
 
