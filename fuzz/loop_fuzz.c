@@ -105,6 +105,19 @@ static void init_python(void) {
     host = call(host_module, "Host", "()");
 }
 
+PyObject *function_addresses(const struct rgb_function *functions, const void *table) {
+    PyObject *addresses = PyDict_New();
+    CHECK(addresses != NULL);
+    for (const struct rgb_function *f = functions; f->name != NULL; f++) {
+        void *pointer;
+        memcpy(&pointer, (const char *)table + f->offset, sizeof pointer);
+        PyObject *address = PyLong_FromVoidPtr(pointer);
+        CHECK(address != NULL && PyDict_SetItemString(addresses, f->name, address) == 0);
+        Py_DECREF(address);
+    }
+    return addresses;
+}
+
 int bytes_equal(PyObject *object, const struct frame *f) {
     return PyBytes_Check(object) && (size_t)PyBytes_GET_SIZE(object) == f->size &&
            !memcmp(PyBytes_AS_STRING(object), f->data, f->size);

@@ -45,8 +45,8 @@ extern long live; /* ZeroMQ messages received and not closed */
 /* What rcl was given to publish: copies, in order. */
 extern struct frame published[MAX_MESSAGES];
 extern int npublished;
-/* The 9 functions a Pump is made with (pump.c pump_init), in order. */
-void fake_zmq_functions(void *functions[9]);
+/* The fake functions a Pump is made with (pump.c pump_init): {name: address}. */
+PyObject *fake_zmq_functions(void);
 
 /* The operations, by opcode (modulo OPS); a RosPump reads the same opcodes otherwise. */
 enum { OP_MESSAGE, OP_TURN, OP_TAKE, OP_FLOOD, OP_FORGET, OP_WATCH, OP_PUBLISH_FAILS, OP_BREAK,
@@ -58,6 +58,9 @@ extern PyObject *module, *host, *host_module;
 /* object.name(*args), args built from `format`; a failure prints Python's error and aborts. */
 PyObject *call(PyObject *object, const char *name, const char *format, ...);
 int bytes_equal(PyObject *object, const struct frame *f);
+/* {name: address} of each of `functions` (rgb_pump_functions, rgb_ros_pump_functions), the
+ * address read from its place in `table` (a struct zmq_foreign or ros_foreign of fakes). */
+PyObject *function_addresses(const struct rgb_function *functions, const void *table);
 
 /* The routes `pump` holds, checked whole; whether the Python reader delivers message `m`, the
  * reference (loop_fuzz_reference.c). */

@@ -349,10 +349,7 @@ static PyObject *make_pump(const uint8_t *config) {
     PyObject *programs = PyDict_New();
     for (Py_ssize_t i = 0; i < PyList_GET_SIZE(spellings); i++)
         CHECK(PyDict_SetItem(programs, PyList_GET_ITEM(spellings, i), programs_of[p]) == 0);
-    void *functions[9];
-    fake_zmq_functions(functions);
-    PyObject *addresses = PyList_New(9);
-    for (int i = 0; i < 9; i++) PyList_SET_ITEM(addresses, i, PyLong_FromVoidPtr(functions[i]));
+    PyObject *addresses = fake_zmq_functions();
     PyObject *pump = call(module, "Pump", "(yOKOndn)", "@/loopfuzz@/model/x/pose", addresses,
                           (unsigned long long)1, programs, (Py_ssize_t)model.capacity,
                           model.rate_limited_all ? 1e-3 : 0.0, (Py_ssize_t)model.max_bytes);

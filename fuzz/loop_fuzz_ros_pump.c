@@ -324,10 +324,12 @@ static PyObject *make_ros_pump(const uint8_t *config) {
         CHECK(item != NULL && PyList_Append(spellings, item) == 0);
         Py_DECREF(item);
     }
-    void *functions[] = {f_take, f_set_callback, f_reset_error, f_default_allocator,
-                         f_publisher_rmw_handle, f_gid_for_publisher, f_send};
-    PyObject *addresses = PyList_New(7);
-    for (int i = 0; i < 7; i++) PyList_SET_ITEM(addresses, i, PyLong_FromVoidPtr(functions[i]));
+    static const struct ros_foreign fakes = {
+        .take = f_take, .set_callback = f_set_callback, .reset_error = f_reset_error,
+        .default_allocator = f_default_allocator, .publisher_rmw_handle = f_publisher_rmw_handle,
+        .gid_for_publisher = f_gid_for_publisher, .send = f_send,
+    };
+    PyObject *addresses = function_addresses(rgb_ros_pump_functions, &fakes);
     PyObject *pump = call(module, "RosPump", "(OKKOd)", addresses, (unsigned long long)1,
                           (unsigned long long)1, spellings, ros.rate_limited_all ? 1e-3 : 0.0);
     Py_DECREF(addresses);

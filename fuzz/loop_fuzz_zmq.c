@@ -90,8 +90,11 @@ static int f_publish(const void *publisher, const void *message, void *allocatio
 
 static void f_reset_error(void) {}
 
-void fake_zmq_functions(void *functions[9]) {
-    void *all[] = {f_msg_init, f_msg_recv, f_msg_close, f_msg_data, f_msg_size,
-                   f_msg_more, f_getsockopt, f_publish, f_reset_error};
-    memcpy(functions, all, sizeof all);
+PyObject *fake_zmq_functions(void) {
+    static const struct zmq_foreign fakes = {
+        .msg_init = f_msg_init, .msg_recv = f_msg_recv, .msg_close = f_msg_close,
+        .msg_data = f_msg_data, .msg_size = f_msg_size, .msg_more = f_msg_more,
+        .getsockopt = f_getsockopt, .publish = f_publish, .reset_error = f_reset_error,
+    };
+    return function_addresses(rgb_pump_functions, &fakes);
 }

@@ -26,6 +26,8 @@ class Extension(Protocol):
     EVENT_HANDED: int
     EVENT_MONITOR: int
     EVENT_BROKEN: int
+    PUMP_FUNCTIONS: tuple[str, ...]
+    ROS_PUMP_FUNCTIONS: tuple[str, ...]
 
 
 @functools.cache

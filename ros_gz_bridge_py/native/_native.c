@@ -1,6 +1,7 @@
 /* The module of the native data plane (docs/native.md): its types (one a file, _native.h),
- * the constants Python reads from here, defined once (the events of a loop's report), the
- * named structures the types return, and the helpers the files share. */
+ * the constants Python reads from here, defined once (the events of a loop's report, the names
+ * of the foreign functions each type calls), the named structures the types return, and the
+ * helpers the files share. */
 #include "_native.h"
 
 #include <string.h>
@@ -37,22 +38,32 @@ PyObject *rgb_record(PyTypeObject *type, PyObject *values) {
     return record;
 }
 
-int rgb_addresses(PyObject *functions, void **out, Py_ssize_t count) {
-    PyObject *sequence = PySequence_Fast(functions, "functions must be a sequence");
-    if (sequence == NULL) return -1;
-    int result = 0;
-    if (PySequence_Fast_GET_SIZE(sequence) != count) {
-        PyErr_Format(PyExc_ValueError, "functions: %zd addresses expected", count);
-        result = -1;
-    }
-    for (Py_ssize_t i = 0; result == 0 && i < count; i++) {
-        out[i] = PyLong_AsVoidPtr(PySequence_Fast_GET_ITEM(sequence, i));
-        if (out[i] == NULL) {
-            if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "a null function address");
-            result = -1;
+int rgb_functions(PyObject *addresses, const struct rgb_function *functions, void *table) {
+    for (const struct rgb_function *f = functions; f->name != NULL; f++) {
+        PyObject *address = PyDict_GetItemString(addresses, f->name); /* borrowed */
+        void *pointer = address != NULL ? PyLong_AsVoidPtr(address) : NULL;
+        if (pointer == NULL) { /* missing or 0; else not an address, and its error stands */
+            if (!PyErr_Occurred())
+                PyErr_Format(PyExc_ValueError, "functions: no address of %s", f->name);
+            return -1;
         }
+        memcpy((char *)table + f->offset, &pointer, sizeof pointer); /* a function pointer */
     }
-    Py_DECREF(sequence);
+    return 0;
+}
+
+/* Adds the names of `functions` to module `m` as the tuple `name`. */
+static int add_names(PyObject *m, const char *name, const struct rgb_function *functions) {
+    Py_ssize_t n = 0;
+    while (functions[n].name != NULL) n++;
+    PyObject *names = PyTuple_New(n);
+    for (Py_ssize_t i = 0; names != NULL && i < n; i++) {
+        PyObject *item = PyUnicode_FromString(functions[i].name);
+        if (item == NULL) Py_CLEAR(names);
+        else PyTuple_SET_ITEM(names, i, item);
+    }
+    int result = names != NULL ? PyModule_AddObjectRef(m, name, names) : -1;
+    Py_XDECREF(names);
     return result;
 }
 
@@ -117,7 +128,9 @@ PyMODINIT_FUNC PyInit__native(void) {
     }
     if (PyModule_AddIntConstant(m, "EVENT_HANDED", RGB_EVENT_HANDED) < 0 ||
         PyModule_AddIntConstant(m, "EVENT_MONITOR", RGB_EVENT_MONITOR) < 0 ||
-        PyModule_AddIntConstant(m, "EVENT_BROKEN", RGB_EVENT_BROKEN) < 0)
+        PyModule_AddIntConstant(m, "EVENT_BROKEN", RGB_EVENT_BROKEN) < 0 ||
+        add_names(m, "PUMP_FUNCTIONS", rgb_pump_functions) < 0 ||
+        add_names(m, "ROS_PUMP_FUNCTIONS", rgb_ros_pump_functions) < 0)
         goto failed;
     return m;
 failed:

@@ -32,9 +32,18 @@ extern struct rgb_records {
 
 /* A record of `type` holding the items of `values` (a tuple, stolen; NULL passes through). */
 PyObject *rgb_record(PyTypeObject *type, PyObject *values);
-/* Reads the `count` function addresses of the sequence `functions` (found by abi.py) into
- * `out`; -1 with a Python error unless it holds exactly that many, none null. */
-int rgb_addresses(PyObject *functions, void **out, Py_ssize_t count);
+/* A function of a foreign library a type calls: its name, and where its pointer goes in the
+ * type's table of them (struct zmq_foreign, struct ros_foreign). Each type's list, ended by a
+ * NULL name, is the one declaration of what it calls: exported to Python (PUMP_FUNCTIONS,
+ * ROS_PUMP_FUNCTIONS), which finds each function's address by that name (abi.py). */
+struct rgb_function {
+    const char *name;
+    size_t offset;
+};
+extern const struct rgb_function rgb_pump_functions[], rgb_ros_pump_functions[];
+/* Fills the table at `table` from `addresses` (a dict of name to address) by the names of
+ * `functions`; -1 with a Python error where one is missing or null. */
+int rgb_functions(PyObject *addresses, const struct rgb_function *functions, void *table);
 /* A copy of `n` bytes (malloc; NULL only when memory runs out). */
 uint8_t *rgb_copy(const void *p, size_t n);
 int64_t rgb_now_ns(clockid_t clock);
@@ -272,7 +281,6 @@ struct ros_foreign {
     int (*gid_for_publisher)(const void *rmw_publisher, rmw_gid *gid);
     int (*send)(void *socket, const void *buffer, size_t length, int flags);
 };
-_Static_assert(sizeof(struct ros_foreign) == 7 * sizeof(void *), "the functions, in order");
 
 #define MAX_SPELLINGS 4
 #define MAX_IGNORED 16

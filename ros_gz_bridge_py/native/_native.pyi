@@ -10,6 +10,10 @@ Buffer = bytes | bytearray | memoryview
 EVENT_HANDED: int
 EVENT_MONITOR: int
 EVENT_BROKEN: int
+#: The foreign functions a Pump and a RosPump call, by name: what their ``functions`` map to
+#: addresses (``abi.py`` finds them in the loaded libraries).
+PUMP_FUNCTIONS: tuple[str, ...]
+ROS_PUMP_FUNCTIONS: tuple[str, ...]
 
 @final
 class Program:
@@ -88,7 +92,7 @@ class Pump:
     def __init__(
         self,
         topic: bytes,
-        functions: Sequence[int],
+        functions: dict[str, int],
         publisher: int,
         programs: dict[bytes, Program],
         capacity: int,
@@ -134,7 +138,7 @@ class RosPump:
         """The errno that took the channel off its loop (its socket or eventfd failed), or 0."""
     def __init__(
         self,
-        functions: Sequence[int],
+        functions: dict[str, int],
         subscription: int,
         sock: int,
         spellings: list[tuple[bytes, bytes, bytes, Encoder]],

@@ -2,9 +2,10 @@
 are laid out as the loops declare them (docs/native.md §5, §7).
 
 The loops call libzmq and rcl/rmw without linking them or reading their headers: their
-functions are the ones the libraries pyzmq and rclpy loaded, passed to C by address
-(:func:`zmq_functions`, :func:`ros_functions`), and the few structures passed to them are
-declared by hand. pump.c declares ``zmq_msg_t`` as the 64 bytes of libzmq 4.2 and later (4.0 had
+functions are the ones the libraries pyzmq and rclpy loaded, found here by the names the
+extension gives (``PUMP_FUNCTIONS``, ``ROS_PUMP_FUNCTIONS``: its one list of them) and passed to
+it by name (:func:`zmq_functions`, :func:`ros_functions`), and the few structures passed to them
+are declared by hand. pump.c declares ``zmq_msg_t`` as the 64 bytes of libzmq 4.2 and later (4.0 had
 32, early 4.1 48); ros_pump.c declares ``rmw_message_info_t`` with the 16-byte ``rmw_gid_t`` of
 Iron and later (Humble and before: 24 bytes, so every field after the GID would be read at the
 wrong place). Where the loaded libraries are known to differ, or a function is missing, the
@@ -21,8 +22,10 @@ import functools
 import importlib.metadata
 import logging
 import os
+from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
+
+from ros_gz_bridge_py.native import extension
 
 _LOG = logging.getLogger("ros_gz_bridge_py.native")
 
@@ -33,9 +36,6 @@ RCLPY_24_BYTE_GID = 3
 #: Distributions whose rmw_gid_t holds 24 bytes.
 DISTROS_24_BYTE_GID = frozenset({"ardent", "bouncy", "crystal", "dashing", "eloquent", "foxy",
                                  "galactic", "humble"})  # fmt: skip
-#: The functions a Pump calls (pump.c), in its order: libzmq's, then rcl's and rcutils'.
-_ZMQ_FUNCTIONS = ("zmq_msg_init", "zmq_msg_recv", "zmq_msg_close", "zmq_msg_data",
-                  "zmq_msg_size", "zmq_msg_more", "zmq_getsockopt")  # fmt: skip
 
 
 def zmq_problem(version: tuple[int, ...]) -> str:
@@ -115,60 +115,58 @@ def libzmq_path() -> str | None:
     return next((path for path in loaded_libraries() if "/libzmq" in path), None)
 
 
-def _addresses(functions: list[Any]) -> tuple[int, ...] | None:
-    addresses = tuple(ctypes.cast(function, ctypes.c_void_p).value or 0 for function in functions)
-    return addresses if all(addresses) else None
+def find_functions(
+    names: Iterable[str], libraries: Mapping[str, str]
+) -> tuple[dict[str, int], str]:
+    """The address of each function of ``names``, found in the library its name's prefix
+    names (``zmq_msg_recv``: ``libraries["zmq"]``, a path or a loaded library's name); or {}
+    and why not."""
+    found: dict[str, int] = {}
+    try:
+        loaded = {prefix: ctypes.CDLL(path) for prefix, path in libraries.items()}
+        for name in names:
+            function = getattr(loaded[name.partition("_")[0]], name)
+            found[name] = ctypes.cast(function, ctypes.c_void_p).value or 0
+    except (OSError, AttributeError, KeyError) as err:
+        return {}, f"a function the native loop calls cannot be found ({err})"
+    missing = [name for name, address in found.items() if not address]
+    return ({}, f"{', '.join(missing)} has no address") if missing else (found, "")
 
 
 @functools.cache
-def zmq_functions() -> tuple[int, ...] | None:
-    """The addresses of the libzmq and rcl functions a Pump calls, or None (then no channel
-    takes the native path; logged once why)."""
-    path, addresses = libzmq_path(), None
+def zmq_functions() -> dict[str, int] | None:
+    """The addresses of the functions a Pump calls (``PUMP_FUNCTIONS``: libzmq's, rcl's and
+    rcutils'), by name, or None (then no channel takes the native path; logged once why)."""
+    native = extension()
+    if native is None:
+        return None
+    path = libzmq_path()
+    found: dict[str, int] = {}
     problem = "pyzmq's libzmq is not among the loaded libraries"
-    try:
-        if path is not None:
-            libzmq, rcl = ctypes.CDLL(path), ctypes.CDLL("librcl.so")
-            functions = [getattr(libzmq, name) for name in _ZMQ_FUNCTIONS]
-            functions += [
-                rcl.rcl_publish_serialized_message,
-                ctypes.CDLL("librcutils.so").rcutils_reset_error,
-            ]
-            addresses, problem = _addresses(functions), "a function has no address"
-    except (OSError, AttributeError) as err:
-        problem = f"libzmq or rcl cannot be used from C ({err})"
-    if addresses is None:
+    if path is not None:
+        libraries = {"zmq": path, "rcl": "librcl.so", "rcutils": "librcutils.so"}
+        found, problem = find_functions(native.PUMP_FUNCTIONS, libraries)
+    if not found:
         _LOG.warning("Every channel takes the Python path: %s", problem)
-    return addresses
+    return found or None
 
 
 @functools.cache
-def ros_functions() -> tuple[int, ...] | None:
-    """The addresses of the rcl, rmw, rcutils and libzmq functions a RosPump calls, or None
-    (logged once why)."""
-    path, rmw = libzmq_path(), _rmw_library()
-    if path is None or rmw is None:
+def ros_functions() -> dict[str, int] | None:
+    """The addresses of the functions a RosPump calls (``ROS_PUMP_FUNCTIONS``: rcl's, rmw's,
+    rcutils' and libzmq's), by name, or None (logged once why)."""
+    native = extension()
+    path, rmw = (libzmq_path(), _rmw_library()) if native is not None else (None, None)
+    if native is None or path is None or rmw is None:
         return None
-    try:
-        rcl, rcutils = ctypes.CDLL("librcl.so"), ctypes.CDLL("librcutils.so")
-        functions = [
-            rcl.rcl_take_serialized_message,
-            rcl.rcl_subscription_set_on_new_message_callback,
-            rcutils.rcutils_reset_error,
-            rcutils.rcutils_get_default_allocator,
-            rcl.rcl_publisher_get_rmw_handle,
-            rmw.rmw_get_gid_for_publisher,
-            ctypes.CDLL(path).zmq_send,
-        ]
-    except (OSError, AttributeError) as err:
-        _LOG.warning(
-            "ROS -> Gazebo channels convert in Python: rcl cannot be used from C (%s)", err
-        )
-        return None
-    return _addresses(functions)
+    libraries = {"zmq": path, "rcl": "librcl.so", "rcutils": "librcutils.so", "rmw": rmw}
+    found, problem = find_functions(native.ROS_PUMP_FUNCTIONS, libraries)
+    if not found:
+        _LOG.warning("ROS -> Gazebo channels convert in Python: %s", problem)
+    return found or None
 
 
-def _rmw_library() -> Any:
+def _rmw_library() -> str | None:
     """The loaded rmw library that has ``rmw_get_gid_for_publisher``: rmw_implementation's
     dispatcher where rcl goes through it (a ROS install), else the implementation rcl is
     linked with (the PyPI wheels link rmw_fastrtps_cpp)."""
@@ -176,8 +174,7 @@ def _rmw_library() -> Any:
     candidates.sort(key=lambda path: "rmw_implementation" not in path)
     for candidate in candidates:
         with contextlib.suppress(OSError, AttributeError):
-            library = ctypes.CDLL(candidate)
-            library.rmw_get_gid_for_publisher  # noqa: B018 - does it have the function?
-            return library
+            ctypes.CDLL(candidate).rmw_get_gid_for_publisher  # noqa: B018 - does it have it?
+            return candidate
     _LOG.warning("ROS -> Gazebo channels convert in Python: no loaded rmw library gives GIDs")
     return None

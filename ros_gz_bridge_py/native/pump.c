@@ -5,13 +5,20 @@
  * makes it with the channel's ROS publisher, gives it the topic's socket (`read_from`), and
  * adds it to its direction's Loop (loop.c). Between the loop's runs, Python takes what the pump
  * left to it (`take_handed`), tells it the routes of the senders it judged (`learn`) and reads
- * its counts. libzmq and rcl are the libraries pyzmq and rclpy already loaded: Python passes
- * the addresses of their functions (abi.py). */
+ * its counts. libzmq and rcl are the libraries pyzmq and rclpy already loaded: Python finds
+ * the functions rgb_pump_functions names there and passes their addresses by name (abi.py). */
 #include "_native.h"
 
 #include <string.h>
 
-_Static_assert(sizeof(struct zmq_foreign) == 9 * sizeof(void *), "the functions, in order");
+#define FUNCTION(name, field) {name, offsetof(struct zmq_foreign, field)}
+const struct rgb_function rgb_pump_functions[] = {
+    FUNCTION("zmq_msg_init", msg_init),     FUNCTION("zmq_msg_recv", msg_recv),
+    FUNCTION("zmq_msg_close", msg_close),   FUNCTION("zmq_msg_data", msg_data),
+    FUNCTION("zmq_msg_size", msg_size),     FUNCTION("zmq_msg_more", msg_more),
+    FUNCTION("zmq_getsockopt", getsockopt), FUNCTION("rcl_publish_serialized_message", publish),
+    FUNCTION("rcutils_reset_error", reset_error), {NULL, 0},
+};
 
 #define MAX_ROUTES 1024
 /* Routes a full table keeps: the most recently used (and those a waiting message names). */
@@ -125,9 +132,7 @@ static PyObject *pump_new(PyTypeObject *type, PyObject *args, PyObject *kwds) {
 }
 
 /* Pump(topic, functions, publisher, programs, capacity, max_rate, max_bytes)
- * functions: 9 addresses (zmq_msg_init, zmq_msg_recv, zmq_msg_close, zmq_msg_data,
- * zmq_msg_size, zmq_msg_more, zmq_getsockopt, rcl_publish_serialized_message,
- * rcutils_reset_error); programs: {wire type (bytes): Program}. */
+ * functions: {name: address} of rgb_pump_functions; programs: {wire type (bytes): Program}. */
 static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"topic", "functions", "publisher", "programs", "capacity",
                                "max_rate", "max_bytes", NULL};
@@ -140,19 +145,17 @@ static int pump_init(PumpObject *self, PyObject *args, PyObject *kwds) {
         PyErr_SetString(PyExc_RuntimeError, "a Pump is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*OKO!ndn", keywords, &topic, &functions,
-                                     &publisher, &PyDict_Type, &programs, &capacity, &max_rate,
-                                     &max_bytes))
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "y*O!KO!ndn", keywords, &topic, &PyDict_Type,
+                                     &functions, &publisher, &PyDict_Type, &programs, &capacity,
+                                     &max_rate, &max_bytes))
         return -1;
     int result = -1;
-    void *addresses[9];
-    if (rgb_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0) goto done;
+    if (rgb_functions(functions, rgb_pump_functions, &self->f) < 0) goto done;
     if ((publisher == 0 && PyDict_Size(programs) > 0) || capacity < 1 ||
         capacity > (1 << 24) || !(max_rate >= 0) || max_bytes < 1) {
         PyErr_SetString(PyExc_ValueError, "publisher, capacity, max_rate or max_bytes out of range");
         goto done;
     }
-    memcpy(&self->f, addresses, sizeof self->f); /* the same order, all pointers */
     self->publisher = (void *)(uintptr_t)publisher;
     Py_ssize_t n = PyDict_Size(programs);
     self->programs = calloc((size_t)n + 1, sizeof *self->programs);

@@ -5,8 +5,8 @@
  * channel's own PUB socket and an encoder per spelling, adds it to its direction's Loop
  * (loop.c), tells it the spellings Gazebo subscribers take and the bridge's own publishers to
  * skip, and between the loop's runs takes what the encoders left to it and reads its counts.
- * rcl, rmw, rcutils and libzmq functions come from the libraries rclpy and pyzmq loaded
- * (abi.py). */
+ * The rcl, rmw, rcutils and libzmq functions rgb_ros_pump_functions names come from the
+ * libraries rclpy and pyzmq loaded, their addresses passed by name (abi.py). */
 #include "_native.h"
 
 #include <string.h>
@@ -53,11 +53,21 @@ static uint8_t *copy_buffer(PyObject *bytes, size_t *len) {
     return rgb_copy(PyBytes_AS_STRING(bytes), *len);
 }
 
+#define FUNCTION(name, field) {name, offsetof(struct ros_foreign, field)}
+const struct rgb_function rgb_ros_pump_functions[] = {
+    FUNCTION("rcl_take_serialized_message", take),
+    FUNCTION("rcl_subscription_set_on_new_message_callback", set_callback),
+    FUNCTION("rcutils_reset_error", reset_error),
+    FUNCTION("rcutils_get_default_allocator", default_allocator),
+    FUNCTION("rcl_publisher_get_rmw_handle", publisher_rmw_handle),
+    FUNCTION("rmw_get_gid_for_publisher", gid_for_publisher),
+    FUNCTION("zmq_send", send),
+    {NULL, 0},
+};
+
 /* RosPump(functions, subscription, sock, spellings, max_rate)
- * functions: 7 addresses (rcl_take_serialized_message,
- * rcl_subscription_set_on_new_message_callback, rcutils_reset_error,
- * rcutils_get_default_allocator, rcl_publisher_get_rmw_handle, rmw_get_gid_for_publisher,
- * zmq_send); spellings: [(type, topic, sender, Encoder)], the configured spelling first. */
+ * functions: {name: address} of rgb_ros_pump_functions; spellings: [(type, topic, sender,
+ * Encoder)], the configured spelling first. */
 static int ros_pump_init(RosPumpObject *self, PyObject *args, PyObject *kwds) {
     static char *keywords[] = {"functions", "subscription", "sock", "spellings", "max_rate", NULL};
     PyObject *functions, *spellings;
@@ -67,17 +77,15 @@ static int ros_pump_init(RosPumpObject *self, PyObject *args, PyObject *kwds) {
         PyErr_SetString(PyExc_RuntimeError, "a RosPump is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OKKO!d", keywords, &functions, &subscription,
-                                     &sock, &PyList_Type, &spellings, &max_rate))
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "O!KKO!d", keywords, &PyDict_Type, &functions,
+                                     &subscription, &sock, &PyList_Type, &spellings, &max_rate))
         return -1;
-    void *addresses[7];
-    if (rgb_addresses(functions, addresses, sizeof addresses / sizeof *addresses) < 0) return -1;
+    if (rgb_functions(functions, rgb_ros_pump_functions, &self->f) < 0) return -1;
     Py_ssize_t n = PyList_GET_SIZE(spellings);
     if (subscription == 0 || sock == 0 || n < 1 || n > MAX_SPELLINGS || !(max_rate >= 0)) {
         PyErr_SetString(PyExc_ValueError, "bad handles, spellings or max_rate");
         return -1;
     }
-    memcpy(&self->f, addresses, sizeof self->f); /* the same order, all pointers */
     self->encoders = PyList_New(0);
     if (self->encoders == NULL) return -1;
     for (Py_ssize_t i = 0; i < n; i++) {

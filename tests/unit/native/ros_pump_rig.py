@@ -28,8 +28,8 @@ SEND = ctypes.CFUNCTYPE(
 )
 
 
-def functions() -> tuple[int, ...]:
-    """The functions a RosPump calls (skips where rcl cannot be called from C)."""
+def functions() -> dict[str, int]:
+    """The functions a RosPump calls, by name (skips where rcl cannot be called from C)."""
     from ros_gz_bridge_py.native.abi import ros_functions  # noqa: PLC0415
 
     found = ros_functions()
@@ -74,9 +74,9 @@ class Channel:
         self.sub.connect(self.pub.getsockopt_string(zmq.LAST_ENDPOINT))
         encoder = encoder_of(default_registry().get("std_msgs/msg/String", TYPE.decode()))
         assert encoder is not None
-        addresses = list(functions())
+        addresses = functions()
         if send is not None:
-            addresses[6] = send
+            addresses = {**addresses, "zmq_send": send}
         self.pump = native.RosPump(
             addresses,
             self.subscription.handle.pointer,
