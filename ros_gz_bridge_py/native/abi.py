@@ -115,6 +115,10 @@ def libzmq_path() -> str | None:
     return next((path for path in loaded_libraries() if "/libzmq" in path), None)
 
 
+#: The libraries of rcl's and rcutils' functions, by the prefix of their names (loaded by rclpy).
+_ROS_LIBRARIES = {"rcl": "librcl.so", "rcutils": "librcutils.so"}
+
+
 def find_functions(
     names: Iterable[str], libraries: Mapping[str, str]
 ) -> tuple[dict[str, int], str]:
@@ -144,8 +148,7 @@ def zmq_functions() -> dict[str, int] | None:
     found: dict[str, int] = {}
     problem = "pyzmq's libzmq is not among the loaded libraries"
     if path is not None:
-        libraries = {"zmq": path, "rcl": "librcl.so", "rcutils": "librcutils.so"}
-        found, problem = find_functions(native.PUMP_FUNCTIONS, libraries)
+        found, problem = find_functions(native.PUMP_FUNCTIONS, {**_ROS_LIBRARIES, "zmq": path})
     if not found:
         _LOG.warning("Every channel takes the Python path: %s", problem)
     return found or None
@@ -156,10 +159,12 @@ def ros_functions() -> dict[str, int] | None:
     """The addresses of the functions a RosPump calls (``ROS_PUMP_FUNCTIONS``: rcl's, rmw's,
     rcutils' and libzmq's), by name, or None (logged once why)."""
     native = extension()
-    path, rmw = (libzmq_path(), _rmw_library()) if native is not None else (None, None)
-    if native is None or path is None or rmw is None:
+    if native is None:
         return None
-    libraries = {"zmq": path, "rcl": "librcl.so", "rcutils": "librcutils.so", "rmw": rmw}
+    path, rmw = libzmq_path(), _rmw_library()
+    if path is None or rmw is None:
+        return None
+    libraries = {**_ROS_LIBRARIES, "zmq": path, "rmw": rmw}
     found, problem = find_functions(native.ROS_PUMP_FUNCTIONS, libraries)
     if not found:
         _LOG.warning("ROS -> Gazebo channels convert in Python: %s", problem)
