@@ -2,18 +2,17 @@
 and the plots.
 
 Usage: ``.venv/bin/python -m benchmarks.headline`` (``benchmarks.run`` calls it last). It
-reads what ``sustained``, ``costs``, ``starvation`` and ``fleet`` stored in
-``benchmarks/results.json``,
-writes the headline at the top of BENCHMARKS.md and draws the plots it links.
-Each figure is shown with the commit and date of the run it came from, and each verdict is
-computed from the figure beside it when the headline is written, never stored.
+reads what ``sustained``, ``costs``, ``starvation``, ``fleet`` and ``busy_neighbour`` stored
+in ``benchmarks/results.json``, writes the headline at the top of BENCHMARKS.md and draws the
+plots it links. Each figure is shown with the commit and date of the run it came from, and each
+verdict is computed from the figure beside it when the headline is written, never stored.
 """
 
 from __future__ import annotations
 
 import sys
 
-from benchmarks import plots, starvation
+from benchmarks import busy_neighbour, plots, starvation
 from benchmarks.costs import (
     GZ_TO_ROS,
     ROS_TO_GZ,
@@ -363,11 +362,16 @@ def section(
     clock: Stored | None,
     plots_text: str,
     fleet_run: Stored | None = None,
+    *,
+    busy_run: Stored | None = None,
 ) -> str:
-    """The headline, from the stored runs of ``sustained``, ``costs``, ``starvation`` and
-    ``fleet``."""
+    """The headline, from the stored runs of ``sustained``, ``costs``, ``starvation``,
+    ``fleet`` and ``busy_neighbour``."""
     rows = [*image_rows(sustained), clock_row(clock), *cpu_rows(costs)]
-    named = {"sustained": sustained, "costs": costs, "starvation": clock, "fleet": fleet_run}
+    named = {
+        "sustained": sustained, "costs": costs, "starvation": clock, "fleet": fleet_run,
+        "busy_neighbour": busy_run,
+    }  # fmt: skip
     present = {name: stored for name, stored in named.items() if stored is not None}
     runs = [f"- `{name}`: {stored.run_line()}" for name, stored in present.items()]
     notes = clock_notes(clock)
@@ -411,6 +415,10 @@ A fleet as users run it (issues 28, 36){_from(fleet_run)}: every figure against 
 of the same run (details in [its report](benchmarks/reports/fleet.md)):
 {chr(10).join(fleet_lines(fleet_run))}
 
+One topic at 20 kHz (issue 36){_from(busy_run)}: against an rclpy publisher of the same run
+(details in [its report](benchmarks/reports/busy_neighbour.md)):
+{chr(10).join(busy_neighbour.goal_lines(busy_run))}
+
 Measured (2 cores shared with other work: every figure is noisy, the load averages say how
 busy the machine was):
 {chr(10).join(runs)}
@@ -420,7 +428,14 @@ busy the machine was):
 def main(argv: list[str] | None = None) -> int:
     del argv  # no options
     sustained, costs, clock = load("sustained"), load("costs"), load("starvation")
-    text = section(sustained, costs, clock, draw(sustained, costs), load("fleet"))
+    text = section(
+        sustained,
+        costs,
+        clock,
+        draw(sustained, costs),
+        load("fleet"),
+        busy_run=load("busy_neighbour"),
+    )
     write_section("headline", text, first=True)
     return 0
 

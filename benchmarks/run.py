@@ -3,8 +3,9 @@
 Usage: ``.venv/bin/python -m benchmarks.run [--quick] [--only NAME ...]``. The full run takes
 about 30 minutes on 2 cores; ``--quick`` shortens every phase (a smoke run, numbers noisier).
 Each module writes its own report; a module that fails is reported and the others still run.
-Last, the headline is rewritten from the figures stored by ``sustained``, ``costs`` and
-``starvation`` (this run's, or their last run's when they were not run), and its plots drawn.
+Last, the headline is rewritten from the figures stored by ``sustained``, ``costs``,
+``starvation``, ``fleet`` and ``busy_neighbour`` (this run's, or their last run's when they
+were not run), and its plots drawn.
 The Gazebo ends of ZeroMQ flows are the C++ peer on the real ign-transport 11 (built on first
 use, see ``testing/gzpeer.py``); ``BENCH_GZ_END=python`` puts our Python workers there instead.
 """
@@ -19,6 +20,7 @@ import traceback
 from collections.abc import Callable
 
 from benchmarks import (
+    busy_neighbour,
     conversion,
     costs,
     discovery,
@@ -92,6 +94,9 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
                 *("--seconds", "10" if quick else "60"),
                 *("--rounds", "1" if quick else "2"),
             ]
+        ),
+        "busy_neighbour": lambda: busy_neighbour.main(
+            ["--seconds", "2" if quick else "4", "--rounds", "1" if quick else "2"]
         ),
         "memory": lambda: memory.main(
             ["--flood-seconds", "15" if quick else "60", "--slow-seconds", "8" if quick else "15"]
