@@ -10,12 +10,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import signal
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from benchmarks.busy_loops import busy_loops
 from benchmarks.soak import ATTACKS_SECTION
 from testing.attacks import ROOT, AttackRun, attacks
 
@@ -98,20 +98,8 @@ def main(argv: list[str] | None = None) -> int:
         "--load", type=int, default=0, help="busy loops beside the bridge (its own section)"
     )
     args = parser.parse_args(argv)
-    # each in a process group of its own, killed whole (timeout and yes): they stop by
-    # themselves after 15 minutes if this process dies first
-    loops = [
-        subprocess.Popen(
-            ["timeout", "900", "yes"], stdout=subprocess.DEVNULL, start_new_session=True
-        )
-        for _ in range(args.load)
-    ]
-    try:
+    with busy_loops(args.load):
         runs = _run_all(args)
-    finally:
-        for loop in loops:
-            os.killpg(loop.pid, signal.SIGKILL)
-            loop.wait()
     given = sys.argv[1:] if argv is None else argv
     command = " ".join(["python -m benchmarks.attacks", *given])
     write_section(args.report, report(runs, args.seconds, args.after, command, args.load))

@@ -19,12 +19,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
-import subprocess
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 
 from benchmarks.bridged import Backend, bridge_process, flow_through
+from benchmarks.busy_loops import busy_loops
 from benchmarks.harness import Flow, FlowResult, bridge_config, run_flow, topic_name
 from benchmarks.native_overload import QUEUE
 from benchmarks.native_paths import path_backend
@@ -67,30 +65,13 @@ def ceiling(seconds: float) -> FlowResult:
     return run_flow(_flow("ros-pub", seconds), topic_name("busy_neighbour_ceiling"), run_env())
 
 
-@contextmanager
-def busy_loop(on: bool) -> Iterator[None]:
-    """A process at 100% of a core while the block runs (``on``), in a process group of its
-    own, killed whole; it stops by itself after 15 minutes if this process dies first."""
-    if not on:
-        yield
-        return
-    busy = subprocess.Popen(
-        ["timeout", "900", "yes"], stdout=subprocess.DEVNULL, start_new_session=True
-    )
-    try:
-        yield
-    finally:
-        os.killpg(busy.pid, signal.SIGKILL)
-        busy.wait()
-
-
 def measure(seconds: float, rounds: int) -> tuple[dict[str, FlowResult], dict[str, float]]:
     """The flows by ``who.condition.round`` and the bridge's counters by
     ``bridge.condition.round.in|out|dropped``."""
     flows: dict[str, FlowResult] = {}
     numbers: dict[str, float] = {}
     for condition in CONDITIONS:
-        with busy_loop(condition == "busy"):
+        with busy_loops(1 if condition == "busy" else 0):
             for index in range(rounds):
                 order = ("bridge", "ceiling") if index % 2 == 0 else ("ceiling", "bridge")
                 for who in order:

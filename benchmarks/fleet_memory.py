@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import statistics
 import subprocess
 import sys
@@ -35,6 +34,7 @@ from dataclasses import dataclass
 import zmq
 
 from benchmarks.bridged import Backend, bridge_process, flow_through
+from benchmarks.busy_loops import busy_loops
 from benchmarks.fleet_rounds import start_bridged
 from benchmarks.harness import Flow, FlowResult, bridge_config, stop_all, topic_name
 from benchmarks.native_overload import QUEUE
@@ -243,20 +243,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         for hwm in (gz_transport, "") if index % 2 == 0 else ("", gz_transport):
             rounds.append(memory_round(args.robots, args.seconds, hwm))
             print(rounds[-1].cells(), flush=True)
-    # in a process group of its own, killed whole (timeout and yes): it stops by itself after
-    # 15 minutes if this process dies first
-    busy = subprocess.Popen(
-        ["timeout", "900", "yes"], stdout=subprocess.DEVNULL, start_new_session=True
-    )
-    try:
-        floods = []
+    floods = []
+    with busy_loops(1):
         for index in range(args.flood_rounds):
             for hwm in ("", str(args.low_hwm)) if index % 2 == 0 else (str(args.low_hwm), ""):
                 floods.append((hwm, flooded_topic(hwm)))
                 print(flood_cells(*floods[-1]), flush=True)
-    finally:
-        os.killpg(busy.pid, signal.SIGKILL)
-        busy.wait()
     command = (
         f".venv/bin/python -m benchmarks.fleet_memory --robots {args.robots} "
         f"--seconds {args.seconds:g} --rounds {args.rounds} --low-hwm {args.low_hwm} "
