@@ -21,14 +21,13 @@ import argparse
 import os
 from collections.abc import Sequence
 
-from benchmarks.bridged import Backend, bridge_process, flow_through
+from benchmarks.bridged import bridge_process, flow_through
 from benchmarks.busy_loops import busy_loops
 from benchmarks.harness import Flow, FlowResult, bridge_config, run_flow, topic_name
 from benchmarks.native_overload import QUEUE
-from benchmarks.native_paths import path_backend
+from benchmarks.native_paths import Counters, counted_since, counters, path_backend
 from benchmarks.report import write_section
 from benchmarks.results import Stored, load, store
-from benchmarks.starvation import channel_counts
 from benchmarks.tables import verdict
 from testing.run_env import run_env
 
@@ -43,21 +42,16 @@ def _flow(publisher: str, seconds: float) -> Flow:
     return Flow(publisher, "ros-sub", "odometry", seconds, HZ, depth=QUEUE, raw=True)
 
 
-def bridged(seconds: float) -> tuple[FlowResult, tuple[int, int, int] | None]:
-    """One round through a fresh bridge: the flow, and the channel's IN, OUT and DROPPED."""
+def bridged(seconds: float) -> tuple[FlowResult, Counters | None]:
+    """One round through a fresh bridge: the flow, and the channel's counters over it."""
     native = path_backend("native")
     topic = topic_name("busy_neighbour")
     arguments = bridge_config([(topic, "odometry", "gz2ros")], QUEUE)
     with bridge_process(arguments, native.bridge_env, channels=1) as bridge:
-        first = channel_counts(bridge, topic)
-        result = flow_through(
-            _flow("gz-pub", seconds), topic, Backend(native.name, native.bridge_env,
-                                                     native.gz_env), bridge
-        )  # fmt: skip
-        last = channel_counts(bridge, topic)
-    if first is None or last is None:
-        return result, None
-    return result, (last[0] - first[0], last[1] - first[1], last[2] - first[2])
+        before = counters(bridge, [topic])
+        result = flow_through(_flow("gz-pub", seconds), topic, native, bridge)
+        after = counters(bridge, [topic])
+    return result, counted_since(before, after, topic)
 
 
 def ceiling(seconds: float) -> FlowResult:
@@ -80,8 +74,10 @@ def measure(seconds: float, rounds: int) -> tuple[dict[str, FlowResult], dict[st
                         flows[key] = ceiling(seconds)
                         continue
                     flows[key], counted = bridged(seconds)
-                    for name, value in zip(("in", "out", "dropped"), counted or (), strict=False):
-                        numbers[f"{key}.{name}"] = value
+                    if counted is not None:
+                        numbers[f"{key}.in"] = counted.received
+                        numbers[f"{key}.out"] = counted.published
+                        numbers[f"{key}.dropped"] = counted.dropped
                     print(key, flows[key], counted, flush=True)
     return flows, numbers
 
