@@ -25,7 +25,13 @@ from benchmarks.bridged import bridge_process, flow_through
 from benchmarks.busy_loops import busy_loops
 from benchmarks.harness import Flow, FlowResult, bridge_config, run_flow, topic_name
 from benchmarks.native_overload import QUEUE
-from benchmarks.native_paths import Counters, counted_since, counters, path_backend
+from benchmarks.native_paths import (
+    Counters,
+    counted_since,
+    counters,
+    path_backend,
+    stored_counters,
+)
 from benchmarks.report import write_section
 from benchmarks.results import Stored, load, store
 from benchmarks.tables import verdict
@@ -75,9 +81,7 @@ def measure(seconds: float, rounds: int) -> tuple[dict[str, FlowResult], dict[st
                         continue
                     flows[key], counted = bridged(seconds)
                     if counted is not None:
-                        numbers[f"{key}.in"] = counted.received
-                        numbers[f"{key}.out"] = counted.published
-                        numbers[f"{key}.dropped"] = counted.dropped
+                        numbers |= counted.numbers(f"{key}.")
                     print(key, flows[key], counted, flush=True)
     return flows, numbers
 
@@ -103,11 +107,11 @@ def where_lost(stored: Stored, condition: str) -> str:
     subscriber took of what it published, over the condition's rounds."""
     sent = received = published = dropped = 0
     for key, flow in _rounds(stored, "bridge", condition):
-        if f"{key}.out" not in stored.numbers:
+        counted = stored_counters(stored.numbers, f"{key}.")
+        if counted is None:
             return "the bridge's counters were not read"
         sent, received = sent + flow.sent, received + flow.received
-        published += int(stored.numbers[f"{key}.out"])
-        dropped += int(stored.numbers[f"{key}.dropped"])
+        published, dropped = published + counted.published, dropped + counted.dropped
     reached = published + dropped
     return (
         f"of {sent} sent the bridge received {reached} ({reached / max(sent, 1):.1%}), dropped "
@@ -145,9 +149,8 @@ def goal_lines(stored: Stored | None) -> list[str]:
 
 def _row(key: str, flow: FlowResult, numbers: dict[str, float]) -> str:
     who, condition, index = key.split(".")
-    counted = "-"
-    if f"{key}.out" in numbers:
-        counted = " / ".join(f"{numbers[f'{key}.{n}']:.0f}" for n in ("in", "out", "dropped"))
+    counters = stored_counters(numbers, f"{key}.")
+    counted = "-" if counters is None else counters.text()
     if flow.error:
         return f"| {LABELS[condition]} | {int(index) + 1} | {who} | failed: {flow.error} |||||"
     cpu = "-" if flow.cpu is None else f"{flow.cpu:.0f}%"

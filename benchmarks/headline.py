@@ -35,6 +35,7 @@ from benchmarks.fleet_goals import (
     short_kinds,
 )
 from benchmarks.harness import PYTHON_THREADS, FlowResult
+from benchmarks.native_paths import stored_counters
 from benchmarks.reference import (
     CLOCK_UNDER_FLOOD,
     CPU_PER_FRAME_30HZ,
@@ -250,11 +251,7 @@ def clock_notes(stored: Stored | None) -> list[str]:
         flow = stored.flow(phase.name)
         if flow is None:
             return []
-        numbers = stored.numbers
-        names = [f"{phase.name} bridge {counter}" for counter in ("in", "out", "dropped")]
-        counted = None
-        if all(name in numbers for name in names):
-            counted = (int(numbers[names[0]]), int(numbers[names[1]]), int(numbers[names[2]]))
+        counted = stored_counters(stored.numbers, f"{phase.name} bridge ")
         runs[phase.name] = starvation.ClockRun(phase, flow, counted)
     return starvation.bounds(runs)
 

@@ -8,7 +8,7 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from benchmarks.bridged import Backend
@@ -52,6 +52,27 @@ class Counters:
 
     def text(self) -> str:
         return f"{self.received} / {self.published} / {self.dropped}"
+
+    def numbers(self, prefix: str) -> dict[str, float]:
+        """The three counts as ``results.store`` keeps them: ``prefix`` + in, out, dropped."""
+        return {
+            f"{prefix}in": self.received,
+            f"{prefix}out": self.published,
+            f"{prefix}dropped": self.dropped,
+        }
+
+
+def stored_counters(numbers: Mapping[str, float], prefix: str) -> Counters | None:
+    """The counts :meth:`Counters.numbers` gave under ``prefix`` (the path is not stored)."""
+    try:
+        return Counters(
+            int(numbers[f"{prefix}in"]),
+            int(numbers[f"{prefix}out"]),
+            int(numbers[f"{prefix}dropped"]),
+            "",
+        )
+    except KeyError:
+        return None
 
 
 def counters(bridge: PeerProcess | None, topics: Sequence[str]) -> dict[str, Counters]:

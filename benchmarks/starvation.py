@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
-import time
 from dataclasses import dataclass
 
 from benchmarks.bridged import Backend, backend, bridge_process, flow_through
@@ -27,6 +25,7 @@ from benchmarks.harness import (
     run_flow,
     topic_name,
 )
+from benchmarks.native_paths import Counters, counted_since, counters
 from benchmarks.reference import CLOCK_UNDER_FLOOD, GOAL_CLOCK_SHARE, QUOTED
 from benchmarks.report import write_section
 from benchmarks.results import store
@@ -79,37 +78,15 @@ class ClockRun:
     phase: Phase
     result: FlowResult
     #: The bridge's IN, OUT and DROPPED counters of the clock channel over the flow.
-    counted: tuple[int, int, int] | None = None
-
-
-def channel_counts(bridge: PeerProcess | None, topic: str) -> tuple[int, int, int] | None:
-    """IN, OUT and DROPPED of the bridge's GZ->ROS channel on ``topic`` (its SIGUSR1 status
-    table)."""
-    if bridge is None:
-        return None
-    before = len(bridge.output().splitlines())
-    deadline = time.monotonic() + 5
-    while time.monotonic() < deadline:
-        # Until the bridge spins, SIGUSR1 is ignored: ask again until a table comes.
-        os.kill(bridge.pid, signal.SIGUSR1)
-        time.sleep(0.3)
-        for line in bridge.output().splitlines()[before:]:
-            fields = line.split()
-            if len(fields) >= 10 and fields[1] == "GZ->ROS" and fields[2] == topic:
-                return int(fields[5]), int(fields[6]), int(fields[8])
-    return None
+    counted: Counters | None = None
 
 
 def _counted(
     phase: Phase, flow: Flow, topic: str, which: Backend, bridge: PeerProcess | None
 ) -> ClockRun:
-    first = channel_counts(bridge, topic)
+    first = counters(bridge, [topic])
     result = flow_through(flow, topic, which, bridge)
-    last = channel_counts(bridge, topic)
-    if first is None or last is None:
-        return ClockRun(phase, result)
-    counted = (last[0] - first[0], last[1] - first[1], last[2] - first[2])
-    return ClockRun(phase, result, counted)
+    return ClockRun(phase, result, counted_since(first, counters(bridge, [topic]), topic))
 
 
 def _flow(phase: Phase, ends: tuple[str, str], seconds: float, flood: Flood | None) -> Flow:
@@ -157,7 +134,7 @@ def _row(run: ClockRun) -> str:
     r = run.result
     if r.error:
         return f"| {run.phase.label} | failed: {r.error} |||||||"
-    counted = "-" if run.counted is None else " / ".join(str(n) for n in run.counted)
+    counted = "-" if run.counted is None else run.counted.text()
     flood = "-" if r.flood is None else f"{r.flood.received}/{r.flood.sent}"
     cpu = "-" if r.cpu is None else f"{r.cpu:.0f}%"
     return (
@@ -171,12 +148,13 @@ def bounds(runs: dict[str, ClockRun]) -> list[str]:
     lines = []
     default = runs[DEFAULT.name]
     result = default.result
-    if default.counted is not None and result.sent:
-        received, published, dropped = default.counted
+    counted = default.counted
+    if counted is not None and result.sent:
+        received, published, dropped = counted.received, counted.published, counted.dropped
         took = result.received / max(published, 1)
         lines.append(
             f"- Of the {result.sent} clock messages sent under the flood, the bridge received "
-            f"{received} ({received / result.sent:.1%}; {result.sent - received - dropped} "
+            f"{received} ({received / result.sent:.1%}; {result.sent - received} "
             "never reached its queue: the Gazebo publisher drops what exceeds its send queue of "
             f"{LARGE_HWM} messages, set so (GZ_TRANSPORT_SNDHWM) for the whole flooding process "
             "to bound its queue of 6 MB frames, where Gazebo's default is 1000), dropped "
@@ -264,10 +242,10 @@ def main(argv: list[str] | None = None) -> int:
     load = os.getloadavg()[0]
     section, runs = run(args.seconds)
     write_section("starvation", section)
-    numbers = {}
+    numbers: dict[str, float] = {}
     for name, clock_run in runs.items():
-        for counter, value in zip(("in", "out", "dropped"), clock_run.counted or (), strict=False):
-            numbers[f"{name} bridge {counter}"] = float(value)
+        if clock_run.counted is not None:
+            numbers |= clock_run.counted.numbers(f"{name} bridge ")
     store("starvation", {name: r.result for name, r in runs.items()}, load, numbers)
     return 0
 

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from benchmarks import headline
+from benchmarks import headline, starvation
+from benchmarks.native_paths import Counters, stored_counters
 from benchmarks.results import Stored, stored
 
 SUSTAINED_WHEN = "2026-11-26 17:49 UTC"
@@ -30,9 +31,21 @@ def flow(
     }
 
 
-def entry(commit: str, when: str, flows: dict[str, dict[str, Any]]) -> Stored:
+def entry(
+    commit: str,
+    when: str,
+    flows: dict[str, dict[str, Any]],
+    numbers: dict[str, float] | None = None,
+) -> Stored:
     return stored(
-        {"commit": commit, "when": when, "load_before": 0.5, "load_after": 0.7, "flows": flows}
+        {
+            "commit": commit,
+            "when": when,
+            "load_before": 0.5,
+            "load_after": 0.7,
+            "flows": flows,
+            "numbers": numbers or {},
+        }
     )
 
 
@@ -144,3 +157,21 @@ def test_the_fleet_verdicts_follow_the_figures_shown() -> None:
     assert "1.50% of a core (goal < 1%): **missed** by 0.50 points" in missed
     assert "A fleet as users run it (issues 28, 36) (commit eee5555, 2026-11-28 06:00 UTC)" in met
     assert "- not measured yet (`benchmarks.fleet`)" in headline.section(None, None, None, "")
+
+
+def test_where_the_clock_was_lost_reads_the_bridge_counters_starvation_stored() -> None:
+    flows = {phase.name: flow(5000, 4950, 5.0) for phase in starvation.PHASES}
+    flows[starvation.DEFAULT.name] = flow(5000, 4800, 90.0)
+    numbers = Counters(4950, 4900, 50, "native").numbers(f"{starvation.DEFAULT.name} bridge ")
+    run = entry("ccc3333", COSTS_WHEN, flows, numbers)
+
+    (first, *_) = headline.clock_notes(run)
+
+    assert first.startswith(
+        "- Of the 5000 clock messages sent under the flood, the bridge received 4950 (99.0%; "
+        "50 never reached its queue"
+    )
+    assert first.endswith(
+        "dropped 50 in its own queue and published 4900; the subscriber took 4800 of those (98.0%)."
+    )
+    assert stored_counters(numbers, "deep bridge ") is None
