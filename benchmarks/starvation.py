@@ -179,6 +179,8 @@ def bounds(runs: dict[str, ClockRun]) -> list[str]:
             "bridge: what carrying the frames (the bridge's image channel and the rclpy "
             "subscriber of the frames, on the same 2 cores) costs the clock."
         )
+    if counted is not None and result.sent and not bypass.error and not result.error:
+        lines.append(_shares(result, counted, bypass))
     deep, ceiling = runs[DEEP.name].result, runs[CEILING.name].result
     if not deep.error:
         lines.append(
@@ -194,6 +196,22 @@ def bounds(runs: dict[str, ClockRun]) -> list[str]:
             f"{ceiling.share:.1%}."
         )
     return lines
+
+
+def _shares(result: FlowResult, counted: Counters, bypass: FlowResult) -> str:
+    """Which part of the loss under the flood the bridge can change, and which it cannot."""
+    before = result.sent - counted.received
+    after = counted.published - result.received
+    return (
+        f"- What the bridge can change, and what it cannot: of the {result.sent - result.received} "
+        f"clock messages lost under the flood, {counted.dropped} were dropped in the bridge's "
+        f"own queue (its part: the queue, and the CPU it leaves the subscriber); {before} were "
+        "lost before it, in the flooded Gazebo process's send queue, and "
+        f"{after} after it, between its ROS writer and the subscriber, whose keep-last history "
+        "only the subscriber's process empties: with the bridge at "
+        f"{bypass.cpu or 0:.0f}% of a core and its clock channel alone (the control row), the "
+        f"same subscriber still lost {1 - bypass.share:.1%}."
+    )
 
 
 def run(seconds: float) -> tuple[str, dict[str, ClockRun]]:

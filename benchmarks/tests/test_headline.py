@@ -159,13 +159,14 @@ def test_the_fleet_verdicts_follow_the_figures_shown() -> None:
     assert "- not measured yet (`benchmarks.fleet`)" in headline.section(None, None, None, "")
 
 
-def test_where_the_clock_was_lost_reads_the_bridge_counters_starvation_stored() -> None:
+def test_the_clock_notes_split_the_loss_before_in_and_after_the_bridge_from_counters() -> None:
     flows = {phase.name: flow(5000, 4950, 5.0) for phase in starvation.PHASES}
     flows[starvation.DEFAULT.name] = flow(5000, 4800, 90.0)
+    flows[starvation.BYPASS.name] = flow(5000, 4600, 8.0, cpu=7.0)
     numbers = Counters(4950, 4900, 50, "native").numbers(f"{starvation.DEFAULT.name} bridge ")
     run = entry("ccc3333", COSTS_WHEN, flows, numbers)
 
-    (first, *_) = headline.clock_notes(run)
+    first, _hop, _bypass, shares, *_ = headline.clock_notes(run)
 
     assert first.startswith(
         "- Of the 5000 clock messages sent under the flood, the bridge received 4950 (99.0%; "
@@ -174,4 +175,13 @@ def test_where_the_clock_was_lost_reads_the_bridge_counters_starvation_stored() 
     assert first.endswith(
         "dropped 50 in its own queue and published 4900; the subscriber took 4800 of those (98.0%)."
     )
+    assert shares.startswith(
+        "- What the bridge can change, and what it cannot: of the 200 clock messages lost under "
+        "the flood, 50 were dropped in the bridge's own queue"
+    )
+    assert (
+        "; 50 were lost before it, in the flooded Gazebo process's send queue, and 100 " in shares
+    )
+    assert shares.endswith("with the bridge at 7% of a core and its clock channel alone (the "
+                           "control row), the same subscriber still lost 8.0%.")  # fmt: skip
     assert stored_counters(numbers, "deep bridge ") is None
