@@ -31,8 +31,11 @@ BYTECODE := $(PY) -m compileall -q ros_gz_bridge_py
 setup-demo: $(DEMO_STAMP)
 	@$(BYTECODE)
 
+# The C++ test peer (testing/peer), built once per version of its sources; a second run only
+# checks that it is (testing/gzpeer.py).
 setup: $(STAMP)
 	@$(BYTECODE)
+	@$(PY) -m testing.gzpeer
 
 # The pinned requirements first (pyproject.toml's, without the package: tools/requirements.py),
 # then the editable package, whose native extension compiles, beside tf2_msgs's build.

@@ -1,7 +1,8 @@
 """Harness for tests that talk to real Ignition Transport 11 processes.
 
-Three kinds of real peers are offered: our scriptable C++ peer (``testing/peer``, built here on
-first use, once per source hash, into ``.build/ign_peer/<hash>/``), and the Debian CLI
+Three kinds of real peers are offered: our scriptable C++ peer (``testing/peer``, built here,
+by ``make setup`` or else on first use, once per source hash, into
+``.build/ign_peer/<hash>/``), and the Debian CLI
 binaries ``ign-transport-topic`` / ``ign-transport-service`` (called directly; the ``ign``
 Ruby wrapper is broken on bookworm). Every process started through this module is
 remembered and killed by :func:`stop_processes` (the ``gz_processes`` fixture calls it at
@@ -338,3 +339,25 @@ class Inbox:
     def wait_for_count(self, count: int, timeout: float) -> list[tuple[Any, Any]]:
         """Wait until at least ``count`` messages arrived."""
         return self.wait_for(lambda items: len(items) >= count, timeout, f"{count} messages")
+
+
+def main() -> int:
+    """``python -m testing.gzpeer``: build the C++ peer now, as ``make setup`` does, so that its
+    first build (a minute or more on 2 cores) is set-up time and not the first test's. Without
+    the Debian tools it says what is missing and exits 0: the tests that need them then skip,
+    or fail under CI=true, with the same words."""
+    missing = tools_missing()
+    if missing:
+        print(f"C++ test peer: not built, missing {', '.join(missing)}; run tools/setup_peer.sh")
+        return 0
+    if (BUILD_ROOT / _source_hash() / "ign_peer").exists():
+        print("C++ test peer: up to date")
+        return 0
+    start = time.monotonic()
+    peer_binary()
+    print(f"C++ test peer: built ({time.monotonic() - start:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
