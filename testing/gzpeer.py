@@ -159,16 +159,20 @@ def peer_binary() -> Path:
     A file lock makes concurrent pytest processes build it only once.
     """
     require_peer()
-    build = BUILD_ROOT / _source_hash()
-    binary = build / "ign_peer"
+    binary = _binary()
     if binary.exists():
         return binary
     BUILD_ROOT.mkdir(parents=True, exist_ok=True)
     with (BUILD_ROOT / ".lock").open("w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if not binary.exists():
-            _build(build)
+            _build(binary.parent)
     return binary
+
+
+def _binary() -> Path:
+    """Where the peer of the current sources is (or will be) built."""
+    return BUILD_ROOT / _source_hash() / "ign_peer"
 
 
 def _build(build: Path) -> None:
@@ -350,7 +354,7 @@ def main() -> int:
     if missing:
         print(f"C++ test peer: not built, missing {', '.join(missing)}; run tools/setup_peer.sh")
         return 0
-    if (BUILD_ROOT / _source_hash() / "ign_peer").exists():
+    if _binary().exists():
         print("C++ test peer: up to date")
         return 0
     start = time.monotonic()
