@@ -134,12 +134,19 @@ def tools_missing() -> list[str]:
     return missing
 
 
-def require_peer() -> None:
-    """Skip the calling test when the Debian tools are missing; fail instead under CI=true."""
+def missing_reason() -> str:
+    """Why the peer tests cannot run here ("" when they can)."""
     missing = tools_missing()
     if not missing:
+        return ""
+    return f"real ign-transport tools missing ({', '.join(missing)}); run tools/setup_peer.sh"
+
+
+def require_peer() -> None:
+    """Skip the calling test when the Debian tools are missing; fail instead under CI=true."""
+    reason = missing_reason()
+    if not reason:
         return
-    reason = f"real ign-transport tools missing ({', '.join(missing)}); run tools/setup_peer.sh"
     if os.environ.get("CI", "").lower() == "true":
         pytest.fail(reason)
     pytest.skip(reason)
@@ -350,9 +357,9 @@ def main() -> int:
     first build (a minute or more on 2 cores) is set-up time and not the first test's. Without
     the Debian tools it says what is missing and exits 0: the tests that need them then skip,
     or fail under CI=true, with the same words."""
-    missing = tools_missing()
-    if missing:
-        print(f"C++ test peer: not built, missing {', '.join(missing)}; run tools/setup_peer.sh")
+    reason = missing_reason()
+    if reason:
+        print(f"C++ test peer: not built, {reason}")
         return 0
     if _binary().exists():
         print("C++ test peer: up to date")

@@ -34,5 +34,6 @@ def test_missing_tools_are_named_and_do_not_stop_the_set_up(
     assert gzpeer.main() == 0
 
     assert capsys.readouterr().out == (
-        "C++ test peer: not built, missing cmake, /usr/include/x.hh; run tools/setup_peer.sh\n"
+        "C++ test peer: not built, real ign-transport tools missing (cmake, /usr/include/x.hh); "
+        "run tools/setup_peer.sh\n"
     )
