@@ -30,6 +30,7 @@ from benchmarks import (
     fleet_memory,
     headline,
     images,
+    instructions,
     memory,
     native_plane,
     small_messages,
@@ -57,6 +58,7 @@ def steps(quick: bool) -> dict[str, Callable[[], int]]:
         "sustained": lambda: sustained.main(
             ["--seconds", "1.5" if quick else "5", "--rates", *(f"{hz:g}" for hz in rates)]
         ),
+        "instructions": lambda: instructions.main(["--messages", "50" if quick else "200"]),
         "small_messages": lambda: small_messages.main(["--seconds", str(flow)]),
         "costs": lambda: costs.main(["--seconds", "1.5" if quick else "3"]),
         "starvation": lambda: starvation.main(["--seconds", "3" if quick else "5"]),
@@ -116,8 +118,8 @@ def main(argv: list[str] | None = None) -> int:
         began = time.monotonic()
         print(f"== {name}", file=sys.stderr, flush=True)
         try:
-            chosen[name]()
-            outcome = "done"
+            failed = chosen[name]()
+            outcome = f"**not run** (exit status {failed}, see the console)" if failed else "done"
         except Exception:
             traceback.print_exc()
             outcome = "**failed** (see the console output); its report is from an earlier run"

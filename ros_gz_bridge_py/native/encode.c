@@ -15,7 +15,7 @@
 /* ---- reading CDR -------------------------------------------------------------------------- */
 
 static int cdr_align(struct reader *r, size_t size) {
-    size_t pad = (size - (r->pos - 4) % size) % size;
+    size_t pad = rgb_pad(r->pos - 4, size);
     if (r->n - r->pos < pad) return RGB_UNDECODABLE;
     r->pos += pad;
     return 0;

@@ -150,13 +150,18 @@ static int slot_of(struct ctx *c, struct at a, uint32_t number, const int32_t **
     return k;
 }
 
-int pb_last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, int *found) {
-    int k = slot_of(c, a, number, NULL);
+/* The last occurrence of field `number` of `a`, from slot `k` of its index (-1: scanned). */
+static int last_in(struct ctx *c, struct at a, int k, uint32_t number, struct field *out,
+                   int *found) {
     if (k < 0) return pb_find(c, a.v, number, 0, out, found);
     const struct slot *s = &node_at(c, a.node)->slots[k];
     *found = s->count > 0;
     if (*found) *out = s->last;
     return 0;
+}
+
+int pb_last_of(struct ctx *c, struct at a, uint32_t number, struct field *out, int *found) {
+    return last_in(c, a, slot_of(c, a, number, NULL), number, out, found);
 }
 
 /* The submessage reached through `steps` (an empty view where one is absent), indexed where
@@ -167,7 +172,7 @@ int pb_descend(struct ctx *c, struct at a, const int32_t *steps, int32_t nsteps,
         const int32_t *sf = NULL;
         int k = slot_of(c, a, (uint32_t)steps[i], &sf);
         struct field f;
-        int found, status = pb_last_of(c, a, (uint32_t)steps[i], &f, &found);
+        int found, status = last_in(c, a, k, (uint32_t)steps[i], &f, &found);
         if (status) return status;
         if (!found) {
             a = (struct at){{NULL, 0}, NO_NODE};

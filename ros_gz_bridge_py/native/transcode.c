@@ -16,7 +16,8 @@
 
 /* Pads with zeros to `size`, counted from the end of the 4-byte encapsulation header. */
 static int align(struct rgb_out *out, size_t size) {
-    size_t pad = (size - (out->len - 4) % size) % size;
+    size_t pad = rgb_pad(out->len - 4, size);
+    if (pad == 0) return 0;
     int status = rgb_grow(out, pad);
     if (status) return status;
     memset(out->data + out->len, 0, pad);
@@ -206,15 +207,46 @@ static int header_entry(void *ctx, const struct field *f) {
     return 0;
 }
 
+/* Where the last path of a run led, step by step. A message's ops read its fields through
+ * paths that share their first steps (pose.position.x, .y, .z), and a walk depends only on the
+ * run's message and the steps (each submessage is indexed once and kept until the run ends), so
+ * a shared beginning is walked once. */
+#define KEPT_STEPS 8
+struct walked {
+    int32_t n;
+    int32_t steps[KEPT_STEPS];
+    struct at reached[KEPT_STEPS]; /* after each step */
+};
+
+/* The message `steps` reach from `v`, from where the last walk of the same run parted. */
+static int descend(struct ctx *c, struct walked *w, struct at v, const int32_t *steps, int32_t n,
+                   struct at *out) {
+    int32_t same = 0;
+    while (same < n && same < w->n && steps[same] == w->steps[same]) same++;
+    struct at a = same ? w->reached[same - 1] : v;
+    for (int32_t i = same; i < n; i++) {
+        int status = pb_descend(c, a, steps + i, 1, &a);
+        if (status) return status;
+        if (i < KEPT_STEPS) {
+            w->steps[i] = steps[i];
+            w->reached[i] = a;
+        }
+    }
+    w->n = n < KEPT_STEPS ? n : KEPT_STEPS;
+    *out = a;
+    return 0;
+}
+
 static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v) {
     struct rgb_out *out = c->out;
+    struct walked walked = {0};
     while (op < end && *op != OP_END) {
         int32_t code = *op++;
         struct at at;
         int status;
         const char *layout = rgb_layout(rgb_op_layouts, OP_COUNT, code);
         if (layout != NULL && layout[0] == 'P') { /* the message its path (count, steps) reaches */
-            status = pb_descend(c, v, op + 1, op[0], &at);
+            status = descend(c, &walked, v, op + 1, op[0], &at);
             if (status) return status;
             op += 1 + op[0];
         }

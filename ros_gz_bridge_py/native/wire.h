@@ -200,6 +200,14 @@ static inline int rgb_put(struct rgb_out *out, const void *bytes, size_t n) {
     return 0;
 }
 
+/* The padding that takes offset `at` to a multiple of `size`: a CDR alignment (1, 2, 4 or 8,
+ * all the loaders admit) by a mask, as a division costs tens of cycles a value; any other size
+ * in full. */
+static inline size_t rgb_pad(size_t at, size_t size) {
+    if (size && !(size & (size - 1))) return (size - (at & (size - 1))) & (size - 1);
+    return size ? (size - at % size) % size : 0;
+}
+
 /* The `size` (at most 8) bytes at `b` as a little-endian number. */
 static inline uint64_t rgb_le(const uint8_t *b, size_t size) {
     uint64_t bits = 0;
