@@ -128,6 +128,32 @@ static int scalar_element(void *ctx, const struct field *f) {
     return status;
 }
 
+/* Writes a fixed list of doubles given as one packed run of its length (a covariance, the
+ * most common fixed list; Gazebo sends it as floats or doubles) in one pass over the run, each
+ * value as put_value writes it. *written is 0 where the list is given otherwise (element by
+ * element, in several runs, of another length): it is then read element by element. */
+static int packed_doubles(struct ctx *c, struct at at, uint32_t number, int32_t type,
+                          int32_t count, int *written) {
+    size_t size = type == PB_DOUBLE ? 8 : 4, occurrences;
+    struct field f;
+    int found = 0;
+    *written = 0;
+    int status = pb_count_of(c, at, number, &occurrences);
+    if (!status && occurrences == 1) status = pb_last_of(c, at, number, &f, &found);
+    if (status || !found || f.wire != WIRE_LEN || f.payload.n != (size_t)count * size)
+        return status;
+    status = align(c->out, 8);
+    if (!status) status = rgb_grow(c->out, (size_t)count * 8);
+    if (status) return status;
+    for (int32_t k = 0; k < count; k++) {
+        struct rgb_number v = rgb_float_bits(rgb_le(f.payload.p + (size_t)k * size, size), size);
+        memcpy(c->out->data + c->out->len, &v.d, 8);
+        c->out->len += 8;
+    }
+    *written = 1;
+    return 0;
+}
+
 /* The elements of a repeated submessage field, each indexed (when its type is known) and run
  * through a body of ops; the element's index is popped after. */
 struct messages {
@@ -285,6 +311,11 @@ static int run(struct ctx *c, const int32_t *op, const int32_t *end, struct at v
             uint32_t number = (uint32_t)op[0];
             int32_t type = op[1], kind = op[2], count = op[3];
             op += 4;
+            if ((type == PB_DOUBLE || type == PB_FLOAT) && kind == ROS_DOUBLE) {
+                int written;
+                status = packed_doubles(c, at, number, type, count, &written);
+                if (status || written) break;
+            }
             struct scalars counting = {type, 0, 0, out};
             status = pb_for_each(c, at, number, scalar_element, &counting);
             if (status) return status;

@@ -19,6 +19,7 @@ import array
 import collections
 import os
 import random
+import struct
 from collections.abc import Iterable
 from typing import Any
 
@@ -216,6 +217,37 @@ def test_packed_and_unpacked_repeated_numbers_agree(transcoder: Transcoder) -> N
     msg = distinctive(transcoder.pair.gz_type)
     for _ in range(20):
         assert transcoder.check(gzp.encode(msg, rng), well_formed=True) == OK
+
+
+#: Floats whose conversion to double must keep every bit the Python path keeps.
+_COVARIANCE = [0.01, -0.0, float("inf"), float("-inf"), 1e-45, 3.4e38, -2.5, 0.0]
+_COVARIANCE_NAN = struct.pack("<I", 0x7FA00001)  # a signalling NaN with a payload
+
+
+def _float_runs(values: list[bytes], runs: list[int]) -> bytes:
+    """A Float_V's data (field 2) as packed runs of the given lengths (0: one unpacked value)."""
+    out, at = b"", 0
+    for run in runs:
+        if run == 0:
+            out += gzp.tag(2, gzp.I32) + values[at]
+            at += 1
+        else:
+            out += gzp.length_delimited(2, b"".join(values[at : at + run]))
+            at += run
+    return out
+
+
+def test_covariances_in_any_encoding_are_written_alike() -> None:
+    """A fixed list of doubles sent as one packed run of its length is written in one pass
+    (transcode.c packed_doubles); in any other form, element by element. Both as Python."""
+    pair = next(p for p, _ in PAIRS if p.gz_type == "gz.msgs.IMU")
+    transcoder = Transcoder(pair, next(c for p, c in PAIRS if p is pair))
+    nine = [struct.pack("<f", v) for v in _COVARIANCE] + [_COVARIANCE_NAN]
+    for runs in ([9], [4, 5], [0] * 9, [3, 0, 5], [8], [9, 1], []):
+        values = nine + nine[:1] if sum(max(r, 1) for r in runs) > 9 else nine
+        covariance = _float_runs(values, runs)
+        payload = b"".join(gzp.length_delimited(n, covariance) for n in (4, 6, 8))
+        assert transcoder.check(payload, well_formed=True) == OK, runs
 
 
 def test_odd_tags_wrong_wire_types_and_merged_submessages_agree(transcoder: Transcoder) -> None:
