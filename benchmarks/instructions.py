@@ -40,7 +40,7 @@ from benchmarks.payloads import KINDS
 from benchmarks.report import write_section
 
 #: The kinds measured by default: every kind a channel converts message by message.
-DEFAULT_KINDS = ("clock", "twist", "odometry", "imu", "tf20", "tf50", "scan1440")
+DEFAULT_KINDS = ("clock", "twist", "odometry", "imu", "joint_states", "tf20", "tf50", "scan1440")
 #: The C functions whose inclusive counts are the native figures, per direction.
 NATIVE_FUNCTIONS = {"gz_to_ros": "rgb_to_cdr", "ros_to_gz": "rgb_to_pb"}
 #: The marker: callgrind dumps what it counted before each call of this C function.

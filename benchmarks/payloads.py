@@ -143,6 +143,16 @@ def _imu() -> Any:
     return msg
 
 
+def _joint_states() -> Any:
+    """Two wheels, as the fleet's simulator sends them (testing/fleet_sim.py)."""
+    from sensor_msgs.msg import JointState  # noqa: PLC0415
+
+    msg = JointState(name=["left_wheel", "right_wheel"], position=[1.5, -1.5])
+    msg.velocity = [0.25, -0.25]
+    msg.effort = [0.0, 0.0]
+    return msg
+
+
 def _clock() -> Any:
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
 
@@ -169,6 +179,9 @@ KINDS = {
         Kind("odometry", "nav_msgs/msg/Odometry", "gz.msgs.Odometry", _odometry, "header"),
         Kind("imu", "sensor_msgs/msg/Imu", "gz.msgs.IMU", _imu, "header"),
         Kind("clock", "rosgraph_msgs/msg/Clock", "gz.msgs.Clock", _clock, "clock"),
+        Kind(
+            "joint_states", "sensor_msgs/msg/JointState", "gz.msgs.Model", _joint_states, "header"
+        ),
     )
 }
 
