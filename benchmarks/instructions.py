@@ -156,14 +156,10 @@ class Counted:
 
 
 def _dumps(directory: Path) -> list[Path]:
-    """The numbered dumps of the traced process, in order (the exec'd Python's: the last pid)."""
+    """The numbered dumps of the traced process, in order. They share one pid: the ROS wheels'
+    bootstrapper re-executes Python in the same process, and only the driver calls the marker."""
     numbered = [p for p in directory.iterdir() if re.fullmatch(r"cg\.\d+\.\d+", p.name)]
-    pids = {p.name.split(".")[1] for p in numbered}
-    if not pids:
-        return []
-    pid = max(pids, key=lambda value: sum(p.name.split(".")[1] == value for p in numbered))
-    mine = [p for p in numbered if p.name.split(".")[1] == pid]
-    return sorted(mine, key=lambda p: int(p.name.split(".")[2]))
+    return sorted(numbered, key=lambda p: int(p.name.split(".")[2]))
 
 
 def totals(text: str) -> int:
