@@ -5,8 +5,9 @@
  * validated against the whole schema, as the Python protobuf runtime does when it parses
  * (UTF-8 of every string field, every nested message), so that what the transcoder accepts
  * the Python path accepts too; anything this code is not sure about is left to Python
- * (RGB_FALLBACK). Then each message the ops read is scanned once into an index (struct node)
- * that every op reads from, so that the work is linear in the payload. */
+ * (RGB_FALLBACK). Each message the ops read is indexed once (struct node), which every op
+ * reads from, so that the work is linear in the payload: the payload and its singular
+ * submessages by the validating scan itself, a sequence's elements and the rest when reached. */
 #include "transcode_ops.h"
 
 #include <stdlib.h>
@@ -21,6 +22,9 @@ static const int32_t *message_words(const struct rgb_program *pr, int32_t msg) {
 
 /* The index among message `m`'s fields of the one numbered `number`, or -1 when unknown. */
 static int field_index(const int32_t *m, uint32_t number) {
+    /* the descriptors of Gazebo's messages mostly list field n n-th */
+    uint32_t guess = number - 1; /* wraps for 0, which no field has */
+    if (guess < (uint32_t)m[0] && (uint32_t)m[1 + 4 * guess] == number) return (int)guess;
     for (int32_t i = 0; i < m[0]; i++)
         if ((uint32_t)m[1 + 4 * i] == number) return (int)i;
     return -1;
@@ -42,18 +46,51 @@ static int validate_packed(struct view run, int32_t type) {
     return 0;
 }
 
-int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth) {
+static struct node *node_at(struct ctx *c, size_t offset) {
+    return (struct node *)((uint8_t *)c->out->scratch + offset);
+}
+
+/* Reserves an index for a message of type `msg` on the scratch stack, its slots empty. */
+static int push_node(struct ctx *c, int32_t msg, size_t *offset) {
+    const int32_t *m = message_words(c->pr, msg);
+    size_t size = sizeof(struct node) + (size_t)m[0] * sizeof(struct slot);
+    if (size > MAX_SCRATCH - c->top) return RGB_FALLBACK;
+    size_t need = c->top + size;
+    if (rgb_reserve(&c->out->scratch, &c->out->scratch_cap, need, 1, 4096)) return RGB_FALLBACK;
+    *offset = c->top;
+    c->top = need;
+    struct node *n = node_at(c, *offset);
+    n->msg = msg;
+    for (int32_t i = 0; i < m[0]; i++)
+        n->slots[i] = (struct slot){0, 0, 0, {0, 0, 0, {NULL, 0}}, NO_NODE};
+    return 0;
+}
+
+/* Records field `f` (from `start` to `end`) of the message `node` indexes in its slot `k`. */
+static void note_field(struct ctx *c, size_t node, int k, size_t start, size_t end,
+                       const struct field *f) {
+    struct slot *s = &node_at(c, node)->slots[k];
+    if (s->count++ == 0) s->first = start;
+    s->end = end;
+    s->last = *f;
+}
+
+int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth, size_t *node) {
     if (depth > MAX_DEPTH) return RGB_FALLBACK;
     const int32_t *m = message_words(c->pr, msg);
+    int status = node != NULL ? push_node(c, msg, node) : 0;
+    if (status) return status;
     /* Singular submessages seen, to leave merged duplicates to Python (bit per field). */
     uint64_t seen = 0;
     size_t pos = 0;
     while (pos < v.n) {
+        size_t start = pos;
         struct field f;
-        int status = read_field(c, v, &pos, &f);
+        status = read_field(c, v, &pos, &f);
         if (status) return status;
         int index = field_index(m, f.number);
         if (index < 0) continue; /* unknown: kept aside by the runtime, never an error */
+        if (node != NULL) note_field(c, *node, index, start, pos, &f);
         const int32_t *sf = m + 1 + 4 * index;
         int32_t type = sf[1], repeated = sf[2];
         int wire = rgb_wire_of(type);
@@ -71,8 +108,13 @@ int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth) {
                 if (bit == 0 || (seen & bit)) return RGB_FALLBACK;
                 seen |= bit;
             }
-            status = pb_validate(c, f.payload, sf[3], depth + 1);
+            /* a singular one of an indexed message is indexed in the same scan, while the
+             * index is small (each sequence element is indexed when its turn comes) */
+            int eager = node != NULL && !repeated && c->top <= EAGER_SCRATCH;
+            size_t child = NO_NODE;
+            status = pb_validate(c, f.payload, sf[3], depth + 1, eager ? &child : NULL);
             if (status) return status;
+            if (eager) node_at(c, *node)->slots[index].child = child;
         } else if (type == PB_GROUP) {
             return RGB_FALLBACK;
         }
@@ -100,26 +142,6 @@ int pb_find(struct ctx *c, struct view v, uint32_t number, int first, struct fie
     return 0;
 }
 
-static struct node *node_at(struct ctx *c, size_t offset) {
-    return (struct node *)((uint8_t *)c->out->scratch + offset);
-}
-
-/* Reserves an index for a message of type `msg` on the scratch stack, its slots empty. */
-static int push_node(struct ctx *c, int32_t msg, size_t *offset) {
-    const int32_t *m = message_words(c->pr, msg);
-    size_t size = sizeof(struct node) + (size_t)m[0] * sizeof(struct slot);
-    if (size > MAX_SCRATCH - c->top) return RGB_FALLBACK;
-    size_t need = c->top + size;
-    if (rgb_reserve(&c->out->scratch, &c->out->scratch_cap, need, 1, 4096)) return RGB_FALLBACK;
-    *offset = c->top;
-    c->top = need;
-    struct node *n = node_at(c, *offset);
-    n->msg = msg;
-    for (int32_t i = 0; i < m[0]; i++)
-        n->slots[i] = (struct slot){0, 0, 0, {0, 0, 0, {NULL, 0}}, NO_NODE};
-    return 0;
-}
-
 int pb_index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset) {
     int status = push_node(c, msg, offset);
     if (status) return status;
@@ -131,11 +153,7 @@ int pb_index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset) 
         status = read_field(c, v, &pos, &f);
         if (status) return status;
         int k = field_index(m, f.number);
-        if (k < 0) continue;
-        struct slot *s = &node_at(c, *offset)->slots[k];
-        if (s->count++ == 0) s->first = start;
-        s->end = pos;
-        s->last = f;
+        if (k >= 0) note_field(c, *offset, k, start, pos, &f);
     }
     return 0;
 }

@@ -444,8 +444,7 @@ enum rgb_status rgb_to_cdr(const struct rgb_program *program, const uint8_t *pay
     out->limit = output_limit(payload_len);
     out->refuse_above = refusal_limit(payload_len);
     struct at root = {v, NO_NODE};
-    int status = pb_validate(&c, v, program->root, 0);
-    if (!status) status = pb_index_message(&c, v, program->root, &root.node);
+    int status = pb_validate(&c, v, program->root, 0, &root.node);
     if (!status) status = rgb_put(out, header, 4);
     if (!status) status = run(&c, program->ops, program->ops + program->ops_len, root);
     if (status) {

@@ -21,6 +21,10 @@ struct view {
 /* Reads a varint at *pos; 0 on success, RGB_UNDECODABLE when it is cut off or longer than 10
  * bytes. */
 static inline int read_varint(struct view v, size_t *pos, uint64_t *out) {
+    if (*pos < v.n && v.p[*pos] < 0x80) { /* most tags and lengths: one byte */
+        *out = v.p[(*pos)++];
+        return 0;
+    }
     uint64_t result = 0;
     for (int shift = 0; shift < 70; shift += 7) {
         if (*pos >= v.n) return RGB_UNDECODABLE;
@@ -109,6 +113,9 @@ static inline int read_field(struct ctx *c, struct view v, size_t *pos, struct f
 /* Most scratch bytes one payload may index; past them it is left to Python. Legitimate
  * programs index a few nodes per level of nesting, each at most 64 slots. */
 #define MAX_SCRATCH ((size_t)64 << 20)
+/* The index validation builds as it goes: the submessages of any pair's message fit many times
+ * over, a payload of a hundred thousand of them does not make it index them all. */
+#define EAGER_SCRATCH ((size_t)16 << 10)
 
 struct slot {
     size_t count;      /* occurrences of the field */
@@ -132,8 +139,10 @@ struct at {
 
 /* ---- reading a validated payload (pb_read.c) --------------------------------------------- */
 
-/* Validates message `v` of schema type `msg`, as the Python runtime's parse would. */
-int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth);
+/* Validates message `v` of schema type `msg`, as the Python runtime's parse would; with `node`,
+ * indexes it in the same scan (*node), and its singular submessages while the index holds at
+ * most EAGER_SCRATCH bytes (past that, a submessage is indexed when a path first reaches it). */
+int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth, size_t *node);
 /* Indexes `v`, a validated message of schema type `msg`, in one scan. */
 int pb_index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset);
 /* The last (or `first`) occurrence of field `number` in `v`, scanned (found 0 when absent). */

@@ -210,6 +210,19 @@ static inline size_t rgb_pad(size_t at, size_t size) {
 
 /* The `size` (at most 8) bytes at `b` as a little-endian number. */
 static inline uint64_t rgb_le(const uint8_t *b, size_t size) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    /* a double's or a float's bits (most numbers read): the host's own order */
+    if (size == 8) {
+        uint64_t wide;
+        memcpy(&wide, b, 8);
+        return wide;
+    }
+    if (size == 4) {
+        uint32_t narrow;
+        memcpy(&narrow, b, 4);
+        return narrow;
+    }
+#endif
     uint64_t bits = 0;
     for (size_t k = 0; k < size && k < 8; k++) bits |= (uint64_t)b[k] << (8 * k);
     return bits;
@@ -217,6 +230,9 @@ static inline uint64_t rgb_le(const uint8_t *b, size_t size) {
 
 /* Appends the `size` low bytes of `bits`, little-endian. */
 static inline int rgb_put_le(struct rgb_out *out, uint64_t bits, size_t size) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    if (size <= 8) return rgb_put(out, &bits, size); /* the low bytes come first */
+#endif
     uint8_t b[8];
     for (size_t k = 0; k < size && k < 8; k++) b[k] = (uint8_t)(bits >> (8 * k));
     return rgb_put(out, b, size < 8 ? size : 8);

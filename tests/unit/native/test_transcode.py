@@ -30,7 +30,7 @@ from ros_gz_bridge_py import native
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.errors import ConversionError
 from ros_gz_bridge_py.msgs import message_class
-from ros_gz_bridge_py.native.codes import Op
+from ros_gz_bridge_py.native.codes import Conv, Op, PbType, RosKind
 from ros_gz_bridge_py.native.program import Compiled
 from ros_gz_bridge_py.ros.cdr_writer import writer_for
 from tests.unit.native import gz_payloads as gzp
@@ -339,3 +339,26 @@ def test_a_header_lookup_that_reaches_a_number_falls_back() -> None:
     program = _native.Program(compiled.schema, ops.tobytes())
     stamp = gzp.length_delimited(1, gzp.tag(2, gzp.VARINT) + gzp.varint(5))
     assert program.to_cdr(stamp) == (FALLBACK, None)
+
+
+def test_submessages_past_the_eager_index_are_read_alike() -> None:
+    """Validation indexes the singular submessages it passes while the index is small (16 KiB,
+    pb_read.c); past that, a path indexes them when it reaches them. Under a type of 64 fields
+    (4 KiB an index), nesting it 7 deep passes the bound: a number at depth 1 and one at depth
+    7 are read alike, whichever side of the bound their messages were indexed on."""
+    fields = [[number, PbType.MESSAGE, 0, 0] for number in range(1, 64)]
+    fields.append([64, PbType.INT32, 0, -1])
+    schema = array.array("i", [1, 2, 64, *[word for field in fields for word in field]])
+
+    def read_at(depth: int) -> list[int]:
+        return [Op.NUM, depth, *[1] * depth, 64, PbType.INT32, RosKind.INT32, Conv.EXACT]
+
+    ops = array.array("i", [*read_at(1), *read_at(7), Op.END])
+    program = _native.Program(schema.tobytes(), ops.tobytes())
+    deep = gzp.tag(64, gzp.VARINT) + gzp.varint(77)
+    for _ in range(6):
+        deep = gzp.length_delimited(1, deep)
+    shallow = gzp.tag(64, gzp.VARINT) + gzp.varint(11)
+    expected = bytes([0, 1, 0, 0]) + struct.pack("<ii", 11, 77)
+    for level_one in (shallow + deep, deep + shallow):  # the depth-1 value before or after
+        assert program.to_cdr(gzp.length_delimited(1, level_one)) == (OK, expected)
