@@ -66,13 +66,21 @@ static int push_node(struct ctx *c, int32_t msg, size_t *offset) {
     return 0;
 }
 
-/* Records field `f` (from `start` to `end`) of the message `node` indexes in its slot `k`. */
-static void note_field(struct ctx *c, size_t node, int k, size_t start, size_t end,
-                       const struct field *f) {
-    struct slot *s = &node_at(c, node)->slots[k];
-    if (s->count++ == 0) s->first = start;
-    s->end = end;
-    s->last = *f;
+/* Reads the field at *pos of a message of schema words `m` into `f`, with its index among
+ * m's fields in *k (-1: unknown); a known one is recorded in the index `node` (NO_NODE: none). */
+static int read_known(struct ctx *c, struct view v, size_t *pos, const int32_t *m, size_t node,
+                      struct field *f, int *k) {
+    size_t start = *pos;
+    int status = read_field(c, v, pos, f);
+    if (status) return status;
+    *k = field_index(m, f->number);
+    if (*k >= 0 && node != NO_NODE) {
+        struct slot *s = &node_at(c, node)->slots[*k];
+        if (s->count++ == 0) s->first = start;
+        s->end = *pos;
+        s->last = *f;
+    }
+    return 0;
 }
 
 int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth, size_t *node) {
@@ -84,13 +92,11 @@ int pb_validate(struct ctx *c, struct view v, int32_t msg, int depth, size_t *no
     uint64_t seen = 0;
     size_t pos = 0;
     while (pos < v.n) {
-        size_t start = pos;
         struct field f;
-        status = read_field(c, v, &pos, &f);
+        int index;
+        status = read_known(c, v, &pos, m, node != NULL ? *node : NO_NODE, &f, &index);
         if (status) return status;
-        int index = field_index(m, f.number);
         if (index < 0) continue; /* unknown: kept aside by the runtime, never an error */
-        if (node != NULL) note_field(c, *node, index, start, pos, &f);
         const int32_t *sf = m + 1 + 4 * index;
         int32_t type = sf[1], repeated = sf[2];
         int wire = rgb_wire_of(type);
@@ -147,15 +153,12 @@ int pb_index_message(struct ctx *c, struct view v, int32_t msg, size_t *offset) 
     if (status) return status;
     const int32_t *m = message_words(c->pr, msg);
     size_t pos = 0;
-    while (pos < v.n) {
-        size_t start = pos;
+    while (pos < v.n && !status) {
         struct field f;
-        status = read_field(c, v, &pos, &f);
-        if (status) return status;
-        int k = field_index(m, f.number);
-        if (k >= 0) note_field(c, *offset, k, start, pos, &f);
+        int k;
+        status = read_known(c, v, &pos, m, *offset, &f, &k);
     }
-    return 0;
+    return status;
 }
 
 /* The slot of field `number` in the index of `a` (with the field's schema words in *sf), or
