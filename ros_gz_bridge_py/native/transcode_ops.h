@@ -113,8 +113,9 @@ static inline int read_field(struct ctx *c, struct view v, size_t *pos, struct f
 /* Most scratch bytes one payload may index; past them it is left to Python. Legitimate
  * programs index a few nodes per level of nesting, each at most 64 slots. */
 #define MAX_SCRATCH ((size_t)64 << 20)
-/* The index validation builds as it goes: the submessages of any pair's message fit many times
- * over, a payload of a hundred thousand of them does not make it index them all. */
+/* The index validation builds as it goes: three times what a pair's message with every singular
+ * submessage present takes (the largest, a JointWrench, 5 KiB), so that a payload of a hundred
+ * thousand submessages does not make it index them all. */
 #define EAGER_SCRATCH ((size_t)16 << 10)
 
 struct slot {
