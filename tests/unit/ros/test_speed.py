@@ -75,6 +75,20 @@ def test_profile_is_a_default_participant_with_a_large_shm_segment() -> None:
     assert int(shm.findtext("f:segment_size", "0", NS)) >= 64 * 1024 * 1024
 
 
+def test_profile_makes_every_writer_suppress_nacks_for_20_ms() -> None:
+    """The default data-writer profile (its effect on Fast DDS's event thread is measured in
+    real processes by tests/ros/test_fastdds_profile.py)."""
+    root = ET.parse(PROFILE).getroot()  # noqa: S314 - our own packaged file
+    writer = root.find("f:data_writer", NS)
+    assert writer is not None
+    assert writer.get("is_default_profile") == "true"
+    suppression = writer.find("f:times/f:nackSupressionDuration", NS)
+    assert suppression is not None
+    seconds = int(suppression.findtext("f:sec", "0", NS))
+    nanoseconds = int(suppression.findtext("f:nanosec", "0", NS))
+    assert (seconds, nanoseconds) == (0, 20_000_000)
+
+
 # --- zombie Fast DDS segments --------------------------------------------------------------
 
 

@@ -1,0 +1,86 @@
+"""One side of a reliable topic in a process of its own, for tests/ros/test_fastdds_profile.py.
+
+usage: profile_writer.py publish TOPIC COUNT
+       profile_writer.py subscribe TOPIC SECONDS
+
+``publish`` waits (at most 20 s) for a subscriber, publishes COUNT strings at about 1 kHz
+(reliable, volatile, depth 10, as the bridge's publishers are), waits for them to be
+acknowledged, and prints ``WAKES <n> SENT <count>``: how often this process's Fast DDS event
+threads (``dds.ev.<n>``) went to sleep and were woken meanwhile (their voluntary context
+switches). Exit status 2 means no subscriber matched. ``subscribe`` takes the topic for
+SECONDS and prints ``TOOK <n>``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import rclpy
+from rclpy.duration import Duration
+from rclpy.utilities import try_shutdown
+from std_msgs.msg import String
+
+MATCH_TIMEOUT_S = 20.0
+PERIOD_S = 0.001
+ACK_TIMEOUT_S = 5.0
+EVENT_THREAD_PREFIX = "dds.ev."
+
+
+def event_thread_wakes() -> int:
+    """The voluntary context switches of this process's Fast DDS event threads."""
+    total = 0
+    for task in Path("/proc/self/task").iterdir():
+        if (task / "comm").read_text().strip().startswith(EVENT_THREAD_PREFIX):
+            for line in (task / "status").read_text().splitlines():
+                if line.startswith("voluntary_ctxt_switches:"):
+                    total += int(line.split()[1])
+    return total
+
+
+def publish(topic: str, count: int) -> int:
+    node = rclpy.create_node("profile_writer")
+    publisher = node.create_publisher(String, topic, 10)
+    deadline = time.monotonic() + MATCH_TIMEOUT_S
+    while publisher.get_subscription_count() == 0:
+        if time.monotonic() > deadline:
+            return 2
+        time.sleep(0.05)
+    time.sleep(0.5)  # past the match's own discovery traffic
+    before = event_thread_wakes()
+    message = String()
+    start = time.monotonic()
+    for index in range(count):
+        message.data = f"sample {index}"
+        publisher.publish(message)
+        time.sleep(max(0.0, start + (index + 1) * PERIOD_S - time.monotonic()))
+    publisher.wait_for_all_acked(Duration(seconds=ACK_TIMEOUT_S))
+    print(f"WAKES {event_thread_wakes() - before} SENT {count}", flush=True)
+    return 0
+
+
+def subscribe(topic: str, seconds: float) -> int:
+    node = rclpy.create_node("profile_reader")
+    taken = [0]
+    node.create_subscription(String, topic, lambda _: taken.__setitem__(0, taken[0] + 1), 10)
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    print(f"TOOK {taken[0]}", flush=True)
+    return 0
+
+
+def main() -> int:
+    mode, topic, amount = sys.argv[1:4]
+    rclpy.init()
+    try:
+        if mode == "publish":
+            return publish(topic, int(amount))
+        return subscribe(topic, float(amount))
+    finally:
+        try_shutdown()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
