@@ -36,9 +36,7 @@ def wakes_per_sample(profile: bool) -> float:
         env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE)
     topic = f"/profile_{uuid.uuid4().hex[:8]}"
     command = [sys.executable, str(WRITER)]
-    with subprocess.Popen(
-        [*command, "subscribe", topic, "30"], env=env, stdout=subprocess.PIPE, text=True
-    ) as reader:
+    with subprocess.Popen([*command, "subscribe", topic, "30"], env=env) as reader:
         try:
             writer = subprocess.run(
                 [*command, "publish", topic, str(SAMPLES)],
