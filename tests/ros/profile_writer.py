@@ -2,6 +2,7 @@
 
 usage: profile_writer.py publish TOPIC COUNT
        profile_writer.py subscribe TOPIC SECONDS
+(with the repository on PYTHONPATH, for ``testing``)
 
 ``publish`` waits (at most 20 s) for a subscriber, publishes COUNT strings at about 1 kHz
 (reliable, volatile, depth 10, as the bridge's publishers are), waits for the subscriber to
@@ -21,6 +22,8 @@ import rclpy
 from rclpy.duration import Duration
 from rclpy.utilities import try_shutdown
 from std_msgs.msg import String
+
+from testing.polling import wait_until
 
 MATCH_TIMEOUT_S = 20.0
 PERIOD_S = 0.001
@@ -42,11 +45,8 @@ def event_thread_wakes() -> int:
 def publish(topic: str, count: int) -> int:
     node = rclpy.create_node("profile_writer")
     publisher = node.create_publisher(String, topic, 10)
-    deadline = time.monotonic() + MATCH_TIMEOUT_S
-    while publisher.get_subscription_count() == 0:
-        if time.monotonic() > deadline:
-            return 2
-        time.sleep(0.05)
+    if not wait_until(lambda: publisher.get_subscription_count() > 0, MATCH_TIMEOUT_S):
+        return 2
     time.sleep(0.5)  # past the match's own discovery traffic
     before = event_thread_wakes()
     message = String()

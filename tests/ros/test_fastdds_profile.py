@@ -21,6 +21,7 @@ from ros_gz_bridge_py.ros.speed import PROFILE, PROFILE_ENVS
 pytestmark = pytest.mark.ros
 
 WRITER = Path(__file__).with_name("profile_writer.py")
+ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = 1500
 #: Measured on the project machine: under Fast DDS's defaults the event thread was woken
 #: 1.1-1.2 times a sample (1.3-3.7 beside two busy loops), under the profile 0.10 (0.14-0.19):
@@ -32,6 +33,7 @@ TIMEOUT_S = 60
 def wakes_per_sample(profile: bool) -> float:
     """The publisher's event-thread wake-ups per sample, with or without the profile."""
     env = {name: value for name, value in os.environ.items() if name not in PROFILE_ENVS}
+    env["PYTHONPATH"] = str(ROOT)
     if profile:
         env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE)
     topic = f"/profile_{uuid.uuid4().hex[:8]}"
