@@ -23,19 +23,19 @@ from rclpy.duration import Duration
 from rclpy.utilities import try_shutdown
 from std_msgs.msg import String
 
+from ros_gz_bridge_py.ros.runtime import DDS_EVENT_THREAD_PREFIX
 from testing.polling import wait_until
 
 MATCH_TIMEOUT_S = 20.0
 PERIOD_S = 0.001
 ACK_TIMEOUT_S = 5.0
-EVENT_THREAD_PREFIX = "dds.ev."
 
 
 def event_thread_wakes() -> int:
     """The voluntary context switches of this process's Fast DDS event threads."""
     total = 0
     for task in Path("/proc/self/task").iterdir():
-        if (task / "comm").read_text().strip().startswith(EVENT_THREAD_PREFIX):
+        if (task / "comm").read_text().strip().startswith(DDS_EVENT_THREAD_PREFIX):
             for line in (task / "status").read_text().splitlines():
                 if line.startswith("voluntary_ctxt_switches:"):
                     total += int(line.split()[1])
