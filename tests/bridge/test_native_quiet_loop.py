@@ -1,7 +1,7 @@
 """A native ROS -> Gazebo loop that has been quiet learns a new Gazebo subscriber at once
 (docs/native.md §7).
 
-An idle loop returns to Python only every ``QUIET_COUNT_EVERY`` seconds; what it reads there that
+An idle loop returns to Python only every ``COUNT_EVERY`` seconds; what it reads there that
 changes (the spellings Gazebo subscribers take, the bridge's own publishers) is pushed to it.
 A Fortress subscriber (the C++ peer, ``ignition.msgs`` spelling) that appears while the loop is
 quiet must get a single message published a moment after it is discovered: without the push the
@@ -17,7 +17,7 @@ import pytest
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.native import extension
-from ros_gz_bridge_py.native.loop import QUIET_COUNT_EVERY
+from ros_gz_bridge_py.native.loop import COUNT_EVERY
 from ros_gz_bridge_py.transport import GzNode
 from testing.behaviour_harness import (
     STRING,
@@ -72,4 +72,4 @@ def test_a_quiet_loop_sends_to_a_fortress_subscriber_that_just_appeared(
         wait_for_line(echo, f'^MSG ignition.msgs.StringMsg data: "single {attempt}"', WAIT)
         echo.stop()
         wait_until(lambda: not subscribed(gz_node, topic), WAIT, "the subscriber gone")
-        time.sleep(QUIET_COUNT_EVERY * (attempt + 1) / 4)  # another point of a quiet run
+        time.sleep(COUNT_EVERY * (attempt + 1) / 4)  # another point of a quiet run

@@ -52,8 +52,8 @@ def test_small_traffic_is_never_trimmed() -> None:
 
 
 def test_a_channel_told_only_when_it_moves_trims_once_its_burst_is_over() -> None:
-    """The native loop's form: at each count (every 0.25 s while messages flow, every 1 s once
-    none did) a channel that moved is told the bytes it read since the last; only while a trim
+    """The native loop's form: at each count (here every 0.25 s; the loop counts once a
+    second) a channel that moved is told the bytes it read since the last; only while a trim
     is pending is it told the time at counts where it did not move."""
     trimmer = BurstTrimmer(lambda: None)
     now = 10.0
