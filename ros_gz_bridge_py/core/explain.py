@@ -45,6 +45,10 @@ CONFIRM_AFTER = EXPLAIN_PERIOD / 2
 RELOG_AFTER = 60.0
 #: How often the bridge may ask Gazebo peers to list their subscriptions.
 ASK_SUBSCRIBERS_EVERY = 10.0
+#: Seconds a channel's ROS endpoints are reused while the graph's nodes and the topic's count
+#: of them stay the same (either changing asks them anew at the next pass): asking every
+#: channel's every 2 s was 8 ms a pass for a fleet of 25 robots, most of the bridge's Python.
+ROS_ENDPOINTS_REFRESH = 10.0
 #: Causes that concern the whole bridge rather than one channel (logged once).
 BRIDGE_WIDE = frozenset({"no-peer"})
 
@@ -136,6 +140,11 @@ class _Seen:
     logged: dict[str, float] = field(default_factory=dict)
     #: Keys logged during their current presence.
     announced: set[str] = field(default_factory=set)
+    #: The ROS endpoints last asked, what they were asked for (the graph's nodes, the topic's
+    #: count of them) and when.
+    endpoints: list[RosEndpoint] = field(default_factory=list)
+    endpoints_key: tuple[frozenset[tuple[str, str]], int] | None = None
+    endpoints_at: float = 0.0
 
 
 class Explainer:
@@ -177,12 +186,12 @@ class Explainer:
         graph: dict[str, list[GraphEndpoint]] = {}
         for endpoint in self._gz.graph():
             graph.setdefault(endpoint.topic, []).append(endpoint)
-        ros_others = self._ros_others(channels[0].ctx.ros_node)
+        nodes = self._ros_others(channels[0].ctx.ros_node)
         for channel in channels:
             seen = self._seen.get(id(channel)) or self._remember(channel, now)
             self._count(seen, channel, now)
             situation = self._situation(
-                channel, seen, now, (peers, listening), graph, ros_others=ros_others
+                channel, seen, now, (peers, listening), graph, ros_nodes=nodes
             )
             if (
                 situation.direction is Direction.ROS_TO_GZ
@@ -199,12 +208,27 @@ class Explainer:
             if now - seen.started >= WARM_UP:
                 self._report(channel, seen, found, now)
 
-    def _ros_others(self, ros_node: Any) -> bool:
-        """Whether the ROS graph shows a node that is not the bridge's. When it shows none, no
+    def _ros_others(self, ros_node: Any) -> frozenset[tuple[str, str]] | None:
+        """The ROS graph's nodes, or None when it shows none that is not the bridge's: then no
         channel has a ROS endpoint to check, and the pass asks no topic's endpoints (2 µs
         instead of about 20 µs per channel: most of a fleet's explanation pass at rest)."""
-        names = ros_node.get_node_names_and_namespaces()
-        return any((name, namespace) not in self._own for name, namespace in names)
+        names = frozenset(ros_node.get_node_names_and_namespaces())
+        return None if names <= self._own else names
+
+    def _ros_endpoints(
+        self, channel: Channel, seen: _Seen, now: float, nodes: frozenset[tuple[str, str]]
+    ) -> list[RosEndpoint]:
+        """The channel's ROS endpoints, asked again only when the graph's nodes or the topic's
+        count of them changed, or :data:`ROS_ENDPOINTS_REFRESH` after the last ask (a reader
+        replaced by another in a node that stays, between two passes)."""
+        ros_node, topic = channel.ctx.ros_node, channel.ros_topic
+        to_ros = channel.direction is Direction.GZ_TO_ROS
+        count = ros_node.count_subscribers(topic) if to_ros else ros_node.count_publishers(topic)
+        key = (nodes, count)
+        if key != seen.endpoints_key or now - seen.endpoints_at >= ROS_ENDPOINTS_REFRESH:
+            seen.endpoints = ros_endpoints(ros_node, channel.direction, topic, seen.qos, self._own)
+            seen.endpoints_key, seen.endpoints_at = key, now
+        return seen.endpoints
 
     def _remember(self, channel: Channel, now: float) -> _Seen:
         """A channel's first evaluation; what does not change is worked out once (at rest, a
@@ -229,11 +253,11 @@ class Explainer:
         gz_side: tuple[int, str],
         graph: dict[str, list[GraphEndpoint]],
         *,
-        ros_others: bool,
+        ros_nodes: frozenset[tuple[str, str]] | None,
     ) -> Situation:
         """``gz_side``: (peer processes, where the node listens); ``graph``: the endpoints of
-        other processes by topic name (``GzNode.graph``); ``ros_others``: the ROS graph shows a
-        node not the bridge's (:meth:`_ros_others`)."""
+        other processes by topic name (``GzNode.graph``); ``ros_nodes``: the ROS graph's nodes,
+        None when it shows none but the bridge's (:meth:`_ros_others`)."""
         spec = channel.spec
         peers, listening = gz_side
         partition, name = seen.gz_name
@@ -246,11 +270,9 @@ class Explainer:
             gz_type=spec.gz_type,
             partition=partition,
             gz_endpoints=graph.get(name, []),
-            ros_endpoints=ros_endpoints(
-                channel.ctx.ros_node, channel.direction, channel.ros_topic, seen.qos, self._own
-            )
-            if ros_others
-            else [],
+            ros_endpoints=[]
+            if ros_nodes is None
+            else self._ros_endpoints(channel, seen, now, ros_nodes),
             gz_peers=peers,
             listening=listening,
             gz_subscriber_registered=registered,

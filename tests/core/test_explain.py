@@ -24,7 +24,13 @@ from std_msgs.msg import Int32, String
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.core.channel import Channel
 from ros_gz_bridge_py.core.diagnosis import Flow
-from ros_gz_bridge_py.core.explain import CONFIRM_AFTER, WARM_UP, Explainer
+from ros_gz_bridge_py.core.explain import (
+    CONFIRM_AFTER,
+    EXPLAIN_PERIOD,
+    ROS_ENDPOINTS_REFRESH,
+    WARM_UP,
+    Explainer,
+)
 from ros_gz_bridge_py.core.status import OK, WARN, StatusTracker
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import Spelling
@@ -329,3 +335,37 @@ def test_a_graph_of_the_bridges_nodes_alone_asks_no_topics_endpoints(
     rig.world.run(lambda: alone.evaluate(rig.bridge.channels))
     assert asked == [topic]
     assert channel.findings == []
+
+
+def test_ros_endpoints_are_asked_again_only_when_the_graph_changes_or_they_are_old(
+    rig: Rig, world: RosWorld, other_process: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A channel's ROS endpoints are reused while the graph's nodes and the topic's count of
+    them stay the same; a reader that comes has them asked at the next pass, and so do
+    ROS_ENDPOINTS_REFRESH seconds, whatever the graph."""
+    topic = unique("asked")
+    channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS)))
+    rig.gazebo().advertise(topic, STRING)
+    other_process.create_subscription(Int32, topic, lambda _m: None, 10)
+    wait_until(lambda: len(world.subscribers(topic)) == 1, "the other type's reader in the graph")
+    asked: list[str] = []
+    ask = rig.node.get_subscriptions_info_by_topic
+
+    def spy(name: str) -> Any:
+        asked.append(name)
+        return ask(name)
+
+    monkeypatch.setattr(rig.node, "get_subscriptions_info_by_topic", spy)
+    judge = Judge(rig)
+    judge.evaluate()
+    judge.evaluate(EXPLAIN_PERIOD)
+    assert asked == [topic]
+    assert [f.key.split(":")[0] for f in channel.findings] == ["ros-type"]
+    world.subscribe(String, topic, QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+    wait_until(lambda: len(world.subscribers(topic)) == 2, "the second reader in the graph")
+    judge.evaluate(EXPLAIN_PERIOD)
+    assert asked == [topic, topic]
+    judge.evaluate(EXPLAIN_PERIOD)
+    assert asked == [topic, topic]
+    judge.evaluate(ROS_ENDPOINTS_REFRESH)
+    assert asked == [topic, topic, topic]
