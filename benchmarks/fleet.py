@@ -45,6 +45,7 @@ from benchmarks.fleet_goals import (
     Round,
     Size,
     goal_lines,
+    idle_ceiling_text,
     median,
     percent,
     rss_context,
@@ -223,7 +224,11 @@ def report(
             f"At rest: the bridge of the {idle.robots}-robot YAML ({idle.entries} entries, the "
             "Gazebo -> ROS ones and `cmd_vel` ROS -> Gazebo native) with no simulator and no "
             f"subscriber, measured over {args.idle_seconds:g} s after {IDLE_SETTLE:g} s: "
-            f"**{idle.cpu:.2f}% of a core**, {idle.threads} threads, {idle.rss:.0f} MB.",
+            f"**{idle.cpu:.2f}% of a core**, {idle.threads} threads, {idle.rss:.0f} MB; then, "
+            f"measured the same way, {idle_ceiling_text(idle.ceiling_cpu)} (`fleet_ros pub "
+            f"{idle.robots} --at-rest`: the same ROS endpoints, nothing sent). On a virtual "
+            "machine whose idle CPUs wake slowly every wake-up costs far more than its work, "
+            "so both figures count wake-ups more than code.",
         ]
     lines += ["", "Goals, each judged on this run's figures:", "", *goal_lines(rows, idle)]
     context = rss_context(rows)
@@ -246,6 +251,8 @@ def numbers(rows: Sequence[Round], idle: Idle | None = None) -> dict[str, float]
             f"{key}.threads": idle.threads,
             f"{key}.rss_mb": round(idle.rss, 1),
         }
+        if idle.ceiling_cpu is not None:
+            stored[f"{key}.ceiling_cpu_percent"] = round(idle.ceiling_cpu, 3)
     for size in sizes(rows):
         if not size.measured:
             continue

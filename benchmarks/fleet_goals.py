@@ -202,16 +202,26 @@ def sizes(rows: Sequence[Round]) -> list[Size]:
 
 @dataclass(frozen=True)
 class Idle:
-    """The bridge of a fleet's YAML with nothing on either side: its own cost at rest."""
+    """The bridge of a fleet's YAML with nothing on either side: its own cost at rest, and
+    its ceiling's (the ceiling's rclpy process with the same endpoints, sending nothing)."""
 
     robots: int
     cpu: float
     threads: int
     rss: float
+    ceiling_cpu: float | None = None
 
     @property
     def entries(self) -> int:
         return 1 + 4 * self.robots
+
+
+def idle_ceiling_text(ceiling_cpu: float | None) -> str:
+    """The ceiling at rest beside an idle bridge's figure: what the machine asks of an rclpy
+    process with the same endpoints doing nothing (its Fast DDS threads' wake-ups)."""
+    if ceiling_cpu is None:
+        return "the ceiling at rest not measured"
+    return f"the same run's rclpy ceiling at rest {ceiling_cpu:.2f}%"
 
 
 def percent(share: float) -> str:
@@ -313,7 +323,7 @@ def goal_lines(rows: Sequence[Round], idle: Idle | None = None) -> list[str]:
             f"an idle bridge of {GOAL_IDLE_ENTRIES}+ entries < {GOAL_IDLE_PERCENT:g}% of a core "
             "(issue 28)",
             idle.entries >= GOAL_IDLE_ENTRIES and idle.cpu < GOAL_IDLE_PERCENT,
-            f"{idle.cpu:.2f}% ({idle.entries} entries)",
+            f"{idle.cpu:.2f}% ({idle.entries} entries; {idle_ceiling_text(idle.ceiling_cpu)})",
         )
     return lines
 

@@ -16,7 +16,8 @@ on SIGTERM.
 publishing the same topics at the same rates, each message serialized once, and subscribed
 (serialized) to every robot's ``cmd_vel``, with no Gazebo side and no conversion: what an
 rclpy process pays for the fleet's ROS traffic alone, where the bridge is. Lines: ``READY``;
-on SIGUSR1 ``COUNTS {"cmd_vel": received}``; ``SENT n`` when stopped.
+on SIGUSR1 ``COUNTS {"cmd_vel": received}``; ``SENT n`` when stopped. With ``--at-rest`` it
+makes the same publishers and subscriptions and sends nothing: the ceiling of an idle bridge.
 """
 
 from __future__ import annotations
@@ -162,9 +163,9 @@ def _filled(type_name: str, topic: str) -> Any:
     return msg
 
 
-def publisher(robots: int) -> None:
-    """Publish every topic on its own schedule, as the C++ peer's ``pub-fleet`` does, and take
-    every robot's ``cmd_vel`` serialized, as the bridge does."""
+def publisher(robots: int, at_rest: bool = False) -> None:
+    """Publish every topic on its own schedule, as the C++ peer's ``pub-fleet`` does (none
+    ``at_rest``), and take every robot's ``cmd_vel`` serialized, as the bridge does."""
     rclpy = _ros_start()
     from rclpy.serialization import serialize_message  # noqa: PLC0415
 
@@ -194,6 +195,8 @@ def publisher(robots: int) -> None:
     for entry in schedule:
         entry[0] = start
     sent = 0
+    if at_rest:
+        stop.wait()  # a signal's handler runs in this wait (it sets `stop`)
     while not stop.is_set():
         now = time.monotonic()
         wake = now + 1.0
@@ -230,9 +233,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     publishing = sub.add_parser("pub", help="the ceiling's rclpy process")
     publishing.add_argument("robots", type=int)
+    publishing.add_argument("--at-rest", action="store_true", help="send nothing")
     args = parser.parse_args(argv)
     if args.role == "pub":
-        publisher(args.robots)
+        publisher(args.robots, args.at_rest)
         return 0
     first, last = args.robots or (1, 0)
     subscriber([f"robot_{i}" for i in range(first, last + 1)], args.clock)

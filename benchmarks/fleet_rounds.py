@@ -5,6 +5,7 @@ what each runs). :func:`start_bridged` and :func:`start_ceiling` are also the fl
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 import time
@@ -244,21 +245,38 @@ def ceiling_round(robots: int, seconds: float, env: Mapping[str, str], order: in
     )
 
 
+def _at_rest(
+    command: list[str], env: Mapping[str, str], seconds: float
+) -> tuple[float, PeerProcess]:
+    """CPU (% of a core) of ``command``'s process over ``seconds`` after IDLE_SETTLE, and the
+    process (still running)."""
+    process = start_process(command, env)
+    time.sleep(IDLE_SETTLE)
+    window = CpuWindow(process.pid)
+    window.begin()
+    time.sleep(seconds)
+    window.end()
+    return window.percent or 0.0, process
+
+
 def idle_round(robots: int, seconds: float) -> Idle:
-    """The fleet's bridge alone, no simulator, no subscriber: CPU over ``seconds``."""
+    """The fleet's bridge alone, no simulator, no subscriber: CPU over ``seconds``; then its
+    ceiling at rest, the ceiling's rclpy process with the same endpoints sending nothing."""
     print(f"== idle bridge of {robots} robots", file=sys.stderr)
     env = {**run_env(), "PYTHONPATH": str(ROOT)}
     names = fleet_sim.robots(robots)
+    bridge_command = [str(BIN / "parameter_bridge"), *fleet_sim.bridge_arguments(names)]
+    ceiling_command = [
+        sys.executable, "-m", "benchmarks.fleet_ros", "pub", str(robots), "--at-rest",
+    ]  # fmt: skip
     try:
-        bridge = start_process(
-            [str(BIN / "parameter_bridge"), *fleet_sim.bridge_arguments(names)], env
-        )
-        time.sleep(IDLE_SETTLE)
-        window = CpuWindow(bridge.pid)
-        window.begin()
-        time.sleep(seconds)
-        window.end()
-        result = Idle(robots, window.percent or 0.0, threads_of(bridge), rss_mb(bridge.pid))
+        cpu, bridge = _at_rest(bridge_command, env, seconds)
+        result = Idle(robots, cpu, threads_of(bridge), rss_mb(bridge.pid))
+    finally:
+        stop_all()
+    try:
+        ceiling_cpu, _ceiling = _at_rest(ceiling_command, env, seconds)
+        result = dataclasses.replace(result, ceiling_cpu=ceiling_cpu)
     finally:
         stop_all()
     print(result, file=sys.stderr, flush=True)

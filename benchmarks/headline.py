@@ -32,6 +32,7 @@ from benchmarks.fleet_goals import (
     GOAL_IDLE_PERCENT,
     GOAL_RATIO,
     KINDS,
+    idle_ceiling_text,
     short_kinds,
 )
 from benchmarks.harness import PYTHON_THREADS, FlowResult
@@ -346,9 +347,10 @@ def fleet_lines(stored: Stored | None) -> list[str]:
         robots = int(key.removeprefix("idle").split(".")[0])
         percent, goal = numbers[key], GOAL_IDLE_PERCENT
         judged = verdict(percent < goal, f"{percent - goal:.2f} points")
+        at_rest = idle_ceiling_text(numbers.get(f"idle{robots}.ceiling_cpu_percent"))
         lines.append(
-            f"- at rest, {1 + 4 * robots} entries: {percent:.2f}% of a core (goal < {goal:g}%): "
-            f"{judged}"
+            f"- at rest, {1 + 4 * robots} entries: {percent:.2f}% of a core ({at_rest}; goal < "
+            f"{goal:g}%): {judged}"
         )
     return lines
 
