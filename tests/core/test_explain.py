@@ -309,10 +309,12 @@ def test_a_ros_reader_with_incompatible_qos_is_explained(rig: Rig, world: RosWor
     ), text
 
 
-def test_a_graph_of_the_bridges_nodes_alone_asks_no_topics_endpoints(
-    rig: Rig, world: RosWorld, other_process: Any, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    topic = unique("alone")
+def _read_by_another_type(
+    rig: Rig, world: RosWorld, other_process: Any, monkeypatch: pytest.MonkeyPatch, label: str
+) -> tuple[str, Channel, list[str]]:
+    """A Gazebo -> ROS channel whose topic another process's node reads as another type, and
+    the topics the bridge's node is asked the subscribers of from now on."""
+    topic = unique(label)
     channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS)))
     rig.gazebo().advertise(topic, STRING)
     other_process.create_subscription(Int32, topic, lambda _m: None, 10)
@@ -325,6 +327,13 @@ def test_a_graph_of_the_bridges_nodes_alone_asks_no_topics_endpoints(
         return ask(name)
 
     monkeypatch.setattr(rig.node, "get_subscriptions_info_by_topic", spy)
+    return topic, channel, asked
+
+
+def test_a_graph_of_the_bridges_nodes_alone_asks_no_topics_endpoints(
+    rig: Rig, world: RosWorld, other_process: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    topic, channel, asked = _read_by_another_type(rig, world, other_process, monkeypatch, "alone")
     judge = Judge(rig)
     judge.evaluate()  # another process's node is in the graph: its reader is found
     assert asked == [topic]
@@ -343,19 +352,7 @@ def test_ros_endpoints_are_asked_again_only_when_the_graph_changes_or_they_are_o
     """A channel's ROS endpoints are reused while the graph's nodes and the topic's count of
     them stay the same; a reader that comes has them asked at the next pass, and so do
     ROS_ENDPOINTS_REFRESH seconds, whatever the graph."""
-    topic = unique("asked")
-    channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS)))
-    rig.gazebo().advertise(topic, STRING)
-    other_process.create_subscription(Int32, topic, lambda _m: None, 10)
-    wait_until(lambda: len(world.subscribers(topic)) == 1, "the other type's reader in the graph")
-    asked: list[str] = []
-    ask = rig.node.get_subscriptions_info_by_topic
-
-    def spy(name: str) -> Any:
-        asked.append(name)
-        return ask(name)
-
-    monkeypatch.setattr(rig.node, "get_subscriptions_info_by_topic", spy)
+    topic, channel, asked = _read_by_another_type(rig, world, other_process, monkeypatch, "asked")
     judge = Judge(rig)
     judge.evaluate()
     judge.evaluate(EXPLAIN_PERIOD)
