@@ -136,16 +136,21 @@ class Flood:
     """A second stream that a flow's publisher process sends beside its own, from ``lead``
     seconds before the flow's first message until just after its last, to a subscriber of its
     own (``hz`` 0: back to back): through the bridge like the flow, or with ``bypass`` straight
-    to a subscriber on the publisher's side (the bridge then never sees it)."""
+    to a subscriber on the publisher's side (the bridge then never sees it). An ``apart`` flood
+    comes from a Gazebo publisher process of its own, to a Gazebo subscriber: the same load on
+    the machine beside a flow whose publisher is not that process (an rclpy one)."""
 
     kind: str
     topic: str
     hz: float = 0.0
     lead: float = 3.0
     bypass: bool = False
+    apart: bool = False
 
     def subscriber(self, flow: Flow) -> str:
         """The role of the flood's subscriber."""
+        if self.apart:
+            return "gz-sub"
         if not self.bypass:
             return flow.subscriber
         return "gz-sub" if flow.publisher == "gz-pub" else "ros-sub"
@@ -299,9 +304,10 @@ def run_flow(
     to see the bridge's publisher. ``during`` runs once publishing started (RSS sampling)."""
     pub_env = dict(pub_env or env)
     flood = flow.flood
-    if flow.publisher == "gz-pub" and LARGE_KINDS & {flow.kind, flood.kind if flood else ""}:
-        for prefix in ("GZ_", "IGN_"):
-            pub_env[f"{prefix}TRANSPORT_SNDHWM"] = LARGE_HWM
+    #: The flood the flow's own publisher sends (an ``apart`` one has a process of its own).
+    own = None if flood is None or flood.apart else flood
+    if flow.publisher == "gz-pub" and LARGE_KINDS & {flow.kind, own.kind if own else ""}:
+        pub_env |= _large_hwm()
     extra: tuple[str, ...] = ("--slow-ms", str(flow.slow_ms)) if flow.slow_ms else ()
     depth = () if flow.depth is None else ("--depth", str(flow.depth))
     if flow.qos_profile is not None:
@@ -310,18 +316,22 @@ def run_flow(
     if flow.raw and flow.subscriber == "ros-sub":
         sub_extra += ("--raw",)
     pub_extra = ("--hz", str(flow.hz), *(depth if flow.publisher == "ros-pub" else ()))
-    pub_extra += tuple(flood_options(flood, flow.publisher == "gz-pub" and uses_ign_peer(pub_env)))
-    lead = 0.0 if flood is None else flood.lead + MATCH_WAIT
+    pub_extra += tuple(flood_options(own, flow.publisher == "gz-pub" and uses_ign_peer(pub_env)))
+    lead = 0.0 if own is None else own.lead + MATCH_WAIT
     ends: list[PeerProcess] = []
     try:
-        flood_sub = None
+        flood_sub = flooder = None
         if flood is not None:
             role = flood.subscriber(flow)
+            beside = flood.bypass or flood.apart
             flood_sub = _subscriber(
-                flow, role, flood.topic, flood.kind, env=pub_env if flood.bypass else env,
-                extra=(), bridge_pid=None if flood.bypass else bridge_pid,
+                flow, role, flood.topic, flood.kind, env=pub_env if beside else env,
+                extra=(), bridge_pid=None if beside else bridge_pid,
             )  # fmt: skip
             ends.append(flood_sub)
+            if flood.apart:
+                flooder = _flooder(flood, flow.seconds, pub_env)
+                ends.append(flooder)
         sub = _subscriber(
             flow, flow.subscriber, topic, flow.kind, env=env, extra=sub_extra, bridge_pid=bridge_pid
         )
@@ -344,8 +354,7 @@ def run_flow(
         stats = _stats(sub)
         flooded = None
         if flood_sub is not None:
-            flood_sent = int(wait_for_line(pub, r"^FLOOD_SENT (\d+)", 10)[1])
-            flooded = _result(flood_sent, _stats(flood_sub))
+            flooded = _result(_flood_sent(pub, flooder), _stats(flood_sub))
     except FlowFailure as error:
         return failed(error)
     finally:
@@ -359,6 +368,33 @@ def run_flow(
         flood=flooded,
         bridge_threads=windows[0].groups,
     )
+
+
+def _large_hwm() -> dict[str, str]:
+    """The send queue of a Gazebo publisher of large messages: :data:`LARGE_HWM`."""
+    return {f"{prefix}TRANSPORT_SNDHWM": LARGE_HWM for prefix in ("GZ_", "IGN_")}
+
+
+def _flooder(flood: Flood, seconds: float, env: Mapping[str, str]) -> PeerProcess:
+    """The Gazebo process of an ``apart`` flood, sending back to back to its subscriber since
+    ``flood.lead`` seconds; it runs until stopped (its SENT line then counts the frames)."""
+    spare = 60.0  # the flow's own start-up: stopped as soon as the flow has sent
+    flooder = worker(
+        "gz-pub", flood.topic, flood.kind, seconds + spare, {**env, **_large_hwm()},
+        "--hz", str(flood.hz),
+    )  # fmt: skip
+    wait_for_line(flooder, r"^START$", 40)
+    time.sleep(flood.lead)
+    return flooder
+
+
+def _flood_sent(pub: PeerProcess, flooder: PeerProcess | None) -> int:
+    """How many flood messages were sent: by the flow's publisher, or by the flood's own
+    process (stopped here)."""
+    if flooder is None:
+        return int(wait_for_line(pub, r"^FLOOD_SENT (\d+)", 10)[1])
+    flooder.stop()
+    return int(wait_for_line(flooder, r"^SENT (\d+)", 10)[1])
 
 
 def _subscriber(

@@ -195,3 +195,48 @@ def test_the_clock_notes_split_the_loss_before_in_and_after_the_bridge_from_coun
     assert shares.endswith("with the bridge at 7% of a core and its clock channel alone (the "
                            "control row), the same subscriber still lost 8.0%.")  # fmt: skip
     assert stored_counters(numbers, "deep bridge ") is None
+
+
+def clock_run(same_flood: dict[str, Any] | None) -> Stored:
+    """A stored starvation run: the bridge 80% under the flood, the control 76%."""
+    flows = {phase.name: flow(5000, 4950, 5.0) for phase in starvation.PHASES}
+    flows[starvation.DEFAULT.name] = flow(5000, 4000, 90.0)
+    flows[starvation.BYPASS.name] = flow(5000, 3800, 8.0, cpu=7.0)
+    flows[starvation.CEILING.name] = flow(5000, 4990, 3.0)
+    del flows[starvation.SAME_FLOOD.name]
+    if same_flood is not None:
+        flows[starvation.SAME_FLOOD.name] = same_flood
+    return entry("fff6666", COSTS_WHEN, flows)
+
+
+def test_the_ceiling_under_the_same_flood_is_the_clock_figures_yardstick() -> None:
+    frames = flow(2000, 1500, 50.0)
+    run = clock_run(flow(5000, 3900, 10.0, flood=frames))
+
+    last = headline.clock_notes(run)[-1]
+    clock = row(headline.section(None, None, run, ""), "/clock at 1 kHz")
+
+    assert last == (
+        "- The same run's yardstick: rclpy alone publishing /clock at 1 kHz to the same depth-10 "
+        "subscriber, beside a Gazebo process flooding 1080p frames back to back to a Gazebo "
+        "subscriber (1500/2000 frames delivered), gave 78.0% (p99 10.0 ms): the bridge under "
+        "the flood +2.0 points against it, the control row -2.0; the machine under this flood "
+        "leaves even rclpy short of the goal."
+    )
+    assert "| 99.8%; 78.0% beside the same Gazebo flood | >= 99%: **missed**" in clock
+    met = headline.clock_notes(clock_run(flow(5000, 5000, 2.0, flood=frames)))[-1]
+    assert met.endswith(
+        "-20.0 points against it, the control row -24.0; the subscriber keeps up with a steady "
+        "1 kHz under this load; the bridge's clock comes in the bursts in which the flooding "
+        "process sends it (the hop's p99: 5 ms), published as they come, and a burst that "
+        "outgrows the depth-10 history before the subscriber drains it loses its oldest."
+    )
+
+
+def test_a_stored_clock_run_from_before_the_same_flood_ceiling_keeps_its_notes() -> None:
+    notes = headline.clock_notes(clock_run(None))
+    clock = row(headline.section(None, None, clock_run(None), ""), "/clock at 1 kHz")
+
+    assert notes[0].startswith("- The flooded publisher's own delivery")
+    assert not any("same run's yardstick" in note for note in notes)
+    assert "| 99.8% | >= 99%: **missed**" in clock
