@@ -27,6 +27,7 @@ from rclpy.utilities import remove_ros_args
 from ros_gz_bridge_py.app import discover
 from ros_gz_bridge_py.app.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
 from ros_gz_bridge_py.app.check import Sides, run_check
+from ros_gz_bridge_py.app.one_cpu import OneCpu, start_one_cpu
 from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
     Switches,
@@ -113,6 +114,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         bridge: Bridge | None = None
         diagnostics: DiagnosticsPublisher | None = None
         discovered: DiscoveredBridges | None = None
+        one_cpu: OneCpu | None = None
         try:
             try:
                 params = declare_parameter_bridge_parameters(node)
@@ -136,6 +138,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 return discover_yaml(node, cli, params, discover_seconds, values)
             bridge, discovered = build_bridge(node, cli, params, switches, values)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
+            one_cpu = start_one_cpu(node, bridge.carries_bulk, switches.one_cpu)
             finish_start_up(node)
             serve(
                 node,
@@ -145,6 +148,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 dds_event_batch=switches.dds_event_batch,
             )
         finally:
+            if one_cpu is not None:
+                one_cpu.close()
             if diagnostics is not None:
                 diagnostics.close()
             if discovered is not None:

@@ -56,6 +56,8 @@ CDR_WRITE_ENV = "ROS_GZ_BRIDGE_CDR_WRITE"
 NATIVE_ENV = "ROS_GZ_BRIDGE_NATIVE"
 #: A switch: off leaves Fast DDS's event threads at normal scheduling (not SCHED_BATCH).
 DDS_EVENT_BATCH_ENV = "ROS_GZ_BRIDGE_DDS_EVENT_BATCH"
+#: A switch: off leaves ``parameter_bridge``'s threads on every CPU (no :mod:`~.one_cpu`).
+ONE_CPU_ENV = "ROS_GZ_BRIDGE_ONE_CPU"
 
 
 #: The switches that are :class:`BridgeOptions` of the same names (how messages travel).
@@ -91,6 +93,8 @@ class Switches:
     native: bool = True
     #: False with ``ROS_GZ_BRIDGE_DDS_EVENT_BATCH=off``.
     dds_event_batch: bool = True
+    #: False with ``ROS_GZ_BRIDGE_ONE_CPU=off``.
+    one_cpu: bool = True
     #: What was wrong with a value, one sentence each: the executables log them once their
     #: node exists (the switches are read before ``rclpy.init``).
     warnings: tuple[str, ...] = ()
@@ -137,6 +141,7 @@ def read_switches(env: Mapping[str, str] | None = None) -> Switches:
         cdr_write=not switched_off(CDR_WRITE_ENV, env),
         native=not switched_off(NATIVE_ENV, env),
         dds_event_batch=not switched_off(DDS_EVENT_BATCH_ENV, env),
+        one_cpu=not switched_off(ONE_CPU_ENV, env),
         warnings=(nice_warning,) if nice_warning else (),
     )
 

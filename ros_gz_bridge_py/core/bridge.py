@@ -131,6 +131,10 @@ class Bridge:
     def channels(self) -> list[Channel]:
         return [channel for handle in self.handles for channel in handle.channels]
 
+    def carries_bulk(self) -> bool:
+        """True when a channel takes the bulk path (images, point clouds)."""
+        return any(channel.bulk is not None for channel in self.channels)
+
     @property
     def services(self) -> list[ServiceBridge]:
         return [h.service for h in self.handles if h.service is not None]

@@ -22,6 +22,7 @@ from ros_gz_bridge_py.app.settings import (
     LIGHT_READ_ENV,
     MESSAGE_PATH_SWITCHES,
     NATIVE_ENV,
+    ONE_CPU_ENV,
     SERIALIZED_PUBLISH_ENV,
     ImageBridgeParameters,
     ParameterBridgeParameters,
@@ -47,6 +48,7 @@ OFF_SWITCHES = {
     CDR_WRITE_ENV: "cdr_write",
     DDS_EVENT_BATCH_ENV: "dds_event_batch",
     NATIVE_ENV: "native",
+    ONE_CPU_ENV: "one_cpu",
 }
 #: Each choice switch, the value that chooses, and the field it sets False.
 CHOICES = {
@@ -72,6 +74,7 @@ def test_nothing_set_is_the_fast_defaults() -> None:
         light_read=True,
         cdr_write=True,
         dds_event_batch=True,
+        one_cpu=True,
         warnings=(),
     )
 
@@ -138,6 +141,7 @@ def test_every_switch_at_once() -> None:
         LIGHT_READ_ENV: "false",
         CDR_WRITE_ENV: "off",
         DDS_EVENT_BATCH_ENV: "No",
+        ONE_CPU_ENV: "OFF",
     }
     assert read_switches(env) == Switches(
         events_executor=False,
@@ -148,6 +152,7 @@ def test_every_switch_at_once() -> None:
         light_read=False,
         cdr_write=False,
         dds_event_batch=False,
+        one_cpu=False,
     )
 
 
