@@ -63,17 +63,11 @@ class Sample:
 
 
 @dataclass(frozen=True)
-class Pin:
-    """Put every thread on ``cpu``; ``why`` says so in the log."""
+class Move:
+    """Put every thread on ``cpu``, or with None give them back the CPUs they started with;
+    ``why`` says so in the log."""
 
-    cpu: int
-    why: str
-
-
-@dataclass(frozen=True)
-class Release:
-    """Give every thread back the CPUs it started with."""
-
+    cpu: int | None
     why: str
 
 
@@ -86,7 +80,7 @@ class OneCpuPolicy:
         self._hold_until = 0.0
         self._hold = FIRST_HOLD
 
-    def step(self, now: Sample) -> Pin | Release | None:
+    def step(self, now: Sample) -> Move | None:
         last, self._last = self._last, now
         if last is None or now.time <= last.time:
             return None
@@ -102,12 +96,12 @@ class OneCpuPolicy:
             self._hold_until = now.time + self._hold
             why = f"{why} ({figures}); spread for {self._hold:.0f} s"
             self._hold = min(self._hold * 2, LONGEST_HOLD)
-            return Release(why)
+            return Move(None, why)
         if now.time < self._hold_until or now.bulk or load > PIN_LOAD or len(shares) < 2:
             return None
         cpu = min(shares, key=lambda cpu: (shares[cpu], cpu))
         self.pinned = cpu
-        return Pin(cpu, f"a light load ({figures})")
+        return Move(cpu, f"a light load ({figures})")
 
 
 def _release_reason(
@@ -174,16 +168,15 @@ class OneCpu:
         """Sample the process and apply the policy's move (the timer's callback)."""
         try:
             move = self._policy.step(self.sample())
-            if isinstance(move, Pin):
+            if move is not None:
                 self._placed.clear()
-            elif isinstance(move, Release):
-                self._place(self._allowed, set())
+                if move.cpu is None:
+                    self._place(self._allowed, set())
             if self._policy.pinned is not None:  # threads started since are placed too
                 self._place(frozenset({self._policy.pinned}), self._placed)
-            if isinstance(move, Pin):
-                self._logger.info(f"bridge threads on CPU {move.cpu}: {move.why}")
-            elif isinstance(move, Release):
-                self._logger.info(f"bridge threads on every CPU again: {move.why}")
+            if move is not None:
+                where = "every CPU again" if move.cpu is None else f"CPU {move.cpu}"
+                self._logger.info(f"bridge threads on {where}: {move.why}")
         except OSError as err:  # /proc unreadable here: leave the threads as they are
             self._logger.warning(f"cannot place the bridge's threads ({err}); leaving them")
             self.close()
