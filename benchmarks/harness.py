@@ -22,7 +22,7 @@ import pytest
 
 from benchmarks.bridge_threads import LIBZMQ_THREAD
 from benchmarks.payloads import KINDS
-from benchmarks.transport import STATS_LINE
+from benchmarks.transport import LARGE_HWM, STATS_LINE
 from benchmarks.workers import MATCH_WAIT
 from benchmarks.workers import SETTLE as PUBLISH_SETTLE
 from ros_gz_bridge_py.ros.speed import remove_zombie_segments
@@ -31,8 +31,6 @@ from testing.procstat import cpu_seconds
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
-#: ZeroMQ high-water mark for the Gazebo publisher of large kinds: bounds its own queue.
-LARGE_HWM = "20"
 #: Seconds between a subscriber seeing the bridge and the publisher starting (connections).
 SETTLE = 1.0
 #: The same for an rclpy subscriber of the bridge's publisher. It sees the bridge's writer
@@ -371,8 +369,9 @@ def run_flow(
 
 
 def _large_hwm() -> dict[str, str]:
-    """The send queue of a Gazebo publisher of large messages: :data:`LARGE_HWM`."""
-    return {f"{prefix}TRANSPORT_SNDHWM": LARGE_HWM for prefix in ("GZ_", "IGN_")}
+    """The send queue of a Gazebo publisher of large messages: ``transport.LARGE_HWM``, the
+    transport benchmark's bound."""
+    return {f"{prefix}TRANSPORT_SNDHWM": str(LARGE_HWM) for prefix in ("GZ_", "IGN_")}
 
 
 def _flooder(flood: Flood, seconds: float, env: Mapping[str, str]) -> PeerProcess:

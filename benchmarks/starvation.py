@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from benchmarks.bridged import Backend, backend, bridge_process, flow_through
 from benchmarks.harness import (
     GZ_ENDS,
-    LARGE_HWM,
     Flood,
     Flow,
     FlowResult,
@@ -30,6 +29,7 @@ from benchmarks.reference import CLOCK_UNDER_FLOOD, GOAL_CLOCK_SHARE, QUOTED
 from benchmarks.report import write_section
 from benchmarks.results import store
 from benchmarks.tables import verdict
+from benchmarks.transport import LARGE_HWM
 from testing.gzpeer import PeerProcess
 from testing.run_env import run_env
 
