@@ -136,7 +136,9 @@ def cpu_ticks(stat: str, cpus: Iterable[int]) -> dict[int, tuple[int, int]]:
         name, _, rest = line.partition(" ")
         if not name.startswith("cpu") or not name[3:].isdigit() or int(name[3:]) not in wanted:
             continue
-        values = [int(value) for value in rest.split()]
+        # user nice system idle iowait irq softirq steal; guest time (the columns after) is
+        # counted in user and nice already
+        values = [int(value) for value in rest.split()[:8]]
         idle = sum(values[3:5])  # idle, iowait
         ticks[int(name[3:])] = (sum(values) - idle, sum(values))
     return ticks

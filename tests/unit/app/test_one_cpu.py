@@ -13,16 +13,16 @@ from ros_gz_bridge_py.app.one_cpu import (
 )
 
 STAT = """cpu  100 0 50 800 10 0 5 0 0 0
-cpu0 60 0 30 400 4 0 2 0 0 0
-cpu1 40 0 20 400 6 0 3 0 0 0
+cpu0 60 0 30 400 4 0 2 0 7 0
+cpu1 40 0 20 400 6 0 3 1 0 5
 cpu3 1 0 1 1 1 0 0 0 0 0
 intr 12345
 ctxt 678
 """
 
 
-def test_cpu_ticks_are_busy_and_total_of_the_wanted_cpus() -> None:
-    assert cpu_ticks(STAT, {0, 1, 2}) == {0: (92, 496), 1: (63, 469)}
+def test_cpu_ticks_are_busy_and_total_of_the_wanted_cpus_without_guest_time() -> None:
+    assert cpu_ticks(STAT, {0, 1, 2}) == {0: (92, 496), 1: (64, 470)}
 
 
 def is_pin(move: Move | None) -> bool:
