@@ -161,11 +161,6 @@ class OneCpu:
         self._timer = ros_node.create_timer(period, self.look, clock=steady_clock())
         self._node = ros_node
 
-    @property
-    def pinned(self) -> int | None:
-        """The CPU every thread is on, or None while they are spread."""
-        return self._policy.pinned
-
     def look(self) -> None:
         """Sample the process and apply the policy's move (the timer's callback)."""
         try:
@@ -208,8 +203,8 @@ class OneCpu:
 
 
 def start_one_cpu(ros_node: Any, bulk: Callable[[], bool], enabled: bool) -> OneCpu | None:
-    """The placement the executables run, or None when switched off or when there is only one
-    CPU to run on."""
+    """The placement ``parameter_bridge`` runs, or None when switched off or when there is only
+    one CPU to run on."""
     if not enabled or len(os.sched_getaffinity(0)) < 2:
         return None
     return OneCpu(ros_node, bulk)
