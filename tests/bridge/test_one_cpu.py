@@ -35,18 +35,23 @@ def thread_cpus(pid: int) -> set[frozenset[int]]:
 
 
 def start(
-    args: list[str], env: dict[str, str] | None = None, prefix: tuple[str, ...] = ()
+    started: list[PeerProcess],
+    args: list[str],
+    env: dict[str, str] | None = None,
+    prefix: tuple[str, ...] = (),
 ) -> PeerProcess:
+    """A bridge, in ``started`` (stopped at test end, also when this wait fails) once its
+    process exists, returned once it has created its channel."""
     bridge = start_process(
         [*prefix, *bridge_command(*args)], None if env is None else {**os.environ, **env}
     )
+    started.append(bridge)
     wait_for_line(bridge, r"\]: Creating ", timeout=30)
     return bridge
 
 
 def test_a_light_bridge_shares_one_cpu(started: list[PeerProcess]) -> None:
-    bridge = start([f"{unique_name('one_cpu')}@std_msgs/msg/String@{STRING}"])
-    started.append(bridge)
+    bridge = start(started, [f"{unique_name('one_cpu')}@std_msgs/msg/String@{STRING}"])
     cpu = int(wait_for_line(bridge, PINNED, timeout=WAIT + DECIDED)[1])
     assert thread_cpus(bridge.pid) == {frozenset({cpu})}
 
@@ -66,10 +71,8 @@ def test_threads_stay_where_they_were(
     """Judged once a light bridge started after it has pinned: by then this one has looked at
     its load as often, and moved nothing."""
     allowed = frozenset({0}) if prefix else frozenset(os.sched_getaffinity(0))
-    bridge = start([unique_name("one_cpu") + entry], env, prefix)
-    started.append(bridge)
-    later = start([f"{unique_name('one_cpu')}@std_msgs/msg/String@{STRING}"])
-    started.append(later)
+    bridge = start(started, [unique_name("one_cpu") + entry], env, prefix)
+    later = start(started, [f"{unique_name('one_cpu')}@std_msgs/msg/String@{STRING}"])
     wait_for_line(later, PINNED, timeout=WAIT + DECIDED)
     assert bridge.poll() is None
     assert thread_cpus(bridge.pid) == {allowed}
