@@ -255,6 +255,17 @@ def gz_stamp(kind: Kind, msg: Any) -> int:
     return int(time_msg.sec) * NS + int(time_msg.nsec)
 
 
+def gz_message(kind: Kind) -> Any:
+    """The Gazebo message of ``kind``; an image with the header a gz-sensors camera gives each
+    frame: its stamp, ``frame_id`` and ``seq`` (``CameraSensor::Update``, ``AddSequence``)."""
+    msg = kind.pair.to_gz(kind.make_ros())
+    if kind.gz_type == "gz.msgs.Image":
+        entry = msg.header.data.add()
+        entry.key = "seq"
+        entry.value.append("1")
+    return msg
+
+
 class GzPayloads:
     """Serialized, stamped Gazebo messages of one kind, cheap for large ones.
 

@@ -281,8 +281,9 @@ publisher sent {result.sent} images in {seconds:g} s and {result.received} ({kep
 subscriber. Over the sampled window the bridge process used {bridge:.0f}% of one core, the
 Gazebo publisher {pub:.0f}% and the rclpy subscriber {sub:.0f}%: {total:.0f}% of the 200% the 2
 cores offer. The image delivery thread takes the bulk path: `gz_to_ros_cdr` (split the payload,
-convert the small fields, the one copy of the 6.2 MB data) is on its stack in {convert:.0f}% of
-the ticks and holds the GIL in {convert_gil:.0f}%; `SerializedPublisher.publish`
+convert the small fields, write the CDR around the 6.2 MB data in the received frame) is on its
+stack in {convert:.0f}% of the ticks and holds the GIL in {convert_gil:.0f}%;
+`SerializedPublisher.publish`
 (`rcl_publish_serialized_message` through ctypes: Fast DDS copies the frame into shared memory
 and hands it to the subscriber) in {publish:.0f}%, holding the GIL in only {publish_gil:.0f}%
 because ctypes releases it, so the other channels' threads run meanwhile. That thread used
@@ -292,9 +293,10 @@ flow control beyond TCP's (the channel's own connection; what does not fit is dr
 publisher), so flat out it sends more than the bridge converts, and the bridge pays the TCP
 receive of frames its bounded queue then drops to keep the newest. What
 bounds the rate is therefore the machine: three processes moving 6 MB frames with, per frame
-delivered, the publisher's serialization, two kernel TCP copies, the bridge's one copy, Fast
-DDS's copy and the subscriber's deserialization, plus the receive cost of the dropped frames;
-the ceiling moves each frame with rclpy alone, in two processes."""
+delivered, the publisher's serialization, two kernel TCP copies, Fast DDS's copies (the
+bridge itself copies nothing of a camera's frame) and the subscriber's deserialization, plus
+the receive cost of the dropped frames; the ceiling moves each frame with rclpy alone, in two
+processes."""
 
 
 def markdown(

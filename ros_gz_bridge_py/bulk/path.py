@@ -76,18 +76,21 @@ def gz_to_ros_cdr(
     gz_class: type[Any],
     payload: memoryview,
     finish: Callable[[Any], None] | None = None,
-) -> bytes:
-    """Gazebo payload -> serialized ROS message; the bulk bytes are copied once.
+) -> bytes | memoryview:
+    """Gazebo payload -> serialized ROS message; the bulk bytes are copied at most once.
 
-    ``finish`` may edit the ROS message (header overrides) before it is serialized.
+    ``finish`` may edit the ROS message (header overrides) before it is serialized. A writable
+    ``payload`` is the caller's own (``transport/api.py`` ``Callback``): when the bytes around
+    the bulk field have room for the CDR before and after it, they are written there and the
+    result is a view of ``payload``, the bulk bytes not copied at all (:func:`in_place`).
     """
-    rest, bulk = split_bytes_field(payload, path.gz_field)
+    rest, bulk_at, bulk_length = split_bytes_field(payload, path.gz_field)
     try:
         small = gz_class.FromString(rest)
     except DecodeError as err:
         msg = f"{gz_class.DESCRIPTOR.full_name} payload is not a valid message: {err}"
         raise UndecodableError(msg) from err
-    ros, take = path.gz_meta_to_ros(small, len(bulk))
+    ros, take = path.gz_meta_to_ros(small, bulk_length)
     if finish is not None:
         finish(ros)
     cdr = memoryview(serialize_message(ros))
@@ -95,9 +98,34 @@ def gz_to_ros_cdr(
     if where is None:  # rclpy always writes plain CDR; kept total for the type checker
         msg = "rclpy produced a serialized message that is not plain CDR"
         raise ConversionError(msg)
+    bulk = payload[bulk_at : bulk_at + bulk_length]
     pieces, size = taken(bulk, take)
     length = struct.pack("<I" if where.little_endian else ">I", size)
-    return b"".join((cdr[: where.length_at], length, *pieces, cdr[where.end :]))
+    head, tail = bytes(cdr[: where.length_at]) + length, cdr[where.end :]
+    if isinstance(take, int):
+        built = in_place(payload, head, (bulk_at, bulk_at + take), tail)
+        if built is not None:
+            return built
+    return b"".join((head, *pieces, tail))
+
+
+def in_place(
+    payload: memoryview, head: bytes, bulk: tuple[int, int], tail: memoryview
+) -> memoryview | None:
+    """``head``, ``payload[bulk[0]:bulk[1]]`` and ``tail`` as one view of ``payload``, written
+    over the records before and after the bulk bytes (already parsed), or None when
+    ``payload`` is read-only or those records are shorter than ``head`` or ``tail``.
+
+    A Gazebo camera's header (stamp, ``frame_id``, ``seq``), width, height and step take more
+    bytes before its data than a sensor_msgs/Image's CDR does, so a camera frame's 6 MB are
+    handed to the DDS write where ZeroMQ received them.
+    """
+    start, end = bulk[0] - len(head), bulk[1] + len(tail)
+    if payload.readonly or start < 0 or end > len(payload):
+        return None
+    payload[start : bulk[0]] = head
+    payload[bulk[1] : end] = tail
+    return payload[start:end]
 
 
 def ros_cdr_to_gz(path: BulkPath, ros_class: type[Any], cdr: bytes) -> bytes | None:

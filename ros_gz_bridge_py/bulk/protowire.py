@@ -44,16 +44,15 @@ def bytes_field_prefix(field_number: int, length: int) -> bytes:
     return encode_varint(field_number << 3 | _LEN) + encode_varint(length)
 
 
-def split_bytes_field(payload: memoryview, field_number: int) -> tuple[bytes, memoryview]:
-    """Split ``payload`` into (every other record, the value of bytes field ``field_number``).
-
-    The value is a view into ``payload`` (no copy); it is empty when the field is absent.
+def split_bytes_field(payload: memoryview, field_number: int) -> tuple[bytes, int, int]:
+    """Split ``payload`` into (every other record, where the value of bytes field
+    ``field_number`` starts, its length); the value is not copied (0, 0 when it is absent).
 
     Raises:
         ConversionError: the payload is not a well-formed protobuf message.
     """
     rest: list[memoryview] = []
-    bulk = payload[0:0]
+    bulk_at = bulk_length = 0
     start = pos = 0
     end = len(payload)
     while pos < end:
@@ -72,7 +71,7 @@ def split_bytes_field(payload: memoryview, field_number: int) -> tuple[bytes, me
                 if pos + length > end:
                     break
                 rest.append(payload[start:record])
-                bulk = payload[pos : pos + length]
+                bulk_at, bulk_length = pos, length
                 pos += length
                 start = pos
                 continue
@@ -84,4 +83,4 @@ def split_bytes_field(payload: memoryview, field_number: int) -> tuple[bytes, me
         msg = f"protobuf payload of {end} bytes is truncated (a record runs past its end)"
         raise UndecodableError(msg)
     rest.append(payload[start:end])
-    return b"".join(rest), bulk
+    return b"".join(rest), bulk_at, bulk_length

@@ -152,7 +152,9 @@ class TransportStats:
         return asdict(self)
 
 
-#: Subscription callback: ``callback(payload or message, info)``.
+#: Subscription callback: ``callback(payload or message, info)``. A payload handed as a
+#: writable buffer is the callback's alone, to keep or write into (the bulk path builds its
+#: CDR there, ``bulk/path.py``); one that other subscriptions also get is read-only.
 Callback = Callable[[Any, MessageInfo], None]
 #: Told about each message a subscription could not use: ``on_reject(reason, detail)``.
 RejectCallback = Callable[[Rejection, str], None]

@@ -49,10 +49,14 @@ def rgb_frame(width: int, height: int, *, frame_id: str = "", data: bytes | None
     return frame
 
 
-def rgb_text_proto(width: int, height: int, frame_id: str) -> str:
-    """The peer's TEXTPROTO argument for an RGB_INT8 frame (data comes from ``--bytes``)."""
+def rgb_text_proto(width: int, height: int, frame_id: str, *, seq: str = "") -> str:
+    """The peer's TEXTPROTO argument for an RGB_INT8 frame (data comes from ``--bytes``); with
+    ``seq``, the header a gz-sensors camera sends: a stamp, ``frame_id`` and ``seq``."""
+    header = f'data {{ key: "frame_id" value: "{frame_id}" }}'
+    if seq:
+        header = f'stamp {{ sec: 812 nsec: 4000000 }} {header} data {{ key: "seq" value: "{seq}" }}'
     return (
-        f'header {{ data {{ key: "frame_id" value: "{frame_id}" }} }} '
+        f"header {{ {header} }} "
         f"width: {width} height: {height} step: {width * 3} pixel_format_type: RGB_INT8"
     )
 

@@ -23,6 +23,7 @@ from sensor_msgs.msg import Image, PointCloud2, PointField
 
 from ros_gz_bridge_py.app.settings import BULK_PATH_ENV as BULK_ENV
 from ros_gz_bridge_py.app.settings import DDS_EVENT_BATCH_ENV
+from ros_gz_bridge_py.bulk.path import gz_to_ros_cdr
 from ros_gz_bridge_py.converters.registry import default_registry
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.errors import ConversionError
@@ -55,6 +56,7 @@ __all__ = ["gz_node", "ros_side", "started"]
 pytestmark = [pytest.mark.ros, pytest.mark.peer]
 
 GZ_IMAGE = "gz.msgs.Image"
+IMAGE = default_registry().get("sensor_msgs/msg/Image", GZ_IMAGE)
 GZ_CLOUD = "gz.msgs.PointCloudPacked"
 WIDTH, HEIGHT = 6, 4
 VARIANTS = {
@@ -241,6 +243,39 @@ def test_gazebo_to_ros_image_from_the_real_peer(
     bulk = VARIANTS[bridge.variant].get(BULK_ENV) != "off"
     lowered = [f"{THREAD_NAME_PREFIX}/ZMQbg/IO/0", "gz-sub", "gz-sub"] if bulk else []
     assert lowered_threads(bridge.process.pid) == [(name, BULK_THREAD_NICE) for name in lowered]
+
+
+def test_gazebo_to_ros_camera_frame_from_the_real_peer(
+    bridge: RunningBridge, ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    """A frame of 230 KB (the reader hands frames from 64 KiB on as writable views) with a
+    gz-sensors camera's header: its CDR is built in the frame (``bulk/path.py`` ``in_place``)."""
+    topic = bridge.topics.image_to_ros
+    width, height = 320, 240
+    size = width * height * 3
+    text = rgb_text_proto(width, height, "robot::camera", seq="4711")
+    frame = parse_gz("Image", text)
+    frame.data = pattern_bytes(size)
+    assert IMAGE.bulk is not None
+    own = memoryview(bytearray(frame.SerializeToString()))
+    assert isinstance(gz_to_ros_cdr(IMAGE.bulk, type(frame), own), memoryview)
+    wait_until(lambda: ros_side.count_publishers(topic) >= 1, WAIT, f"a publisher on {topic}")
+    inbox, _ = ros_side.subscribe(Image, topic)
+    peer = start_peer(
+        "pub", topic, "ignition.msgs.Image", "50", "10", text, "--bytes", str(size),
+        "--wire-type", GZ_IMAGE, "--wait", str(WAIT),
+    )  # fmt: skip
+    started.append(peer)
+
+    def frames() -> list[Any]:
+        return [msg for msg, _ in inbox.items() if msg.width == width]
+
+    wait_until(lambda: len(frames()) >= 2, WAIT, "camera frames in rclpy")
+    for msg in frames():
+        assert (msg.width, msg.height, msg.step, msg.encoding) == (width, height, width * 3, "rgb8")
+        assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (812, 4_000_000)
+        assert msg.header.frame_id == "robot/camera"
+        assert bytes(msg.data) == pattern_bytes(size)
 
 
 def test_only_fast_dds_event_threads_are_batched(bridge: RunningBridge) -> None:

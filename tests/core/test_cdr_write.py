@@ -12,11 +12,16 @@ from typing import Any
 
 import pytest
 from nav_msgs.msg import Odometry
+from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import default_registry
-from ros_gz_bridge_py.ros.serialized_publisher import WrittenPublisher, object_publisher
+from ros_gz_bridge_py.ros.serialized_publisher import (
+    SerializedPublisher,
+    WrittenPublisher,
+    object_publisher,
+)
 from tests.core.harness import (
     RosWorld,
     gz_to_ros,
@@ -90,6 +95,29 @@ def test_a_message_the_writer_refuses_is_published_by_rclpy(world: RosWorld) -> 
     assert written.fallbacks >= 1
     # rclpy's own conversion keeps the low 32 bits; the fallback shows what rclpy does.
     assert inbox.messages()[0].clock.sec == 7
+
+
+@pytest.mark.parametrize("through_rcl", [True, False])
+def test_serialized_views_are_published_as_their_bytes(world: RosWorld, through_rcl: bool) -> None:
+    """The bulk path hands a view of the received frame (written in place) or bytes; rcl
+    takes a writable view's memory as it is, a read-only view and rclpy's way take bytes."""
+    topic = unique("clock_views")
+    publisher = world.publisher(Clock, topic)
+    inbox, _ = world.subscribe(Clock, topic)
+    serialized = SerializedPublisher(publisher, through_rcl=through_rcl)
+
+    def cdr(sec: int) -> bytes:
+        msg = Clock()
+        msg.clock.sec = sec
+        return bytes(serialize_message(msg))
+
+    frame = bytearray(b"header" + cdr(11) + b"trailer")  # the CDR inside a larger buffer
+    in_frame = memoryview(frame)[6:-7]
+    publish_until(lambda _i: serialized.publish(in_frame), lambda: bool(inbox.messages()), "")
+    serialized.publish(memoryview(cdr(12)))
+    serialized.publish(cdr(13))
+    got = inbox.wait_for(lambda got: {12, 13} <= {m.clock.sec for m in got}, "the views")
+    assert {m.clock.sec for m in got} == {11, 12, 13}
 
 
 class _FakePublisher:

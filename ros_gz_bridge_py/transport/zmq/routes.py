@@ -50,7 +50,7 @@ class DataRouter:
             route = self._routes.get((frames[0], frames[1], frames[3]))
             if route is not None:
                 subs, info, wrong = route
-                payload = frames[2]
+                payload = _shared(frames[2])
                 for sub in subs:
                     sub.offer(payload, info)
                 self._wrong_type(wrong, info)
@@ -85,8 +85,9 @@ class DataRouter:
                 self._routes.clear()
             self._routes[key] = (accepting, info, wrong)
         self.received += bool(accepting)
+        payload = _shared(message.payload)
         for sub in accepting:
-            sub.offer(message.payload, info)
+            sub.offer(payload, info)
         self._wrong_type(wrong, info)
 
     def _unqueued(self, fqn: str) -> tuple[Subscription, ...]:
@@ -99,6 +100,14 @@ class DataRouter:
                 Rejection.WRONG_TYPE,
                 f"the publisher at {info.publisher_address} sends {info.msg_type}",
             )
+
+
+def _shared(payload: Frame) -> Frame:
+    """A payload that several subscriptions may be handed: read-only, so that none writes
+    into the others' (``transport/api.py`` ``Callback``)."""
+    if isinstance(payload, (bytearray, memoryview)):
+        return memoryview(payload).toreadonly()
+    return payload
 
 
 def _text_or_empty(frame: Frame) -> str:

@@ -68,7 +68,15 @@ def gz_to_ros_outcomes(pair: Pair, gz: Any) -> dict[str, Outcome]:
     def on_bulk_path() -> Any:
         return deserialize_message(gz_to_ros_cdr(bulk, type(gz), payload), pair.ros_class)
 
-    return {"bulk": _outcome(on_bulk_path), "object": _outcome(lambda: pair.to_ros(gz))}
+    def on_bulk_path_own_frame() -> Any:  # writable, as a received frame: built in place
+        own = memoryview(bytearray(payload))
+        return deserialize_message(bytes(gz_to_ros_cdr(bulk, type(gz), own)), pair.ros_class)
+
+    return {
+        "bulk": _outcome(on_bulk_path),
+        "bulk, own frame": _outcome(on_bulk_path_own_frame),
+        "object": _outcome(lambda: pair.to_ros(gz)),
+    }
 
 
 def assert_all(outcomes: dict[str, Outcome], expected: Outcome) -> None:
