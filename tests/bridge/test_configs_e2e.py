@@ -31,6 +31,7 @@ from testing.e2e_harness import (
     RosChecker,
     parse_gz,
     read_entries,
+    status_rows,
     wait_all,
 )
 from testing.gzpeer import PeerProcess
@@ -215,7 +216,13 @@ class ConfigE2E:
         echo = run.echoes[entry.gz_topic]
         expected = _gz_sample(entry)
         wait_all({"arrived": lambda: expected in echo.messages()}, RUN_TIMEOUT)
-        assert publisher.matched(entry.ros_topic), "the bridge never subscribed in ROS"
+        assert publisher.matched(entry.ros_topic), (
+            f"the bridge never subscribed to {entry.ros_topic} in ROS within {RUN_TIMEOUT:g} s "
+            f"(bridge exit status {run.bridge.returncode}); its status rows:\n"
+            + "\n".join(status_rows(run.bridge, [entry.ros_topic]))
+            + f"\nthe ROS publisher's output:\n{publisher.proc.output()}"
+            + f"\nthe bridge's output:\n{run.bridge.output()}"
+        )
         arrived = [msg for msg in echo.messages() if msg.linear.x != -9.5]
         assert expected in arrived, (
             f"{entry.gz_topic}: expected {expected}, got {arrived[:3]}; bridge output:\n"
