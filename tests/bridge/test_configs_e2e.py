@@ -215,7 +215,15 @@ class ConfigE2E:
         publisher = RosChecker(run.group, [], [(entry.ros_topic, entry.ros_type, sample.values)])
         echo = run.echoes[entry.gz_topic]
         expected = _gz_sample(entry)
-        wait_all({"arrived": lambda: expected in echo.messages()}, RUN_TIMEOUT)
+        # Both waited for: the publisher's MATCHED line may be read after the echo's message,
+        # each process's output being collected by a thread of its own.
+        wait_all(
+            {
+                "arrived": lambda: expected in echo.messages(),
+                "matched": lambda: publisher.matched(entry.ros_topic),
+            },
+            RUN_TIMEOUT,
+        )
         assert publisher.matched(entry.ros_topic), (
             f"the bridge never subscribed to {entry.ros_topic} in ROS within {RUN_TIMEOUT:g} s "
             f"(bridge exit status {run.bridge.returncode}); its status rows:\n"
