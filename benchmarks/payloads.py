@@ -257,9 +257,11 @@ def gz_stamp(kind: Kind, msg: Any) -> int:
 
 def gz_message(kind: Kind) -> Any:
     """The Gazebo message of ``kind``; an image with the header a gz-sensors camera gives each
-    frame: its stamp, ``frame_id`` and ``seq`` (``CameraSensor::Update``, ``AddSequence``)."""
+    frame: its stamp (simulation time; a flow's publisher writes its send time there), its
+    ``frame_id`` and ``seq`` (``CameraSensor::Update``, ``AddSequence``)."""
     msg = kind.pair.to_gz(kind.make_ros())
     if kind.gz_type == "gz.msgs.Image":
+        msg.header.stamp.sec, msg.header.stamp.nsec = 12, 345_000_000
         entry = msg.header.data.add()
         entry.key = "seq"
         entry.value.append("1")
