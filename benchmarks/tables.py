@@ -111,7 +111,8 @@ def latency_goal(row: Row, within_ms: float) -> str:
 #: Why a paced flow through the bridge is slower than the ceiling.
 HOP = (
     "; the bridge path is one more hop: the Gazebo publisher's protobuf serialization, the "
-    "ZeroMQ TCP transfer of the whole frame (a kernel copy each way), and the bulk path's one "
-    "copy into the serialized ROS message; the DDS write and the subscriber are the ceiling's "
+    "ZeroMQ TCP transfer of the whole frame (a kernel copy each way), and the bulk path's "
+    "serialized ROS message (written in the received frame, or one copy where it has no room); "
+    "the DDS write and the subscriber are the ceiling's "
     '(see "transport" and "conversion" for those costs alone)'
 )

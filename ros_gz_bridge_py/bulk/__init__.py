@@ -4,9 +4,11 @@ An Image or a PointCloud2 is a few hundred bytes of metadata around megabytes of
 The object path (protobuf message -> converter -> rclpy message -> rclpy publish) copies those
 megabytes about six times and holds the GIL through the DDS write. The bulk path instead:
 
-- splits the Gazebo payload into its small fields and a view of the bulk field
+- splits the Gazebo payload into its small fields and where the bulk field lies
   (:mod:`.protowire`), converts only the small fields with the pair's own converter, lets rclpy
-  serialize that small message, and splices the bulk view into the CDR (:mod:`.cdr`): one copy;
+  serialize that small message, and writes that CDR around the bulk bytes in the received frame
+  where it has room (a Gazebo camera's frame: no copy), else splices them into a copy of the
+  CDR (:mod:`.cdr`): at most one copy;
 - publishes the CDR bytes through ``rcl_publish_serialized_message`` with the GIL released
   (:mod:`ros_gz_bridge_py.ros.serialized_publisher`), so other topics keep flowing during the
   DDS write;

@@ -2,7 +2,7 @@
 sensor_msgs.py.
 
 Image data is copied once, as ``bytes``; on the bulk path (``IMAGE_BULK``) the channel converts
-only the other fields with the ``*_meta_*`` halves and copies the data once into the output.
+only the other fields with the ``*_meta_*`` halves and copies the data at most once.
 Both paths check the sizes with the same ``*_meta_*`` code, so they reject the same messages
 with the same text. The output always has step = width * bytes per pixel and exactly
 height * step bytes of data; ``is_bigendian`` is ignored, as in the reference.

@@ -20,10 +20,11 @@ instead, so ZeroMQ buffers up to 1000 messages of every topic behind a slow one;
 holds as many, per topic.)
 
 Pairs with a bulk path (Image, PointCloud2) take it unless ``BridgeOptions.bulk_path`` is off:
-serialized messages on the ROS side, the bulk bytes copied once, and the DDS write made with
-the GIL released (see :mod:`ros_gz_bridge_py.bulk`). The other ROS->Gazebo channels take the
-serialized message too and read it with :mod:`ros_gz_bridge_py.ros.light_reader` (several
-times cheaper than rclpy's message objects) unless ``BridgeOptions.light_read`` is off.
+serialized messages on the ROS side, the bulk bytes copied at most once, and the DDS write
+made with the GIL released (see :mod:`ros_gz_bridge_py.bulk`). The other ROS->Gazebo channels
+take the serialized message too and read it with :mod:`ros_gz_bridge_py.ros.light_reader`
+(several times cheaper than rclpy's message objects) unless ``BridgeOptions.light_read`` is
+off.
 """
 
 from __future__ import annotations
