@@ -58,7 +58,7 @@ def test_a_camera_frame_is_built_in_place_with_the_joined_bytes(extra: int) -> N
 
 
 def test_a_frame_without_room_before_its_data_is_copied_and_left_alone() -> None:
-    gz = _camera_frame(16, 12, header=False)  # 14 bytes before the data; the CDR needs 48
+    gz = _camera_frame(16, 12, header=False)  # 9 bytes before the data; the CDR needs 48
     frame = bytearray(gz.SerializeToString())
     built = _converted(IMAGE, gz, memoryview(frame))
     assert isinstance(built, bytes)
