@@ -262,7 +262,7 @@ def test_gazebo_to_ros_camera_frame_from_the_real_peer(
     wait_until(lambda: ros_side.count_publishers(topic) >= 1, WAIT, f"a publisher on {topic}")
     inbox, _ = ros_side.subscribe(Image, topic)
     peer = start_peer(
-        "pub", topic, "ignition.msgs.Image", "50", "10", text, "--bytes", str(size),
+        "pub", topic, "ignition.msgs.Image", "50", "50", text, "--bytes", str(size),
         "--wire-type", GZ_IMAGE, "--wait", str(WAIT),
     )  # fmt: skip
     started.append(peer)
@@ -270,7 +270,7 @@ def test_gazebo_to_ros_camera_frame_from_the_real_peer(
     def frames() -> list[Any]:
         return [msg for msg, _ in inbox.items() if msg.width == width]
 
-    wait_until(lambda: len(frames()) >= 2, WAIT, "camera frames in rclpy")
+    wait_until(lambda: bool(frames()), WAIT, "a camera frame in rclpy")
     for msg in frames():
         assert (msg.width, msg.height, msg.step, msg.encoding) == (width, height, width * 3, "rgb8")
         assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (812, 4_000_000)
