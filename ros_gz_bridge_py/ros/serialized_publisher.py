@@ -60,11 +60,14 @@ def _rcl() -> _Rcl | None:
     return _Rcl(publish, reset_error)
 
 
-def _address(cdr: bytes | memoryview) -> bytes | int:
-    """What ``_SerializedMessage.buffer`` takes for ``cdr``: bytes as they are, a writable
-    view's address (its memory lives as long as the view, which ``publish``'s caller holds)."""
+def _buffer(cdr: bytes | memoryview) -> bytes | int:
+    """What ``_SerializedMessage.buffer`` takes for ``cdr``: bytes as they are, a read-only
+    view as a copy, a writable view's address (its memory lives as long as the view, which
+    ``publish``'s caller holds)."""
     if isinstance(cdr, bytes):
         return cdr
+    if cdr.readonly:
+        return bytes(cdr)
     return ctypes.addressof(ctypes.c_char.from_buffer(cdr))
 
 
@@ -84,12 +87,10 @@ class SerializedPublisher:
     def publish(self, cdr: bytes | memoryview) -> None:
         """Publish one serialized message; ``cdr`` is not copied before rcl takes it (a
         read-only view is, and every view on the rclpy way: rclpy publishes bytes only)."""
-        if self._rcl is None or (isinstance(cdr, memoryview) and cdr.readonly):
-            cdr = cdr if isinstance(cdr, bytes) else bytes(cdr)
         if self._rcl is None:
-            self._publisher.publish(cdr)
+            self._publisher.publish(cdr if isinstance(cdr, bytes) else bytes(cdr))
             return
-        message = _SerializedMessage(_address(cdr), len(cdr), len(cdr))
+        message = _SerializedMessage(_buffer(cdr), len(cdr), len(cdr))
         with self._handle:
             ret = self._rcl.publish_serialized(self._pointer, ctypes.byref(message), None)
         if ret != _RCL_RET_OK:
