@@ -277,7 +277,7 @@ class GzPayloads:
 
     def __init__(self, kind: Kind) -> None:
         self.kind = kind
-        self._message = kind.pair.to_gz(kind.make_ros())
+        self._message = gz_message(kind)
         self._body = b""
         if kind.has_header:
             self._message.ClearField("header")
