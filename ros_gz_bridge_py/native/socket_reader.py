@@ -73,8 +73,14 @@ class SocketReader(PumpMember):
             self.pump.share([])
 
     def _reshare(self, peers: list[ChannelPump]) -> None:
+        """Off the loop, the peers changed, back on it; peers refused leave it as it was."""
         self._loop.detach(self)
-        self.pump.share([peer.pump for peer in peers])
+        try:
+            self.pump.share([peer.pump for peer in peers])
+        except BaseException:
+            if not self._closed:
+                self._join()
+            raise
         self._peers = peers
         self._deadlines = {peer: self._deadlines.get(peer) for peer in peers}
         if not self._closed:

@@ -284,11 +284,12 @@ class NativeReader(_Driver):
         self.topic_frame = topic.fqn.encode()
         super().__init__(context, topic, **driver)
         self._verdicts = Verdicts(topic)
-        self._shared = shared
+        # A topic another channel reads through the shared socket gets a socket of its own.
+        self._shared = shared if shared is not None and shared.claim(self.topic_frame) else None
         self._owner: SocketOwner | None = None
-        if shared is not None:
-            native.watch(watch_size(shared.settings.shared_rcvhwm, topic.max_bytes))
-            shared.add(self, native)
+        if self._shared is not None:
+            native.watch(watch_size(self._shared.settings.shared_rcvhwm, topic.max_bytes))
+            self._shared.add(self, native)
         else:
             self._attach(self._own_socket())
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import collections
 import logging
+import threading
 import time
 from collections.abc import Callable
 from typing import Any, Protocol
@@ -84,6 +85,9 @@ class SharedSub:
             what="the native channels' shared SUB socket",
         )
         self._topics: dict[bytes, TopicReader] = {}  # by topic frame
+        #: The topics the socket reads for a channel, claimed from any thread (``claim``).
+        self._claimed: set[bytes] = set()
+        self._claims = threading.Lock()
         self._users: dict[str, set[TopicReader]] = {}  # by publisher address
         self._posted: collections.deque[Callable[[], object]] = collections.deque()
         self._closed = False
@@ -93,13 +97,29 @@ class SharedSub:
 
     # --- from any thread --------------------------------------------------------------------
 
+    def claim(self, topic_frame: bytes) -> bool:
+        """Whether the socket may read the topic for a new channel: each topic for one
+        channel (its messages go to one pump), so a second channel of a topic (one Gazebo
+        topic to two ROS topics or types) reads a socket of its own."""
+        with self._claims:
+            if topic_frame in self._claimed:
+                return False
+            self._claimed.add(topic_frame)
+            return True
+
     def add(self, reader: TopicReader, native: NativeLoop) -> None:
-        """The socket reads ``reader``'s topic from now on, for its channel ``native``."""
-        native.attach_shared(self.reader, reader)
+        """The socket reads ``reader``'s topic (claimed) from now on, for its channel
+        ``native``."""
+        try:
+            native.attach_shared(self.reader, reader)
+        except BaseException:
+            self._release(reader)
+            raise
         self._post(lambda: self._subscribe(reader))
 
     def remove(self, reader: TopicReader) -> None:
         """The topic's subscription and its publishers go (its channel already left)."""
+        self._release(reader)
         self._post(lambda: self._unsubscribe(reader))
 
     def connect(self, address: str, reader: TopicReader) -> None:
@@ -149,6 +169,10 @@ class SharedSub:
         return [address for address, users in self._users.items() if reader in users]
 
     # --- internals --------------------------------------------------------------------------
+
+    def _release(self, reader: TopicReader) -> None:
+        with self._claims:
+            self._claimed.discard(reader.topic_frame)
 
     def _post(self, command: Callable[[], object]) -> None:
         self._posted.append(command)

@@ -178,3 +178,33 @@ def test_a_topic_that_moved_meanwhile_gets_its_addresses_itself(context: Any) ->
     assert odom.forwarded == [("connect", "tcp://127.0.0.1:5"), ("leave", "tcp://127.0.0.1:6")]
     assert shared.connections.connected == set()
     shared.close()
+
+
+def test_a_topic_is_claimed_once_until_its_channel_leaves(context: Any) -> None:
+    """A second channel of one Gazebo topic (a fan-out to two ROS topics) is told to read a
+    socket of its own; once the first leaves, the topic may be claimed again."""
+    shared, loop = shared_sub(context)
+    first, second = Reader("@/p@/pose"), Reader("@/p@/pose")
+    assert shared.claim(first.topic_frame)
+    assert not shared.claim(second.topic_frame)
+    assert shared.claim(b"@/p@/odom")
+    shared.add(first, loop)  # type: ignore[arg-type]
+    shared.remove(first)
+    assert shared.claim(second.topic_frame)
+    shared.close()
+
+
+def test_a_channel_the_loop_refuses_leaves_its_claim(context: Any) -> None:
+    shared, loop = shared_sub(context)
+    reader = Reader("@/p@/pose")
+
+    def refuse(_reader: Any, _host: NativeHost) -> None:
+        msg = "refused"
+        raise ValueError(msg)
+
+    loop.attach_shared = refuse  # type: ignore[method-assign,assignment]
+    assert shared.claim(reader.topic_frame)
+    with pytest.raises(ValueError, match="refused"):
+        shared.add(reader, loop)  # type: ignore[arg-type]
+    assert shared.claim(reader.topic_frame)
+    shared.close()
