@@ -20,10 +20,13 @@ also cannot run coroutine callbacks).
 
 from __future__ import annotations
 
+import collections
 import threading
+import time
 from typing import Any
 
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.task import Future
 
 from ros_gz_bridge_py.config import ServiceBridgeSpec
 from ros_gz_bridge_py.config.names import renamed
@@ -43,6 +46,10 @@ DEFAULT_TIMEOUT = 5.0
 REQUEST_DEPTH = 1000
 #: Calls that may wait for Gazebo at once; one more is answered ``success=false`` at once.
 MAX_WAITING = 1000
+#: Seconds closing waits for the waiting calls' answers (``success=false``) to go out.
+CLOSE_PATIENCE = 1.0
+#: What a failed call's reason is counted as (``ServiceBridge.failures_by_reason``).
+NOT_CONVERTED = "not converted"
 
 
 class HeldBytes:
@@ -133,7 +140,14 @@ class ServiceBridge:
         self._logger = quick_logger(host.node.get_logger())
         self.calls = 0
         self.failures = 0
+        #: Failed calls by what went wrong, and the last one's reason in full.
+        self.failures_by_reason: collections.Counter[str] = collections.Counter()
+        self.last_failure = ""
         self.waiting = 0
+        #: The replies the waiting calls await; closing answers them (``close``).
+        self._awaited: set[Future] = set()
+        self._settling = threading.Lock()
+        self._closing = False
         #: The bytes the waiting calls hold, within ``max_queued_bytes``.
         self.held = HeldBytes(max_queued_bytes)
         #: Calls answered at once because the waiting ones held the budget.
@@ -186,12 +200,15 @@ class ServiceBridge:
     async def _on_request(self, request: Any, _response: Any) -> Any:
         """One call, answered once: never raises (an exception would leave it unanswered)."""
         self.calls += 1
+        if self._closing:
+            return self._fail("the bridge is shutting down", "shutting down")
         if self.waiting >= MAX_WAITING:
-            return self._fail(f"{self.waiting} calls already wait for Gazebo; try again later")
+            why = f"{self.waiting} calls already wait for Gazebo; try again later"
+            return self._fail(why, "too many waiting")
         try:
             payload = self.pair.request_to_gz(request).SerializeToString()
         except Exception as err:
-            return self._fail(f"request not converted: {err}")
+            return self._fail(f"request not converted: {err}", NOT_CONVERTED)
         if not self.held.admit(len(payload)):
             return self._refuse(len(payload))
         self.waiting += 1
@@ -199,14 +216,14 @@ class ServiceBridge:
         try:
             return await self._forward(payload, held)
         except Exception as err:
-            return self._fail(f"request failed: {err}")
+            return self._fail(f"request failed: {err}", "request failed")
         finally:
             self.waiting -= 1
             self.held.release(sum(held))
 
     def _refuse(self, size: int) -> Any:
         """A call over the byte budget: answered at once, counted, told once per period."""
-        self.failures += 1
+        self._count_failure(f"a request of {size} bytes over max_queued_bytes", "over budget")
         self.refused_over_bytes += 1
         if self._warnings.ready("refused"):
             self._logger.warning(
@@ -223,33 +240,48 @@ class ServiceBridge:
         dropped: list[int] = []
 
         def on_reply(ok: bool | None, reply: bytes) -> None:
-            if future.done():
-                return
             if ok and not self.held.keep(len(reply)):
                 dropped.append(len(reply))  # not kept: only its size waits for the executor
-                future.set_result((None, b""))
-                return
-            held.append(len(reply))
-            future.set_result((ok, reply))
+                ok, reply = None, b""
+            elif ok is not None:
+                held.append(len(reply))
+            self._settle(future, (ok, reply))
 
-        self._gz_node.request_async(
-            self.spec.service, payload, self.gz_req_type, self.gz_rep_type, self.timeout, on_reply
-        )
-        success, reply = await future
+        with self._settling:
+            self._awaited.add(future)
+        try:
+            self._gz_node.request_async(
+                self.spec.service, payload, self.gz_req_type, self.gz_rep_type, self.timeout,
+                on_reply,
+            )  # fmt: skip
+            success, reply = await future
+        finally:
+            with self._settling:
+                self._awaited.discard(future)
         if dropped:
             return self._fail(
                 f"the reply of {dropped[0]} bytes is not kept: with the {self.held.calls} "
                 f"waiting calls' {self.held.held} bytes it is over {self.held.budget} bytes "
-                "(parameter max_queued_bytes)"
+                "(parameter max_queued_bytes)",
+                "over budget",
             )
+        if self._closing and success is None:
+            return self._fail("the bridge is shutting down", "shutting down")
         if success is None:
-            return self._fail(f"no reply from Gazebo within {self.timeout:g} s")
+            return self._fail(f"no reply from Gazebo within {self.timeout:g} s", "no reply")
         if not success:
-            return self._fail("Gazebo reported failure")
+            return self._fail("Gazebo reported failure", "Gazebo failure")
         try:
             return self.pair.reply_to_ros(self._reply_class.FromString(reply))
         except Exception as err:
-            return self._fail(f"reply not converted: {err}")
+            return self._fail(f"reply not converted: {err}", NOT_CONVERTED)
+
+    def _settle(self, future: Future, outcome: tuple[bool | None, bytes]) -> None:
+        """The call's outcome, once (a reply, its timeout, or closing: whichever is first)."""
+        with self._settling:
+            if future.done():
+                return
+            future.set_result(outcome)
 
     def answered_late(self, waited: float) -> None:
         """A held response went out once its client was discovered (late_responses.py)."""
@@ -270,14 +302,29 @@ class ServiceBridge:
                 f"{self.unanswered} given up so far"
             )
 
-    def _fail(self, why: str) -> Any:
+    def _fail(self, why: str, reason: str) -> Any:
         """A call answered success=false: counted, told once per period."""
-        self.failures += 1
+        self._count_failure(why, reason)
         if self._warnings.ready("failed"):
             self._logger.warning(f"{self.describe()}: {why}; {self.failures} failed so far")
         return self.pair.failure_to_ros()
 
+    def _count_failure(self, why: str, reason: str) -> None:
+        self.failures += 1
+        self.failures_by_reason[reason] += 1
+        self.last_failure = why
+
     def close(self) -> None:
+        """The waiting calls answered ``success=false`` (their clients are not left without
+        an answer), then the service goes."""
+        self._closing = True
+        with self._settling:
+            awaited = [future for future in self._awaited if not future.done()]
+        for future in awaited:
+            self._settle(future, (None, b""))
+        deadline = time.monotonic() + CLOSE_PATIENCE
+        while self.waiting and time.monotonic() < deadline:
+            time.sleep(0.01)
         if self._service is not None:
             self._ros_node.destroy_service(self._service)
             self._service = None

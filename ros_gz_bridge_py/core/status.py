@@ -31,7 +31,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from types import FrameType
 from typing import Any, TextIO
@@ -42,7 +42,7 @@ from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.channel import Channel, ChannelState
 from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
-from ros_gz_bridge_py.core.services import ServiceBridge
+from ros_gz_bridge_py.core.services import NOT_CONVERTED, ServiceBridge
 from ros_gz_bridge_py.ros.runtime import (
     batch_dds_event_threads,
     make_executor,
@@ -226,9 +226,7 @@ def channel_status(channel: Channel) -> ChannelStatus:
         why="\n".join(finding.text for finding in channel.findings),
         fault=any(finding.fault for finding in channel.findings),
         rate_limited=stats.rate_limited,
-        errors_by_reason=tuple(
-            sorted(dict(stats.errors_by_reason).items(), key=lambda item: (-item[1], item[0]))
-        ),
+        errors_by_reason=_largest_first(dict(stats.errors_by_reason)),
         conversion_errors=stats.conversion_errors,
         native=channel.native,
         send_queue=channel.send_queue if isinstance(channel, RosToGzChannel) else 0,
@@ -251,8 +249,14 @@ def service_status(service: ServiceBridge) -> ChannelStatus:
         dropped=service.unanswered,
         rate=0.0,
         new_problems=0,
-        conversion_errors=service.failures,
+        last_error=service.last_failure,
+        errors_by_reason=_largest_first(service.failures_by_reason),
+        conversion_errors=service.failures_by_reason[NOT_CONVERTED],
     )
+
+
+def _largest_first(counts: Mapping[str, int]) -> tuple[tuple[str, int], ...]:
+    return tuple(sorted(counts.items(), key=lambda item: (-item[1], item[0])))
 
 
 def diagnostic_array(statuses: list[ChannelStatus], hardware_id: str, stamp: Any) -> Any:

@@ -16,6 +16,7 @@ import uuid
 
 import pytest
 from rcl_interfaces.srv import ListParameters
+from ros_gz_interfaces.srv import ControlWorld
 
 from ros_gz_bridge_py.transport import GzNode
 from ros_gz_bridge_py.transport.zmq.discovery import SILENCE_INTERVAL
@@ -97,6 +98,39 @@ def test_signal_stops_the_bridge_cleanly(
     wait_until(
         lambda: not gz_advertised(gz_node, topic), SILENCE_INTERVAL - 1.5, f"{topic} unadvertised"
     )
+
+
+def test_a_call_waiting_for_gazebo_is_answered_when_the_bridge_stops(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    """Ctrl-C while a service call waits for a Gazebo that never answers: the caller gets
+    success=false at once, not silence, and the bridge exits cleanly (it printed a traceback
+    from the reply callback that ran after its executor was gone)."""
+    service = unique_name("signal_waiting")
+    bridge = start_bridge(
+        f"{service}@ros_gz_interfaces/srv/ControlWorld",
+        ros_args=["-p", "service_timeout:=30.0"],
+        creating=1,
+    )
+    started.append(bridge)
+    client = ros_side.run(lambda: ros_side.node.create_client(ControlWorld, service))
+    try:
+        wait_until(client.service_is_ready, WAIT, f"the service {service}")
+        future = ros_side.run(lambda: client.call_async(ControlWorld.Request()))
+        waiting = re.compile(rf"^\w+\s+service\s+{re.escape(service)}\s+\S+\s+\S+\s+1\s", re.M)
+        deadline = time.monotonic() + WAIT
+        while not waiting.search(bridge.output()):  # the status table counts the call
+            assert time.monotonic() < deadline, bridge.output()
+            bridge.send_signal(signal.SIGUSR1)
+            time.sleep(0.2)
+        bridge.send_signal(signal.SIGINT)
+        assert bridge.wait(WAIT) == 0, bridge.output()
+        wait_until(future.done, WAIT, "the waiting call's answer")
+        assert future.result().success is False
+    finally:
+        ros_side.destroy(client)
+    assert "Traceback" not in bridge.output()
+    assert "shutting down" in bridge.output()
 
 
 @pytest.mark.parametrize("executable", ["parameter_bridge", "image_bridge"])

@@ -129,11 +129,50 @@ def test_a_failing_provider_gives_success_false(rig: Rig, world: RosWorld, reply
 
 
 def test_no_provider_gives_success_false_after_the_timeout(rig: Rig, world: RosWorld) -> None:
+    """Counted as what it is (no reply), not as a conversion error, and said in the status."""
     service = unique("absent")
     rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
     assert call(world, ControlWorld, service, control_request()).success is False
     bridge = rig.bridge.services[0]
     assert (bridge.calls, bridge.failures) == (1, 1)
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert (status.errors, status.conversion_errors) == (1, 0)
+    assert status.errors_by_reason == (("no reply", 1),)
+    assert status.last_error == f"no reply from Gazebo within {SERVICE_TIMEOUT:g} s"
+
+
+def test_closing_answers_the_waiting_calls(make_rig: Callable[..., Rig], world: RosWorld) -> None:
+    """A call waiting for Gazebo when the bridge closes (Ctrl-C) is answered success=false at
+    once, not left to its client's patience; the Gazebo node's closing then ends the call as a
+    timeout, after the bridge's executor is gone, and nothing raises."""
+    rig = make_rig(options(service_timeout=30.0))
+    service = unique("closing")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    bridge = rig.bridge.services[0]
+    client = world.run(lambda: world.node.create_client(ControlWorld, service))
+    wait_until(client.service_is_ready, f"the service {service}")
+    future = world.run(lambda: client.call_async(control_request()))
+    wait_until(lambda: bridge.waiting == 1, "the call waiting for Gazebo")
+    started = time.monotonic()
+    world.run(rig.bridge.close)
+    wait_until(future.done, "the waiting call's answer")
+    assert time.monotonic() - started < 5.0
+    assert future.result().success is False
+    assert bridge.failures_by_reason == {"shutting down": 1}
+    rig.gz.close()  # ends the call Gazebo never answered
+    assert rig.gz.stats.callback_errors == 0
+    world.destroy(client)
+
+
+def test_a_request_not_converted_is_a_conversion_error(rig: Rig, world: RosWorld) -> None:
+    service = unique("not_converted")
+    rig.add(ServiceBridgeSpec(service, "ros_gz_interfaces/srv/SetEntityPose"))
+    request = SetEntityPose.Request()
+    request.entity.id = 2**32  # the gz Pose id is a uint32
+    assert call(world, SetEntityPose, service, request).success is False
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert (status.errors, status.conversion_errors) == (1, 1)
+    assert status.last_error.startswith("request not converted: ")
 
 
 def test_a_request_that_cannot_be_converted_never_reaches_gazebo(rig: Rig, world: RosWorld) -> None:
