@@ -146,6 +146,7 @@ class Bridge:
             ConfigError: the spec cannot be bridged (unsupported type pair, bad name, ...);
                 nothing of it is left open.
         """
+        spec = _checked(spec)
         with self._lock:
             if self._closed:
                 msg = "the bridge is closed"
@@ -293,6 +294,31 @@ class Bridge:
         for line in service.creation_lines():
             self._logger.info(line)
         return BridgeHandle(spec, service=service)
+
+
+def _checked(spec: object) -> BridgeSpec:
+    """``spec`` as the bridge takes it: a spec of the config layer, its direction a
+    :class:`Direction` (the YAML spelling, ``"GZ_TO_ROS"``, is taken too).
+
+    Raises:
+        ConfigError: not a spec, or a direction that is none.
+    """
+    if isinstance(spec, ServiceBridgeSpec):
+        return spec
+    if not isinstance(spec, TopicBridgeSpec):
+        msg = (
+            f"Bridge.add takes a TopicBridgeSpec or a ServiceBridgeSpec, not "
+            f"{type(spec).__name__}; parse_cli_args and parse_yaml make them from text"
+        )
+        raise ConfigError(msg)
+    if isinstance(spec.direction, Direction):
+        return spec
+    try:
+        return dataclasses.replace(spec, direction=Direction(spec.direction))
+    except ValueError:
+        names = ", ".join(direction.value for direction in Direction)
+        msg = f"direction {spec.direction!r} is none of {names}"
+        raise ConfigError(msg, spec.source or None) from None
 
 
 def _failed_text(spec: TopicBridgeSpec, why: str) -> str:

@@ -7,6 +7,7 @@ processes (``native=Spelling.IGNITION``: a Fortress one, which announces and tak
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections import Counter
 from typing import Any
@@ -364,6 +365,18 @@ def test_a_removed_bridge_leaves_nothing_open(rig: Rig, world: RosWorld) -> None
     rig.remove(handle)  # twice is harmless
 
 
+def test_a_direction_in_its_yaml_spelling_is_taken(rig: Rig) -> None:
+    """An embedding user's ``TopicBridgeSpec(..., "GZ_TO_ROS")`` bridges, as the YAML does
+    (it made a handle with no channel, silently)."""
+    topic = unique("spelled")
+    spec = string_spec(topic, Direction.GZ_TO_ROS)
+    spelled = dataclasses.replace(spec, direction="GZ_TO_ROS")  # type: ignore[arg-type]
+    handle = rig.add(spelled)
+    assert [type(channel) for channel in handle.channels] == [type(gz_to_ros(handle))]
+    assert isinstance(handle.spec, TopicBridgeSpec)
+    assert handle.spec.direction is Direction.GZ_TO_ROS
+
+
 def test_an_entry_that_cannot_be_bridged_is_refused_whole(rig: Rig) -> None:
     topic = unique("refused")
     unpaired = TopicBridgeSpec(topic, topic, "std_msgs/msg/String", "gz.msgs.Twist")
@@ -373,6 +386,12 @@ def test_an_entry_that_cannot_be_bridged_is_refused_whole(rig: Rig) -> None:
                                   qos_profile="NOT_A_PROFILE")  # fmt: skip
     with pytest.raises(ConfigError, match="unknown QoS profile"):
         rig.add(bad_profile)
+    spec = string_spec(topic, Direction.GZ_TO_ROS)
+    no_direction = dataclasses.replace(spec, direction="BOTH")  # type: ignore[arg-type]
+    with pytest.raises(ConfigError, match="direction 'BOTH' is none of BIDIRECTIONAL, "):
+        rig.add(no_direction)
+    with pytest.raises(ConfigError, match="not str; parse_cli_args and parse_yaml"):
+        rig.add(f"{topic}@std_msgs/msg/String@{STRING}")  # type: ignore[arg-type]
     assert rig.bridge.handles == []
     assert rig.gazebo().topic_info(topic) == []
     rig.world.run(rig.bridge.close)
