@@ -89,9 +89,16 @@ def ros_endpoints(
             (our_qos, info.qos_profile) if to_ros else (info.qos_profile, our_qos)
         )
         compatibility, reason = qos_check_compatible(publisher, subscription)
-        problem = reason.strip() if compatibility == QoSCompatibility.ERROR else ""
+        problem = qos_errors(reason) if compatibility == QoSCompatibility.ERROR else ""
         found.append(RosEndpoint(node, info.topic_type, problem, describe_qos(info.qos_profile)))
     return found
+
+
+def qos_errors(reason: str) -> str:
+    """rcl's ``"ERROR: a;WARNING: b;ERROR: c;"`` as ``"a, c"``: the incompatibilities only,
+    without rcl's markup, for a sentence of ours."""
+    errors = [part.strip() for part in reason.split(";") if part.strip().startswith("ERROR:")]
+    return ", ".join(error.removeprefix("ERROR:").strip() for error in errors) or reason.strip()
 
 
 def as_the_graph_shows(profile: QoSProfile) -> QoSProfile:

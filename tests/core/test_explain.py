@@ -9,7 +9,6 @@ side is the graph of this process's contexts.
 
 from __future__ import annotations
 
-import re
 import uuid
 from collections.abc import Iterator
 from typing import Any
@@ -30,6 +29,7 @@ from ros_gz_bridge_py.core.explain import (
     ROS_ENDPOINTS_REFRESH,
     WARM_UP,
     Explainer,
+    qos_errors,
 )
 from ros_gz_bridge_py.core.status import OK, WARN, StatusTracker
 from ros_gz_bridge_py.msgs import message_class
@@ -300,13 +300,24 @@ def test_a_ros_reader_with_incompatible_qos_is_explained(rig: Rig, world: RosWor
     world.subscribe(String, topic, QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
     wait_until(lambda: len(world.subscribers(topic)) == 1, "the reliable reader in the graph")
     Judge(rig).evaluate()
-    (text,) = texts(channel)
-    assert re.fullmatch(
-        rf"the ROS subscriber /{world.node.get_name()} of {topic} cannot match the bridge's "
-        rf"QoS: .*[Rr]eliab.*; set the entry's qos_profile \(or qos_overrides\.{topic}\.\*\) "
-        "to what it uses",
-        text,
-    ), text
+    assert texts(channel) == [
+        f"the ROS subscriber /{world.node.get_name()} of {topic} cannot match the bridge's "
+        "QoS: Best effort publisher and reliable subscription; set the entry's qos_profile (or "
+        f"qos_overrides.{topic}.*) to what it uses"
+    ]
+
+
+def test_rcl_qos_reasons_become_a_clause_of_the_explanation() -> None:
+    """rcl's markup ("ERROR: ...;", warnings beside) is not passed on as it is."""
+    reason = (
+        "ERROR: Best effort publisher and reliable subscription;"
+        "WARNING: Publisher deadline is default;ERROR: Volatile publisher and transient local "
+        "subscription;"
+    )
+    assert qos_errors(reason) == (
+        "Best effort publisher and reliable subscription, "
+        "Volatile publisher and transient local subscription"
+    )
 
 
 def _read_by_another_type(
