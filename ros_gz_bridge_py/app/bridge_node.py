@@ -19,6 +19,7 @@ import sys
 from collections.abc import Sequence
 
 from ros_gz_bridge_py.app import parameter_bridge
+from ros_gz_bridge_py.app.settings import ros_arguments_problem
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 PROGRAM = "bridge_node"
@@ -59,6 +60,10 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
     if any(arg in ("-h", "--help") for arg in others):
         print(USAGE)
         return 0
+    problem = ros_arguments_problem(PROGRAM, [argv[0], *ros])
+    if problem:
+        print(problem, file=sys.stderr)
+        return parameter_bridge.USAGE_EXIT
     if others:
         print(
             f"{PROGRAM}: not bridged: {' '.join(others)} ({PROGRAM} reads only parameters: list "

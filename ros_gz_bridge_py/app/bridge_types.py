@@ -1,10 +1,11 @@
 """``bridge_types``: list the supported ROS <=> Gazebo type pairs, like the C++ tool.
 
-Options and their texts and exit codes follow docs/behaviour.md §1.2; the option
-comes first and its argument second. Differences: each pair is listed once (with its
-``gz.msgs.X`` name; ``ignition.msgs.X`` is accepted wherever a Gazebo type is read), types are
-listed once each and sorted, services get their own heading, ``--json`` prints everything
-as one JSON document, and converter modules that could not load are named on stderr.
+Options and their texts and exit codes follow docs/behaviour.md §1.2: one option per run, its
+argument second. Differences: each pair is listed once (with its ``gz.msgs.X`` name;
+``ignition.msgs.X`` is accepted wherever a Gazebo type is read), types are listed once each
+and sorted, services get their own heading, ``--json`` prints everything as one JSON document,
+converter modules that could not load are named on stderr, and arguments after the option
+are refused with one line (exit 1) where C++ ignores them.
 """
 
 from __future__ import annotations
@@ -86,6 +87,16 @@ def _report_unavailable(registry: Registry, err: TextIO) -> None:
         print(f"bridge_types: converters '{name}' could not load: {reason}", file=err)
 
 
+def _extra_arguments_problem(used: Sequence[str], extra: Sequence[str]) -> str:
+    """The line for arguments after the one option (and its TYPE), which the tool used to
+    ignore without a word (``--print-pairs --json`` printed text)."""
+    extras = " ".join(extra)
+    return (
+        f"bridge_types: unexpected {extras!r} after {' '.join(used)!r}: give one option per run "
+        "(--json alone prints every pair and service as JSON; bridge_types -h lists the options)"
+    )
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the tool on ``argv`` (without the program name); return the exit code."""
     args = list(sys.argv[1:] if argv is None else argv)
@@ -103,6 +114,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     listings = ("--print-pairs", "--print-ros", "--print-gz", "--json")
     if option not in listings and option not in lookups:
         print(f"bridge_types: unknown option {option!r}\n{USAGE}", end="", file=err)
+        return 1
+    taken = 2 if option in lookups else 1
+    if len(args) > taken:
+        print(_extra_arguments_problem(args[:taken], args[taken:]), file=err)
         return 1
 
     registry = build_registry()

@@ -47,6 +47,7 @@ from ros_gz_bridge_py.app.settings import (
     checked_max_rate,
     declare_image_bridge_parameters,
     read_switches,
+    ros_arguments_problem,
 )
 from ros_gz_bridge_py.app.startup import finish_start_up
 from ros_gz_bridge_py.config import (
@@ -63,6 +64,7 @@ from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
+PROGRAM = "image_bridge"
 NODE_NAME = "ros_gz_image"
 #: Exit status for bad arguments, as ros_gz_image (``return -1``).
 USAGE_EXIT = 255
@@ -178,10 +180,14 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
     if len(argv) < 2:
         print(USAGE, end="", file=sys.stderr)
         return USAGE_EXIT
+    problem = ros_arguments_problem(PROGRAM, [argv[0], *ros_args])
+    if problem:
+        print(problem, file=sys.stderr)
+        return USAGE_EXIT
     try:
         topics = parse_topic_args(positional)
     except UsageError as err:
-        print(f"image_bridge: {err}\n\n{USAGE}", end="", file=sys.stderr)
+        print(f"{PROGRAM}: {err}\n\n{USAGE}", end="", file=sys.stderr)
         return USAGE_EXIT
 
     if stop is not None and stop.requested:

@@ -35,6 +35,7 @@ from ros_gz_bridge_py.app.settings import (
     checked_max_rate,
     declare_parameter_bridge_parameters,
     read_switches,
+    ros_arguments_problem,
 )
 from ros_gz_bridge_py.app.sources import (
     collect_sources,
@@ -69,6 +70,7 @@ from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, create_gz_node
 from ros_gz_bridge_py.transport.settings import DEFAULT_HWM, planned_rcvhwm
 
+PROGRAM = "parameter_bridge"
 NODE_NAME = "ros_gz_bridge"
 #: ``parameter_bridge --check [SECONDS]``: report on the entries instead of bridging them.
 CHECK_OPTION = "--check"
@@ -81,6 +83,10 @@ USAGE_EXIT = 255
 def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> int:
     argv = list(sys.argv if argv is None else argv)
     args = argv[1:]
+    problem = ros_arguments_problem(PROGRAM, argv)
+    if problem:
+        print(problem, file=sys.stderr)
+        return USAGE_EXIT
     positional = remove_ros_args(argv)[1:]
     if any(arg in ("-h", "--help") for arg in positional):
         print(USAGE)
@@ -97,7 +103,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         parse_cli_args([arg for arg in positional if not templates.names_in([arg])])
     except ConfigError as err:
         print(USAGE)
-        print(f"parameter_bridge: {err}", file=sys.stderr)
+        print(f"{PROGRAM}: {err}", file=sys.stderr)
         return USAGE_EXIT
 
     if stop is not None and stop.requested:
@@ -126,7 +132,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 cli = parse_cli_args(positional, values)
             except ConfigError as err:  # a placeholder of an argument without a value
                 print(USAGE)
-                print(f"parameter_bridge: {err}", file=sys.stderr)
+                print(f"{PROGRAM}: {err}", file=sys.stderr)
                 return USAGE_EXIT
             if stop.requested:
                 return 0

@@ -6,6 +6,7 @@
 (:class:`SharedParameters`) with one name, type and default. The executables then hand the
 library :class:`~ros_gz_bridge_py.core.bridge.Bridge` its :class:`BridgeOptions` and the runtime
 helpers plain arguments (docs/configuration.md: "Node parameters", "Speed settings and switches").
+Their ROS arguments are checked here too, before rclpy reads them (:func:`ros_arguments_problem`).
 
 One rule per kind of value: a switch is off when set to ``off``, ``0``, ``false`` or ``no``; a
 choice compares its value case-blind; an integer that is not one is reported (variable, value,
@@ -15,21 +16,25 @@ fallback) and the default is used.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
-from collections.abc import Collection, Mapping
+import re
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.parameter import Parameter
+from rclpy.utilities import remove_ros_args
 
 from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV
 from ros_gz_bridge_py.config.model import as_rate
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE, BridgeOptions
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.errors import ConfigError
-from ros_gz_bridge_py.transport import NodeOptions
+from ros_gz_bridge_py.transport import BACKENDS, NodeOptions
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 if TYPE_CHECKING:
@@ -58,6 +63,8 @@ NATIVE_ENV = "ROS_GZ_BRIDGE_NATIVE"
 DDS_EVENT_BATCH_ENV = "ROS_GZ_BRIDGE_DDS_EVENT_BATCH"
 #: A switch: off leaves ``parameter_bridge``'s threads on every CPU (no :mod:`~.one_cpu`).
 ONE_CPU_ENV = "ROS_GZ_BRIDGE_ONE_CPU"
+#: gz-transport's choice of implementation (``zeromq`` when unset), read by the transport.
+TRANSPORT_IMPLEMENTATION_ENV = "GZ_TRANSPORT_IMPLEMENTATION"
 
 
 #: The switches that are :class:`BridgeOptions` of the same names (how messages travel).
@@ -152,7 +159,7 @@ class SharedParameters:
 
     config_file: str = ""
     lazy: bool = False
-    #: Milliseconds between two lazy re-checks.
+    #: Milliseconds between two lazy re-checks, at least 1.
     subscription_heartbeat: int = 1000
     override_timestamps_with_wall_time: bool = False
     override_frame_id: str = ""
@@ -190,7 +197,7 @@ class SharedParameters:
         by :func:`~ros_gz_bridge_py.config.gz_version.check_gz_version`."""
         return BridgeOptions(
             lazy=self.lazy,
-            heartbeat=max(self.subscription_heartbeat, 1) / 1000.0,
+            heartbeat=self.subscription_heartbeat / 1000.0,
             override_timestamps_with_wall_time=self.override_timestamps_with_wall_time,
             override_frame_id=self.override_frame_id,
             service_timeout=service_timeout,
@@ -206,7 +213,8 @@ class ParameterBridgeParameters:
     """``parameter_bridge``'s node parameters."""
 
     shared: SharedParameters
-    #: Ours: seconds a ROS service call waits for Gazebo before answering success=false.
+    #: Ours: seconds a ROS service call waits for Gazebo before answering success=false;
+    #: declared with any type (``10`` or ``10.0``) and checked by :func:`checked_service_timeout`.
     service_timeout: float = DEFAULT_TIMEOUT
     #: The ``bridges.<name>.*`` groups to read (a string array parameter with no default).
     bridge_names: tuple[str, ...] = ()
@@ -285,6 +293,8 @@ def declare_shared_parameters(node: Any, env: Mapping[str, str] | None = None) -
     env = os.environ if env is None else env
     defaults = SharedParameters(gz_version=env.get(GZ_VERSION_ENV, ""))
     declared = _declare_fields(node, defaults, ("max_rate",))
+    check_heartbeat(declared.subscription_heartbeat)
+    check_transport_implementation(declared.gz_transport_implementation, env)
     any_type = ParameterDescriptor(dynamic_typing=True)
     max_rate = _declare(node, "max_rate", defaults.max_rate, any_type)
     return dataclasses.replace(declared, max_rate=max_rate)
@@ -298,14 +308,71 @@ def declare_parameter_bridge_parameters(
     declared = _declare_fields(
         node,
         ParameterBridgeParameters(declare_shared_parameters(node, env)),
-        ("shared", "status_period", *arrays),
+        ("shared", "service_timeout", "status_period", *arrays),
     )
     lists: dict[str, Any] = {
         name: tuple(_declare(node, name, Parameter.Type.STRING_ARRAY) or ()) for name in arrays
     }
     any_type = ParameterDescriptor(dynamic_typing=True)
+    timeout = _declare(node, "service_timeout", declared.service_timeout, any_type)
     period = _declare(node, "status_period", declared.status_period, any_type)
-    return dataclasses.replace(declared, status_period=period, **lists)
+    return dataclasses.replace(
+        declared,
+        service_timeout=checked_service_timeout(timeout),
+        status_period=period,
+        **lists,
+    )
+
+
+def check_heartbeat(milliseconds: int) -> None:
+    """Refuse a heartbeat timer period below 1 ms (rclcpp refuses a negative period, and one
+    of 0 would re-check without pause).
+
+    Raises:
+        ConfigError: naming the parameter and its range.
+    """
+    if milliseconds < 1:
+        msg = (
+            f"parameter subscription_heartbeat is {milliseconds}; it must be an integer >= 1 "
+            "(milliseconds between lazy re-checks; default 1000)"
+        )
+        raise ConfigError(msg)
+
+
+def checked_service_timeout(value: object) -> float:
+    """``value`` as the seconds a service call waits: an integer or a decimal number > 0.
+
+    Raises:
+        ConfigError: anything else (a string, a bool, 0, a negative or infinite number).
+    """
+    if isinstance(value, int | float) and not isinstance(value, bool) and 0 < value < math.inf:
+        return float(value)
+    msg = (
+        f"parameter service_timeout must be a number of seconds > 0, such as 5 or 2.5, "
+        f"got {value!r}"
+    )
+    raise ConfigError(msg)
+
+
+def check_transport_implementation(parameter: str, env: Mapping[str, str]) -> None:
+    """Refuse a Gazebo Transport implementation we do not have: the ``parameter``'s value, or
+    when empty, ``GZ_TRANSPORT_IMPLEMENTATION`` of ``env``, as the transport chooses.
+
+    Raises:
+        ConfigError: naming where the value came from and the values there are.
+    """
+    if parameter:
+        chosen, where = parameter, "parameter gz_transport_implementation"
+        fix = f"or leave it out to follow {TRANSPORT_IMPLEMENTATION_ENV}"
+    else:
+        chosen, where = env.get(TRANSPORT_IMPLEMENTATION_ENV, ""), TRANSPORT_IMPLEMENTATION_ENV
+        fix = "or unset it (zeromq)"
+    if chosen and chosen.lower() not in BACKENDS:
+        msg = (
+            f"{where} is {chosen!r}, not a Gazebo Transport implementation; use one of "
+            f"{', '.join(sorted(BACKENDS))}, {fix}"
+        )
+        raise ConfigError(msg)
 
 
 def checked_max_rate(shared: SharedParameters) -> tuple[float, str]:
@@ -333,3 +400,45 @@ def declare_image_bridge_parameters(
     """Declare ``image_bridge``'s parameters on ``node`` and return their values."""
     shared = declare_shared_parameters(node, env)
     return _declare_fields(node, ImageBridgeParameters(shared), ("shared",))
+
+
+#: rcl's words for a kind of ROS argument, and how to write one.
+_ROS_ARGUMENT_FIXES = (
+    ("parameter override", "write -p NAME:=VALUE with a value, e.g. -p config_file:=bridge.yaml"),
+    ("params", "give --params-file the path of a readable parameters YAML file"),
+    ("remap", "write -r FROM:=TO, e.g. -r __ns:=/robot1"),
+    ("log level", "write --log-level LEVEL: debug, info, warn, error or fatal"),
+)
+_ROS_ARGUMENTS_GUIDE = "see 'Passing ROS arguments to nodes' in the ROS 2 documentation"
+#: Where in rcl's C sources an error was raised (", at /src/rcl/arguments.c:352").
+_SOURCE_LOCATION = re.compile(r", at \S+:\d+")
+
+
+def ros_arguments_problem(program: str, argv: Sequence[str]) -> str:
+    """What rcl cannot read in the ROS arguments of ``argv`` (with the program name), as one
+    line naming the argument and the fix; '' when it reads them all.
+
+    Checked before ``rclpy.init``: rclpy raises these from it and from ``remove_ros_args``,
+    which ended the process with a traceback.
+    """
+    try:
+        remove_ros_args(list(argv))
+    except _rclpy.UnknownROSArgsError as err:
+        unknown = str(err).removeprefix("[").removesuffix("]")
+        return (
+            f"{program}: not ROS arguments, yet after --ros-args: {unknown}; put {program}'s "
+            "own arguments before --ros-args, or after a -- that ends the ROS arguments"
+        )
+    except _rclpy.RCLInvalidROSArgsError as err:
+        reason = _rcl_reason(str(err))
+        fix = next((fix for words, fix in _ROS_ARGUMENT_FIXES if words in reason), None)
+        return f"{program}: bad ROS argument: {reason}; {fix or _ROS_ARGUMENTS_GUIDE}"
+    return ""
+
+
+def _rcl_reason(message: str) -> str:
+    """rcl's ``message`` without its prefix and source locations, and for a rule without the
+    state of rcl's lexer, which names nothing the user wrote."""
+    reason = _SOURCE_LOCATION.sub("", message).removeprefix("Failed to parse ROS arguments: ")
+    head = reason.partition(". Error: ")[0]
+    return (head if " rule: " in head else reason).rstrip(".")

@@ -105,3 +105,27 @@ def test_json_document(capsys: pytest.CaptureFixture[str]) -> None:
     assert (clock["native_to_ros"], clock["native_to_gz"]) == (True, True)
     assert isinstance(document["services"], list)
     assert isinstance(document["unavailable"], dict)
+
+
+@pytest.mark.parametrize(
+    ("argv", "used", "extra"),
+    [
+        (["--print-pairs", "--json"], "--print-pairs", "--json"),
+        (["--json", "--print-pairs"], "--json", "--print-pairs"),
+        (["--print-ros", "a", "b"], "--print-ros", "a b"),
+        (
+            ["--get-ros-to-gz", "nav_msgs/msg/Odometry", "--json"],
+            "--get-ros-to-gz nav_msgs/msg/Odometry",
+            "--json",
+        ),
+    ],
+)
+def test_arguments_after_the_option_are_refused_not_ignored(
+    capsys: pytest.CaptureFixture[str], argv: list[str], used: str, extra: str
+) -> None:
+    code, out, err = run(capsys, *argv)
+    assert (code, out) == (1, "")
+    assert err == (
+        f"bridge_types: unexpected {extra!r} after {used!r}: give one option per run "
+        "(--json alone prints every pair and service as JSON; bridge_types -h lists the options)\n"
+    )

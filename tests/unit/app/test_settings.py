@@ -184,12 +184,6 @@ def test_bridge_options_from_parameters_and_switches() -> None:
     )
 
 
-@pytest.mark.parametrize(("milliseconds", "seconds"), [(1000, 1.0), (0, 0.001), (-5, 0.001)])
-def test_heartbeat_is_at_least_one_millisecond(milliseconds: int, seconds: float) -> None:
-    shared = SharedParameters(subscription_heartbeat=milliseconds)
-    assert shared.bridge_options(Switches(), gz_version="").heartbeat == seconds
-
-
 @pytest.mark.parametrize(("value", "implementation"), [("", None), ("zenoh", "zenoh")])
 def test_gz_node_options(value: str, implementation: str | None) -> None:
     shared = SharedParameters(gz_transport_implementation=value)

@@ -1,0 +1,156 @@
+"""Bad ROS arguments and refused parameters end each executable with one line, never a
+traceback, and the exit status of its other bad arguments (255, as the C++ bridge).
+
+The real console scripts run here: rclpy raised these errors from ``rclpy.init`` and
+``remove_ros_args``, and the transport's from the bridge's creation, past every handler.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ros_gz_bridge_py.app.settings import TRANSPORT_IMPLEMENTATION_ENV, ros_arguments_problem
+
+USAGE_EXIT = 255
+#: The console scripts of the venv running the tests (beside the interpreter).
+BIN = Path(sys.prefix) / "bin"
+TOPIC = "/chatter@std_msgs/msg/String@gz.msgs.StringMsg"
+#: What each executable takes as a topic argument.
+TOPICS = {"parameter_bridge": TOPIC, "image_bridge": "/cam", "bridge_node": TOPIC}
+MISPLACED = "put {program}'s own arguments before --ros-args, or after a -- that ends the ROS"
+
+
+def run(program: str, *args: str, env: dict[str, str] | None = None) -> tuple[int, list[str]]:
+    """(exit status, the lines on stderr but rcl's warnings about ROS_LOCALHOST_ONLY)."""
+    done = subprocess.run(
+        [str(BIN / program), *args],
+        capture_output=True,
+        text=True,
+        timeout=30,
+        check=False,
+        env={**os.environ, **(env or {})},
+    )
+    lines = [line for line in done.stderr.splitlines() if "[rcl]:" not in line]
+    return done.returncode, lines
+
+
+@pytest.mark.parametrize(
+    ("ros_args", "named", "fix"),
+    [
+        (["-p", "config_file"], "'-p config_file'", "write -p NAME:=VALUE with a value"),
+        (["-p", "config_file:="], "'-p config_file:='", "write -p NAME:=VALUE with a value"),
+        (["-p"], "-p flag. No parameter override rule found", "write -p NAME:=VALUE with a value"),
+        (
+            ["--params-file", "/nonexistent.yaml"],
+            "'--params-file /nonexistent.yaml'. Error: Error opening YAML file",
+            "give --params-file the path of a readable parameters YAML file",
+        ),
+        (["-r", "foo"], "'-r foo'", "write -r FROM:=TO"),
+        (
+            ["--log-level", "loud"],
+            "'--log-level loud'. Error: Argument does not use a valid severity level",
+            "write --log-level LEVEL: debug, info, warn, error or fatal",
+        ),
+        (
+            ["--enclave"],
+            "--enclave flag. No enclave path provided",
+            "see 'Passing ROS arguments to nodes'",
+        ),
+    ],
+)
+def test_a_bad_ros_argument_is_named_with_its_fix(
+    ros_args: list[str], named: str, fix: str
+) -> None:
+    problem = ros_arguments_problem("parameter_bridge", ["pb", "--ros-args", *ros_args])
+    assert problem.startswith("parameter_bridge: bad ROS argument: Couldn't parse ")
+    assert f"{named}; {fix}" in problem
+    assert ", at /" not in problem  # rcl's source locations
+    assert "lexeme" not in problem  # rcl's lexer state
+
+
+def test_arguments_inside_the_ros_arguments_are_named() -> None:
+    problem = ros_arguments_problem("image_bridge", ["ib", "--ros-args", "-p", "a:=1", "/c", "d"])
+    assert problem == (
+        "image_bridge: not ROS arguments, yet after --ros-args: '/c', 'd'; "
+        + MISPLACED.format(program="image_bridge")
+        + " arguments"
+    )
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["pb"],
+        ["pb", TOPIC],
+        ["pb", "--ros-args", "-p", "lazy:=true", "--", TOPIC],
+        ["pb", TOPIC, "--ros-args", "-p", "config_file:=b.yaml", "-r", "__ns:=/r1"],
+    ],
+)
+def test_readable_ros_arguments_have_no_problem(argv: list[str]) -> None:
+    assert ros_arguments_problem("parameter_bridge", argv) == ""
+
+
+@pytest.mark.parametrize("program", list(TOPICS))
+@pytest.mark.parametrize(
+    ("ros_args", "wanted"),
+    [
+        (["-p", "config_file"], "bad ROS argument: Couldn't parse parameter override rule"),
+        (["--params-file", "/nonexistent.yaml"], "bad ROS argument: Couldn't parse params file"),
+    ],
+)
+def test_each_executable_says_one_line_for_a_bad_ros_argument(
+    program: str, ros_args: list[str], wanted: str
+) -> None:
+    status, lines = run(program, TOPICS[program], "--ros-args", *ros_args)
+    assert status == USAGE_EXIT
+    assert len(lines) == 1, lines
+    assert lines[0].startswith(f"{program}: {wanted}")
+
+
+@pytest.mark.parametrize("program", list(TOPICS))
+def test_each_executable_names_a_topic_after_the_ros_arguments(program: str) -> None:
+    status, lines = run(program, "--ros-args", "-p", "lazy:=true", TOPICS[program])
+    assert status == USAGE_EXIT
+    assert lines == [
+        f"{program}: not ROS arguments, yet after --ros-args: '{TOPICS[program]}'; "
+        + MISPLACED.format(program=program)
+        + " arguments"
+    ]
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize("program", ["parameter_bridge", "image_bridge"])
+@pytest.mark.parametrize(
+    ("ros_args", "env", "wanted"),
+    [
+        (
+            ["-p", "gz_transport_implementation:=foo"],
+            {},
+            "parameter gz_transport_implementation is 'foo', not a Gazebo Transport "
+            "implementation; use one of memory, zenoh, zeromq",
+        ),
+        (
+            [],
+            {TRANSPORT_IMPLEMENTATION_ENV: "foo"},
+            f"{TRANSPORT_IMPLEMENTATION_ENV} is 'foo', not a Gazebo Transport implementation",
+        ),
+        (
+            ["-p", "subscription_heartbeat:=0"],
+            {},
+            "parameter subscription_heartbeat is 0; it must be an integer >= 1",
+        ),
+    ],
+)
+def test_a_refused_parameter_is_one_error_line(
+    program: str, ros_args: list[str], env: dict[str, str], wanted: str
+) -> None:
+    status, lines = run(program, TOPICS[program], "--ros-args", *ros_args, env=env)
+    assert status == USAGE_EXIT
+    assert len(lines) == 1, lines
+    assert "[ERROR]" in lines[0]
+    assert wanted in lines[0]
