@@ -35,7 +35,8 @@ YAML: a null value (``topic_name:``) goes     counts as not set, like the empty 
 through yaml-cpp's string conversion
 YAML: the file is re-read and its errors      parsed once per call; the caller decides when to
 re-logged every heartbeat                     re-read
-YAML: a key written twice                     the last one wins, with a warning
+YAML: a key written twice                     the last one wins, with a warning (none for a key
+                                              an entry sets over its ``<<`` merge)
 YAML: ``ign_topic_name``/``ign_type_name``    accepted with a deprecation warning, so Humble files
 and ``IGN_TO_ROS``/``ROS_TO_IGN`` are         keep working
 Humble-only
@@ -49,6 +50,10 @@ YAML: a missing type is "both ros_type_name   a :class:`TopicPattern` completed 
 and gz_type_name must be set"                 is an entry with a wildcard (``patterns.py``)
 YAML, CLI: no placeholders                    ``${NAME}``, one entry per value (``templates.py``)
 YAML, params: no rate limit                   ``max_rate`` (Hz, 0: none)
+YAML, params: any ``size_t`` queue depth is   above 16777216 (``MAX_QUEUE_DEPTH``): an error
+passed to rclcpp                              "publisher_queue must be at most 16777216, got N"
+YAML, params: a queue of 0 gets rclcpp's      kept, with a warning naming the entry: 0 is the
+warning, which names no entry                 middleware's default depth, not unbounded
 Params: direction ``NONE`` creates nothing,   the bridge is skipped with a warning
 silently
 Params: any negative queue means "default"    only -1 (or unset) means default; other negatives are

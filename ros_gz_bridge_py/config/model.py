@@ -132,14 +132,47 @@ def as_bool(key: str, value: object) -> bool:
     raise ConfigError(msg)
 
 
-def as_queue(key: str, value: object) -> int:
-    """``value`` as a queue depth: a non-negative integer (a string of digits is accepted)."""
+#: The deepest ``publisher_queue``/``subscriber_queue``. A channel's native queue allocates a
+#: slot per message of its ROS depth when it starts, and ``native/pump.c`` refuses more than
+#: ``1 << 24`` slots; a deeper ROS history would only reserve memory nobody reads.
+MAX_QUEUE_DEPTH = 1 << 24
+
+
+def _non_negative_int(value: object) -> int | None:
+    """``value`` as an integer >= 0 (a string of digits too); None when it is not one."""
     if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
         return value
     if isinstance(value, str) and value.strip().isascii() and value.strip().isdigit():
         return int(value.strip())
-    msg = f"{key} must be a non-negative integer, got {value!r}"
-    raise ConfigError(msg)
+    return None
+
+
+def as_queue(key: str, value: object) -> int:
+    """``value`` as a queue depth: an integer from 0 to :data:`MAX_QUEUE_DEPTH`."""
+    depth = _non_negative_int(value)
+    # A float too: ROS parameters read an integer beyond int64 as a double (1e+20).
+    number = value if depth is None else depth
+    if (
+        isinstance(number, int | float)
+        and not isinstance(number, bool)
+        and number > MAX_QUEUE_DEPTH
+    ):
+        msg = f"{key} must be at most {MAX_QUEUE_DEPTH}, got {number}"
+        raise ConfigError(msg)
+    if depth is None:
+        msg = f"{key} must be a non-negative integer, got {value!r}"
+        raise ConfigError(msg)
+    return depth
+
+
+def zero_queue_hint(key: str) -> str:
+    """The warning for a queue of 0, which C++ accepts too: ROS reads depth 0 as the
+    middleware's default, which users who meant "unbounded" do not expect."""
+    return (
+        f"{key} 0 means the middleware's default history depth (1 message with Fast DDS or "
+        f"Cyclone DDS), not an unbounded queue; set {key} to the depth you want, "
+        "or leave it out for the default"
+    )
 
 
 def as_rate(key: str, value: object) -> float:

@@ -22,6 +22,7 @@ from ros_gz_bridge_py.config.model import (
     as_queue,
     as_rate,
     ros_type_hint,
+    zero_queue_hint,
 )
 from ros_gz_bridge_py.errors import ConfigError
 
@@ -32,13 +33,17 @@ _UNSET_QUEUE = -1
 class _Bridge:
     """Reads the ``bridges.<name>.*`` parameters of one bridge."""
 
-    def __init__(self, name: str, get: Callable[[str], object | None]) -> None:
+    def __init__(self, name: str, get: Callable[[str], object | None], warnings: list[str]) -> None:
         self.name = name
         self.source = f"parameter bridges.{name}"
         self._get = get
+        self._warnings = warnings
 
     def error(self, text: str) -> ConfigError:
         return ConfigError(f"Bridge {self.name} {text}", self.source)
+
+    def warn(self, text: str) -> None:
+        self._warnings.append(f"{self.source}: {text}")
 
     def raw(self, key: str) -> object | None:
         return self._get(f"bridges.{self.name}.{key}")
@@ -65,10 +70,13 @@ class _Bridge:
         if value is None or value == _UNSET_QUEUE:
             return None
         try:
-            return as_queue(key, value)
+            depth = as_queue(key, value)
         except ConfigError as err:
             msg = f"has an invalid value: {err.message}; use -1 for the default."
             raise self.error(msg) from err
+        if depth == 0:
+            self.warn(zero_queue_hint(key))
+        return depth
 
     def rate(self) -> float | None:
         value = self.raw("max_rate")
@@ -122,13 +130,13 @@ def _parse_topic(bridge: _Bridge, ros_type: str) -> TopicBridgeSpec | None:
     )
 
 
-def _parse_bridge(bridge: _Bridge, warnings: list[str]) -> BridgeSpec | None:
+def _parse_bridge(bridge: _Bridge) -> BridgeSpec | None:
     ros_type = bridge.required("ros_type_name")
     if bool(bridge.text("ros_topic_name")) == bool(bridge.text("service_name")):
         msg = "needs to set exactly one of ros_topic_name or service_name."
         raise bridge.error(msg)
     if hint := ros_type_hint(ros_type):
-        warnings.append(f"{bridge.source}: {hint}")
+        bridge.warn(hint)
     if bridge.text("service_name"):
         return ServiceBridgeSpec(
             service=bridge.text("service_name"),
@@ -139,7 +147,7 @@ def _parse_bridge(bridge: _Bridge, warnings: list[str]) -> BridgeSpec | None:
         )
     spec = _parse_topic(bridge, ros_type)
     if spec is None:
-        warnings.append(f"{bridge.source}: direction NONE bridges nothing; the bridge is skipped")
+        bridge.warn("direction NONE bridges nothing; the bridge is skipped")
     return spec
 
 
@@ -156,7 +164,7 @@ def parse_parameter_bridges(
     warnings: list[str] = []
     for name in names:
         try:
-            spec = _parse_bridge(_Bridge(name, get), warnings)
+            spec = _parse_bridge(_Bridge(name, get, warnings))
         except ConfigError as err:
             errors.append(err)
             continue

@@ -33,6 +33,7 @@ from ros_gz_bridge_py.config.model import (
     as_queue,
     as_rate,
     ros_type_hint,
+    zero_queue_hint,
 )
 from ros_gz_bridge_py.config.patterns import TopicPattern, check_wildcards, has_wildcard
 from ros_gz_bridge_py.errors import ConfigError
@@ -55,6 +56,7 @@ _KNOWN_KEYS = frozenset(
     (*_NAME_KEYS, "ros_type_name", *_TOPIC_ONLY_KEYS, *_SERVICE_KEYS, *_DEPRECATED_KEYS)
 )
 _NULL_TAG = "tag:yaml.org,2002:null"
+_MERGE_TAG = "tag:yaml.org,2002:merge"
 _T = TypeVar("_T")
 #: What one entry (or one combination of its placeholders' values) reads as.
 Parsed = BridgeSpec | TopicPattern
@@ -77,19 +79,29 @@ class _Entry:
         self.location = self.at(node)
         self._warnings = warnings
         self._constructor = SafeConstructor()
+        for key in _keys_set_twice(node):
+            self.warn(f"key '{key}' is set twice; the last value is used")
+        self._values = self._merged_values(node)
+
+    def _merged_values(self, node: yaml.MappingNode) -> dict[str, yaml.Node]:
+        """Key -> value node, with ``<<: *anchor`` merges resolved (the entry's own keys win).
+
+        Resolved in a copy, so the node still reads as written if an alias brings it back as
+        another entry.
+        """
+        flat = yaml.MappingNode(node.tag, list(node.value), node.start_mark, node.end_mark)
         try:
-            self._constructor.flatten_mapping(node)  # resolve "<<: *anchor" merge keys
+            self._constructor.flatten_mapping(flat)
         except yaml.YAMLError as err:
             msg = f"invalid merge key: {err}"
             raise _entry_error(msg, self.location) from err
-        self._values: dict[str, yaml.Node] = {}
-        for key_node, value_node in node.value:
+        values: dict[str, yaml.Node] = {}
+        for key_node, value_node in flat.value:  # merged pairs come first
             if not isinstance(key_node, yaml.ScalarNode):
                 msg = "keys must be plain strings"
                 raise _entry_error(msg, self.at(key_node))
-            if key_node.value in self._values:
-                self.warn(f"key '{key_node.value}' is set twice; the last value is used")
-            self._values[key_node.value] = value_node
+            values[key_node.value] = value_node
+        return values
 
     def at(self, node: yaml.Node) -> str:
         where = f"{self._source_name} entry {self._index} (line {node.start_mark.line + 1})"
@@ -144,7 +156,10 @@ class _Entry:
 
     def queue(self, key: str) -> int | None:
         raw = self.value(key)
-        return None if raw is None else self._checked(key, lambda: as_queue(key, raw))
+        depth = None if raw is None else self._checked(key, lambda: as_queue(key, raw))
+        if depth == 0:
+            self.warn(zero_queue_hint(key))
+        return depth
 
     def rate(self, key: str) -> float | None:
         raw = self.value(key)
@@ -158,6 +173,20 @@ class _Entry:
 
     def unknown_keys(self) -> list[str]:
         return [key for key in self._values if key not in _KNOWN_KEYS]
+
+
+def _keys_set_twice(node: yaml.MappingNode) -> list[str]:
+    """Each repeat of a key among the entry's own keys; a key that a ``<<`` merge also gives
+    is no repeat (YAML merge semantics: the entry's own value wins)."""
+    seen: set[str] = set()
+    repeats: list[str] = []
+    for key_node, _ in node.value:
+        if not isinstance(key_node, yaml.ScalarNode) or key_node.tag == _MERGE_TAG:
+            continue
+        if key_node.value in seen:
+            repeats.append(key_node.value)
+        seen.add(key_node.value)
+    return repeats
 
 
 def _gz_key(entry: _Entry, key: str) -> str:

@@ -9,6 +9,7 @@ which rclpy reads from the node's parameters when the endpoint is created.
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 from rclpy.duration import Duration
@@ -118,6 +119,12 @@ def endpoint_qos(profile_name: str | None, depth: int | None) -> QoSProfile:
     Raises:
         ConfigError: ``profile_name`` is not one of :data:`NAMED_PROFILES`.
     """
+    if depth == 0:
+        # The config parser warns about a queue of 0 naming the entry and line; rclpy's own
+        # warning (here, and again when the endpoint applies its qos_overrides) names neither.
+        warnings.filterwarnings(
+            "ignore", "A zero depth with KEEP_LAST", UserWarning, module="rclpy.qos"
+        )
     if profile_name is None:
         return QoSProfile(
             history=HistoryPolicy.KEEP_LAST,

@@ -136,6 +136,17 @@ def test_service_bridge() -> None:
             "got -5; use -1 for the default.",
         ),
         (
+            {**_CAMERA, "subscriber_queue": 16777217},
+            "Bridge b has an invalid value: subscriber_queue must be at most 16777216, "
+            "got 16777217; use -1 for the default.",
+        ),
+        (
+            # rcl reads -p ...:=99999999999999999999 (beyond int64) as a double.
+            {**_CAMERA, "publisher_queue": 1e20},
+            "Bridge b has an invalid value: publisher_queue must be at most 16777216, "
+            "got 1e+20; use -1 for the default.",
+        ),
+        (
             {**_CAMERA, "lazy": "maybe"},
             "Bridge b has an invalid value: lazy must be true or false, got 'maybe'.",
         ),
@@ -162,4 +173,17 @@ def test_direction_none_is_skipped_with_a_warning() -> None:
     assert (result.specs, result.errors) == ((), ())
     assert result.warnings == (
         "parameter bridges.idle: direction NONE bridges nothing; the bridge is skipped",
+    )
+
+
+def test_zero_queue_is_kept_with_a_warning() -> None:
+    result = parse_parameter_bridges(
+        ["cam"], lambda key: {**_CAMERA, "publisher_queue": 0}.get(key.rsplit(".", 1)[1])
+    )
+    (spec,) = result.specs
+    assert isinstance(spec, TopicBridgeSpec)
+    assert (spec.publisher_queue, result.errors) == (0, ())
+    (warning,) = result.warnings
+    assert warning.startswith(
+        "parameter bridges.cam: publisher_queue 0 means the middleware's default history depth"
     )

@@ -190,6 +190,11 @@ def test_invalid_entry_is_skipped_and_the_others_kept() -> None:
         ("subscriber_queue: -3", "subscriber_queue must be a non-negative integer, got -3"),
         ("subscriber_queue: 2.5", "subscriber_queue must be a non-negative integer, got 2.5"),
         ("publisher_queue: true", "publisher_queue must be a non-negative integer, got True"),
+        ("publisher_queue: 16777217", "publisher_queue must be at most 16777216, got 16777217"),
+        (
+            "subscriber_queue: 99999999999999999999",
+            "subscriber_queue must be at most 16777216, got 99999999999999999999",
+        ),
         ("lazy: maybe", "lazy must be true or false, got 'maybe'"),
         ("lazy: 1", "lazy must be true or false, got 1"),
         ("ros_topic_name: {a: 1}", "ros_topic_name must be a string, got a map"),
@@ -387,11 +392,40 @@ def test_merge_keys_share_settings() -> None:
 - <<: *base
   topic_name: b
 """
-    first, second = _topics(parse_yaml(text))
+    result = parse_yaml(text)
+    first, second = _topics(result)
     assert (second.ros_topic, second.ros_type, second.direction) == (
         "b",
         first.ros_type,
         Direction.GZ_TO_ROS,
+    )
+    assert result.warnings == ()  # overriding a merged key is no duplicate
+
+
+def test_merge_from_a_flow_map_overrides_without_warning() -> None:
+    text = """\
+- &base {ros_topic_name: /a, gz_topic_name: /a, ros_type_name: std_msgs/msg/String,
+         gz_type_name: gz.msgs.StringMsg, direction: GZ_TO_ROS}
+- &b
+  <<: *base
+  ros_topic_name: /b
+- *b
+"""
+    result = parse_yaml(text)
+    assert [(s.ros_topic, s.gz_topic) for s in _topics(result)] == [
+        ("/a", "/a"),
+        ("/b", "/a"),
+        ("/b", "/a"),  # the alias reads entry 2 as written, not its merged form
+    ]
+    assert result.warnings == ()
+
+
+def test_duplicate_key_beside_a_merge_still_warns() -> None:
+    text = "- &base {topic_name: a}\n- <<: *base\n  topic_name: b\n  topic_name: c\n" + _TYPES
+    result = parse_yaml(text)
+    assert [s.ros_topic for s in result.specs if isinstance(s, TopicBridgeSpec)] == ["c"]
+    assert result.warnings == (
+        "<string> entry 2 (line 2): key 'topic_name' is set twice; the last value is used",
     )
 
 
@@ -418,3 +452,21 @@ def test_non_utf8_file(tmp_path: Path) -> None:
     assert _only_error(read_yaml_file(path)) == (
         f"Could not parse config: file is not UTF-8 text [{path}]"
     )
+
+
+def test_deepest_queue_is_accepted() -> None:
+    result = parse_yaml("- topic_name: a\n  publisher_queue: 16777216\n" + _TYPES)
+    (spec,) = _topics(result)
+    assert (spec.publisher_queue, result.errors) == (16777216, ())
+
+
+def test_zero_queue_is_kept_with_a_located_warning() -> None:
+    text = "- topic_name: a\n" + _TYPES + "  subscriber_queue: 0\n"
+    result = parse_yaml(text, "b.yaml")
+    (spec,) = _topics(result)
+    assert spec.subscriber_queue == 0
+    (warning,) = result.warnings
+    assert warning.startswith(
+        "b.yaml entry 1 (line 1): subscriber_queue 0 means the middleware's default history depth"
+    )
+    assert "set subscriber_queue to the depth you want" in warning
