@@ -59,7 +59,7 @@ from ros_gz_bridge_py.config import (
 from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.status import serve
-from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.errors import ConfigError, TransportError
 from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
@@ -68,6 +68,8 @@ PROGRAM = "image_bridge"
 NODE_NAME = "ros_gz_image"
 #: Exit status for bad arguments, as ros_gz_image (``return -1``).
 USAGE_EXIT = 255
+#: Exit status when the Gazebo Transport side cannot be opened, as parameter_bridge's.
+TRANSPORT_EXIT = 1
 
 
 def bridge_specs(
@@ -158,6 +160,9 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
             events_executor=switches.events_executor,
             dds_event_batch=switches.dds_event_batch,
         )
+    except TransportError as err:
+        node.get_logger().error(str(err))
+        return TRANSPORT_EXIT
     finally:
         if bridge is not None:
             bridge.close()

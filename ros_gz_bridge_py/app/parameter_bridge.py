@@ -63,7 +63,7 @@ from ros_gz_bridge_py.core.discovered import DiscoveredBridges, ros_publishers
 from ros_gz_bridge_py.core.discovery_plan import Plan, Sighting, plan, ros_names_to_read, sightings
 from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
-from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.errors import ConfigError, TransportError
 from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
@@ -78,6 +78,8 @@ CHECK_OPTION = "--check"
 DISCOVER_OPTION = "--discover"
 #: Exit status for bad arguments, as the C++ bridge (``return -1``).
 USAGE_EXIT = 255
+#: Exit status when the Gazebo Transport side cannot be opened (a Zenoh router not there).
+TRANSPORT_EXIT = 1
 
 
 def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> int:
@@ -153,6 +155,9 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 events_executor=switches.events_executor,
                 dds_event_batch=switches.dds_event_batch,
             )
+        except TransportError as err:
+            node.get_logger().error(str(err))
+            return TRANSPORT_EXIT
         finally:
             if one_cpu is not None:
                 one_cpu.close()

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import re
 import threading
 from typing import Any, ClassVar, cast
 
@@ -65,6 +66,8 @@ from ros_gz_bridge_py.transport.zenoh.keys import (
 from ros_gz_bridge_py.transport.zenoh.node_services import ZenohCall, ZenohServices
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
+#: Where in zenoh's Rust sources an error was raised (" at /root/.cargo/.../orchestrator.rs:447").
+_SOURCE_LOCATION = re.compile(r"\s+at \S+\.rs:\d+")
 
 
 class ZenohGzNode(ZenohServices):
@@ -105,7 +108,12 @@ class ZenohGzNode(ZenohServices):
         try:
             self._session = zenoh.open(chosen)
         except zenoh.ZError as error:
-            msg = f"cannot open the Zenoh session: {error}"
+            reason = _SOURCE_LOCATION.sub("", str(error)).rstrip(". ")
+            msg = (
+                f"cannot open the Zenoh session ({self._where}): {reason}; start the router it "
+                "connects to, or set its endpoints (ZENOH_CONFIG, "
+                "GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE; docs/zenoh.md)"
+            )
             raise TransportError(msg) from error
         self._thread = threading.Thread(target=self._node_main, name="gz-zenoh", daemon=True)
         self._thread.start()

@@ -154,3 +154,25 @@ def test_a_refused_parameter_is_one_error_line(
     assert len(lines) == 1, lines
     assert "[ERROR]" in lines[0]
     assert wanted in lines[0]
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize("program", ["parameter_bridge", "image_bridge"])
+def test_a_zenoh_router_not_there_is_one_error_line(program: str) -> None:
+    """Zenoh in client mode towards a port nobody listens on (loopback, no scouting): the
+    session cannot open; said once with where it looked and the fix, exit 1."""
+    env = {
+        TRANSPORT_IMPLEMENTATION_ENV: "zenoh",
+        "GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE": (
+            'mode="client";connect/endpoints=["tcp/127.0.0.1:1"];scouting/multicast/enabled=false'
+        ),
+    }
+    status, lines = run(program, TOPICS[program], env=env)
+    assert status == 1
+    assert len(lines) == 1, lines
+    assert "[ERROR]" in lines[0]
+    assert 'cannot open the Zenoh session (Zenoh client, connect ["tcp/127.0.0.1:1"]' in lines[0]
+    assert lines[0].endswith(
+        "start the router it connects to, or set its endpoints (ZENOH_CONFIG, "
+        "GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE; docs/zenoh.md)"
+    )
