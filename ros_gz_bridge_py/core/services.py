@@ -268,13 +268,35 @@ class ServiceBridge:
         if self._closing and success is None:
             return self._fail("the bridge is shutting down", "shutting down")
         if success is None:
-            return self._fail(f"no reply from Gazebo within {self.timeout:g} s", "no reply")
+            return self._fail(self._no_reply(), "no reply")
         if not success:
             return self._fail("Gazebo reported failure", "Gazebo failure")
         try:
             return self.pair.reply_to_ros(self._reply_class.FromString(reply))
         except Exception as err:
             return self._fail(f"reply not converted: {err}", NOT_CONVERTED)
+
+    def _no_reply(self) -> str:
+        """Why Gazebo did not answer in time, as far as discovery knows."""
+        service, waited = self.spec.service, f"{self.timeout:g} s"
+        providers = self._gz_node.service_info(service)
+        if not providers:
+            return (
+                f"no reply within {waited}: no Gazebo provider of {service} is known (gz service "
+                "-l lists the services there are)"
+            )
+        offered = {(p.request_type, p.response_type) for p in providers}
+        if not any(
+            same_message(request, self.gz_req_type) and same_message(reply, self.gz_rep_type)
+            for request, reply in offered
+        ):
+            types = ", ".join(sorted(f"{request}/{reply}" for request, reply in offered))
+            return (
+                f"no reply within {waited}: the Gazebo providers of {service} take {types}, not "
+                f"{self.gz_req_type}/{self.gz_rep_type}; set gz_req_type_name and "
+                "gz_rep_type_name to theirs"
+            )
+        return f"no reply from Gazebo within {waited}"
 
     def _settle(self, future: Future, outcome: tuple[bool | None, bytes]) -> None:
         """The call's outcome, once (a reply, its timeout, or closing: whichever is first)."""

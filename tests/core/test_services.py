@@ -138,7 +138,26 @@ def test_no_provider_gives_success_false_after_the_timeout(rig: Rig, world: RosW
     (status,) = StatusTracker(rig.bridge).snapshot()
     assert (status.errors, status.conversion_errors) == (1, 0)
     assert status.errors_by_reason == (("no reply", 1),)
-    assert status.last_error == f"no reply from Gazebo within {SERVICE_TIMEOUT:g} s"
+    assert status.last_error == (
+        f"no reply within {SERVICE_TIMEOUT:g} s: no Gazebo provider of {service} is known "
+        "(gz service -l lists the services there are)"
+    )
+
+
+def test_a_provider_of_other_types_is_named_when_nothing_answers(rig: Rig, world: RosWorld) -> None:
+    service = unique("other_types")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    provider = Provider(GzPose, GzBoolean(data=True))
+    rig.gazebo().advertise_service(service, "gz.msgs.Pose", "gz.msgs.Boolean", provider)
+    wait_until(lambda: bool(rig.gz.service_info(service)), "the provider in discovery")
+    assert call(world, ControlWorld, service, control_request()).success is False
+    assert provider.requests == []
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert status.last_error == (
+        f"no reply within {SERVICE_TIMEOUT:g} s: the Gazebo providers of {service} take "
+        "gz.msgs.Pose/gz.msgs.Boolean, not gz.msgs.WorldControl/gz.msgs.Boolean; set "
+        "gz_req_type_name and gz_rep_type_name to theirs"
+    )
 
 
 def test_closing_answers_the_waiting_calls(make_rig: Callable[..., Rig], world: RosWorld) -> None:
