@@ -67,6 +67,15 @@ def check_list(gz_items: Sized, least: int, ros_type: str) -> None:
         raise amplification_error(count, f"{ros_type} items", received, least_total)
 
 
+def check_output(count: int, item_bytes: int, items: str, received: int) -> None:
+    """Raises ConversionError when ``count`` items of ``item_bytes`` each, made for a
+    message of ``received`` bytes (a count it states, padded with zeros where its data is
+    short), would be more than the bound allows."""
+    least_total = count * item_bytes
+    if least_total > OUTPUT_FLOOR and least_total > _limit(received):
+        raise amplification_error(count, items, received, least_total)
+
+
 def _limit(received: int) -> int:
     return min(OUTPUT_FLOOR + OUTPUT_RATIO * received, MAX_OUTPUT)
 

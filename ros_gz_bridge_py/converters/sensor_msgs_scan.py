@@ -16,6 +16,9 @@ Differences from ros_gz_bridge:
 - LaserScan R→G raises ConversionError when (angle_max - angle_min) / angle_increment is not
   a finite non-negative number (UB in C++).
 - LaserScan G→R pads gz ranges/intensities shorter than the selected row with 0.0.
+- LaserScan, both ways: a sample count whose ranges and intensities would be more than
+  ``converters/_limits.py`` allows for the message's size (a 5-byte scan stating 10 million
+  samples and carrying none) raises ConversionError (C++ pads G→R, over-reads R→G).
 - Range G→R raises ConversionError for a scan with no ranges.
 - PointCloud2, both ways, raises ConversionError when the sizes do not describe the data
   (see :func:`check_cloud_sizes`; C++ forwards the message, and a consumer that trusts the
@@ -35,6 +38,7 @@ from sensor_msgs.msg import LaserScan, PointCloud2, PointField, Range
 from ros_gz_bridge_py.bulk.cdr import layout_until
 from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.converters._fields import Value, fields, same
+from ros_gz_bridge_py.converters._limits import check_output
 from ros_gz_bridge_py.converters.std_msgs import HEADER, gz_to_ros_frame
 from ros_gz_bridge_py.errors import ConversionError, SizeMismatchError
 from ros_gz_bridge_py.msgs import message_class
@@ -74,6 +78,14 @@ def scan_count(angle_min: float, angle_max: float, angle_increment: float) -> in
     return int(ratio)
 
 
+#: The bytes one sample writes: a float32 range and a float32 intensity.
+_SAMPLE_BYTES = 8
+
+
+def _check_samples(count: int, received: int) -> None:
+    check_output(count, _SAMPLE_BYTES, "LaserScan samples", received)
+
+
 def _first(values: Any, count: int) -> Any:
     """The first ``count`` values, zero-padded when there are fewer."""
     head = values[:count]
@@ -98,6 +110,7 @@ _LASER_SCAN = fields(
 
 def laser_scan_to_gz(ros: Any) -> Any:
     count = scan_count(ros.angle_min, ros.angle_max, ros.angle_increment)
+    _check_samples(count, 4 * (len(ros.ranges) + len(ros.intensities)) + len(ros.header.frame_id))
     gz = GzLaserScan()
     _LASER_SCAN.to_gz(ros, gz)
     gz.count = count
@@ -111,6 +124,7 @@ def laser_scan_to_ros(gz: Any) -> Any:
     ros = LaserScan()
     _LASER_SCAN.to_ros(gz, ros)
     count = gz.count
+    _check_samples(count, gz.ByteSize())
     start = (gz.vertical_count // 2) * count
     ros.ranges = array("f", _first(gz.ranges[start : start + count], count))
     ros.intensities = array("f", _first(gz.intensities[start : start + count], count))

@@ -51,6 +51,20 @@ def test_missing_intensities_are_zero_padded() -> None:
     assert list(gz.intensities) == [0.0, 0.0]
 
 
+def test_a_sample_count_the_message_does_not_carry_is_refused_past_the_bound() -> None:
+    """A 5-byte Gazebo scan stating 10 million samples made an 80 MB ROS message (and a
+    count of 2**32 - 1 would exhaust memory); a ROS scan whose angles state 100 million
+    samples and carries none likewise. Padding within the bound stays (the test above)."""
+    with pytest.raises(ConversionError, match=r"10000000 LaserScan samples from a message of 5 "):
+        laser_scan_to_ros(GzLaserScan(count=10_000_000))
+    ros = LaserScan(angle_min=0.0, angle_max=1.0, angle_increment=1e-8)
+    with pytest.raises(ConversionError, match=r"LaserScan samples from a message of 0 bytes"):
+        laser_scan_to_gz(ros)
+    carried = GzLaserScan(count=100_000)
+    carried.ranges.extend([1.5] * 100_000)  # no intensities: padded, within the bound
+    assert list(laser_scan_to_ros(carried).intensities[-2:]) == [0.0, 0.0]
+
+
 def test_bad_angles_are_rejected() -> None:
     with pytest.raises(ConversionError, match="angle_increment"):
         laser_scan_to_gz(LaserScan(angle_min=0.0, angle_max=1.0, angle_increment=0.0))
