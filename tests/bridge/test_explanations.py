@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import random
 import re
+import signal
 import subprocess
 import time
 from collections.abc import Iterator
@@ -42,6 +43,8 @@ EXPLAIN_WITHIN = 10.0
 #: How long the bridge keeps running with every cause in place, to count repeats.
 DWELL = 12.0
 OTHER_PARTITION = f"elsewhere-{os.getpid()}"
+#: Seconds a typed subscriber stays before it leaves: past the explainer's warm-up.
+SUBSCRIBED_FOR = 6
 
 
 @dataclass(frozen=True)
@@ -195,6 +198,29 @@ def test_no_gazebo_peer_is_said_once_with_where_the_bridge_listens(
     )  # fmt: skip
     assert done.returncode == 1, done.stdout + done.stderr
     assert "PROBLEM: no Gazebo Transport process is heard at all" in done.stdout
+
+
+def test_a_subscriber_of_our_type_that_left_is_not_one_of_another_type(
+    started: list[PeerProcess],
+) -> None:
+    """A typed Fortress subscriber that took the bridge's Twist and exits: the bridge waits
+    for Gazebo again and says so, and never that the subscriber expects another type (it did,
+    in the seconds between its END_CONNECTION and its process's expiry)."""
+    require_peer()
+    topic = unique_name("xp_left")
+    bridge = start_process(bridge_command(f"{topic}@geometry_msgs/msg/Twist]gz.msgs.Twist"))
+    started.append(bridge)
+    wait_for_line(bridge, r"Creating ROS->GZ", timeout=30)
+    echo = start_peer("echo", topic, "ignition.msgs.Twist", str(SUBSCRIBED_FOR))
+    started.append(echo)  # its SUBSCRIBE reaches the bridge, then it takes the Twist
+    echo.wait(SUBSCRIBED_FOR + WAIT)
+    left = len(bridge.output())
+    deadline = time.monotonic() + EXPLAIN_WITHIN
+    while f"no Gazebo subscriber of {topic}" not in bridge.output()[left:]:
+        assert time.monotonic() < deadline, bridge.output()
+        bridge.send_signal(signal.SIGUSR1)  # the status table: its why lines at this moment
+        time.sleep(0.3)
+    assert "did not take" not in bridge.output()
 
 
 def test_check_without_problems_exits_0(started: list[PeerProcess]) -> None:

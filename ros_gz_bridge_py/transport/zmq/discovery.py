@@ -398,9 +398,7 @@ class DiscoveryEngine:
         self._activity.pop(process, None)
         self.spellings.forget(process)
         for topic in list(self._subscribe_seen):
-            self._subscribe_seen[topic].pop(process, None)
-            if not self._subscribe_seen[topic]:
-                del self._subscribe_seen[topic]
+            self._forget_sighting(topic, process)
         for topic in list(self._listed):
             by_node = self._listed[topic]
             for key in [key for key in by_node if key[0] == process]:
@@ -429,6 +427,12 @@ class DiscoveryEngine:
         subscribers[key] = known | {record.msg.msg_type}
         return [SubscriberAdded(record.topic, *key, record.msg.msg_type)]
 
+    def _forget_sighting(self, topic: str, process: str) -> None:
+        seen = self._subscribe_seen.get(topic, {})
+        seen.pop(process, None)
+        if not seen:
+            self._subscribe_seen.pop(topic, None)
+
     def _on_end_connection(self, record: PublisherRecord) -> list[Event]:
         ctrl = record.msg.ctrl if record.msg is not None else ""
         if ctrl not in ("", self.process_uuid):
@@ -438,4 +442,8 @@ class DiscoveryEngine:
             return []
         if not subscribers:
             self._subscribers.pop(record.topic, None)
+        if not any(process == record.process_uuid for process, _node in subscribers):
+            # Its process no longer subscribes (it left, or is leaving): its SUBSCRIBE is
+            # history, not a subscriber that declined our type (core/diagnosis.py).
+            self._forget_sighting(record.topic, record.process_uuid)
         return [SubscriberRemoved(record.topic, record.process_uuid, record.node_uuid)]

@@ -221,6 +221,23 @@ def test_remote_subscribers_from_new_and_end_connection() -> None:
     assert engine.remote_subscribers(TOPIC) == ()
 
 
+def test_a_subscriber_that_unsubscribes_leaves_no_sighting_behind() -> None:
+    """A typed subscriber that took our type and went (END_CONNECTION) is not one that
+    SUBSCRIBEd and never took it: the explanations called it "did not take ... it expects
+    another message type" for the seconds until its process expired."""
+    engine = DiscoveryEngine(ME, 0.0)
+    engine.advertise(record(ME))
+    engine.datagram_received(datagram(DiscoveryType.SUBSCRIBE, topic=TOPIC), "127.0.0.1", 0.0)
+    assert engine.subscribe_sightings() == {TOPIC: {PEER: "127.0.0.1"}}
+    theirs = PublisherRecord(
+        TOPIC, "a", PEER, PEER_NODE, Scope.ALL, MessagePublisher("gz.msgs.StringMsg", ctrl=ME)
+    )
+    engine.datagram_received(datagram(DiscoveryType.NEW_CONNECTION, pub=theirs), "127.0.0.1", 0.0)
+    ends = DiscoveryEngine(PEER, 0.0).disconnect(TOPIC, PEER_NODE, "a", [ME])
+    engine.datagram_received(ends[0].data, "127.0.0.1", 0.1)
+    assert engine.subscribe_sightings() == {}
+
+
 def test_own_and_foreign_versions_and_garbage_are_dropped() -> None:
     engine = DiscoveryEngine(ME, 0.0)
     assert engine.datagram_received(
