@@ -143,10 +143,10 @@ def _wanted_role(situation: Situation) -> str:
 
 
 def _takes_ours(endpoint: GraphEndpoint, gz_type: str) -> bool:
-    return (
-        endpoint.registered
-        or endpoint.msg_type == GENERIC_TYPE
-        or (bool(endpoint.msg_type) and same_message(endpoint.msg_type, gz_type))
+    """Whether the endpoint takes ``gz_type``: a registration says the type it took, which
+    is another entry's when two of ours share the Gazebo topic (Twist and String on /cmd)."""
+    return endpoint.msg_type == GENERIC_TYPE or (
+        bool(endpoint.msg_type) and same_message(endpoint.msg_type, gz_type)
     )
 
 

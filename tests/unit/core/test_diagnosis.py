@@ -122,6 +122,25 @@ def test_ros_to_gazebo_waits_for_a_registered_subscriber() -> None:
     assert keys(findings(other, HINTS)) == ["gz-type:subscriber:gz.msgs.Vector3d"]
 
 
+def test_a_subscriber_registered_for_another_entry_of_the_topic_is_not_ours() -> None:
+    """Two entries on one Gazebo topic (Twist and String on /cmd): a typed subscriber that
+    registered for the Twist one does not take the String one's messages."""
+    twist_taker = endpoint(SUBSCRIBER, "ignition.msgs.Twist", registered=True)
+    text = situation(
+        Direction.ROS_TO_GZ,
+        ros_type="std_msgs/msg/String",
+        gz_type="gz.msgs.StringMsg",
+        gz_endpoints=[twist_taker],
+    )
+    assert keys(findings(text, HINTS)) == ["gz-type:subscriber:ignition.msgs.Twist"]
+    assert flow(text) is Flow.WAITING_GAZEBO
+    twist = dataclasses.replace(
+        text, ros_type="geometry_msgs/msg/Twist", gz_type="gz.msgs.Twist",
+        gz_subscriber_registered=True,
+    )  # fmt: skip
+    assert findings(twist, HINTS) == []
+
+
 def test_ros_endpoints_of_another_type_or_qos_are_named_even_while_flowing() -> None:
     flowing = situation(
         Direction.GZ_TO_ROS,
