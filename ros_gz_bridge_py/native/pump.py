@@ -126,6 +126,7 @@ class ChannelPump(PumpMember):
             self._reader.remove(self)
             self._reader = None
         self._loop.detach(self)
+        self._count()  # what the loop did after its last turn of the channel (a lazy close)
         self._release()
 
     def wake(self) -> None:
@@ -154,9 +155,7 @@ class ChannelPump(PumpMember):
         refused as too large counted, the counts; then the host's own turn with the frames of
         senders not known yet."""
         handover = self.pump.take_handed() if handed else None
-        received, rate_limited, published = self._deltas("received", "rate_limited", "published")
-        if received:
-            self._counted(received, rate_limited, published)
+        self._count()
         for large in handover.too_large if handover else ():
             self._failed(
                 amplification_error(large.items, "items", large.size, large.items * large.least)
@@ -171,6 +170,12 @@ class ChannelPump(PumpMember):
             broken=broken,
             grown=handover.grown if handover else 0,
         )
+
+    def _count(self) -> None:
+        """What the loop did since it last said, to the channel."""
+        deltas = self._deltas("received", "rate_limited", "published")
+        if any(deltas):
+            self._counted(*deltas)
 
     def _info(self, sender: bytes, msg_type: bytes) -> MessageInfo:
         info = self._infos.get((sender, msg_type))

@@ -122,6 +122,7 @@ class RosChannelPump(PumpMember):
                 return
             self._closed = True
             self._loop.detach(self)
+            self._count()  # what the loop did after its last turn of the channel
             self._release()
 
     def _release(self) -> None:
