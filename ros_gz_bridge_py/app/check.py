@@ -7,38 +7,50 @@ per entry what each side shows and the fix for every cause that keeps it from wo
 Gazebo subscribers show whether they take the type. With ``auto_bridge`` or entries that
 discovery completes, what discovered bridging would bridge (planned half-way through) is
 checked too, each entry with the rule that chose its types. Exit status 1 when an entry cannot
-work.
+work. SIGINT or SIGTERM end the check at once, without a report (exit status 0).
 """
 
 from __future__ import annotations
 
-import time
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, TextIO
 
 from rclpy.qos import QoSProfile
 
+from ros_gz_bridge_py.app.discover import listen
 from ros_gz_bridge_py.config import BridgeSpec, Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Registry
-from ros_gz_bridge_py.core.diagnosis import Finding, RosEndpoint, Situation, findings
+from ros_gz_bridge_py.core.diagnosis import (
+    Finding,
+    RosEndpoint,
+    Situation,
+    findings,
+    takes_ours,
+)
 from ros_gz_bridge_py.core.explain import (
     as_the_graph_shows,
     gazebo_name,
     ros_endpoints,
     type_hints,
 )
-from ros_gz_bridge_py.errors import ConfigError, UnsupportedTypeError
+from ros_gz_bridge_py.errors import ConfigError, TransportError
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.qos import endpoint_qos, gz_to_ros_publisher_qos
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, Publisher
-from ros_gz_bridge_py.transport.api import GraphEndpoint
+from ros_gz_bridge_py.transport.api import PUBLISHER, GraphEndpoint
 
 #: Seconds ``--check`` listens by default: discovery re-announces every second, the ROS graph
 #: settles within about two.
 DEFAULT_SECONDS = 5.0
-#: Step of the ROS spinning while listening.
-_SPIN_STEP = 0.1
+#: What a check stopped by SIGINT or SIGTERM prints instead of its report: the report of a
+#: shorter listen would show as missing what it had no time to hear.
+STOPPED = "Stopped (SIGINT or SIGTERM) before the end of listening: nothing checked"
+#: The source location rcl appends to its messages.
+_RCL_WHERE = re.compile(r", at \S+:\d+$")
+_TILDE_HINT = "; -p expand_gz_topic_names:=true expands '~' in YAML entries as in ROS names"
 
 
 @dataclass(frozen=True)
@@ -67,36 +79,73 @@ def run_check(
     out: TextIO,
     spin_once: Any,
     discovered: Callable[[], Sequence[TopicBridgeSpec]] = list,
+    stop: StopSignal | None = None,
 ) -> int:
     """Listen for ``seconds`` (spinning the ROS node with ``spin_once``), then print one
     report per entry to ``out``; 1 if any cannot work. ``discovered``: the entries discovered
-    bridging would add, asked for half-way through and checked with the others."""
+    bridging would add, asked for half-way through and checked with the others. SIGINT or
+    SIGTERM (``stop``, the executable's) end the check at once without a report, with the
+    status of an interrupted run: 0."""
     gz_node = sides.gz_node
     specs = list(specs)
-    probes: dict[int, Publisher] = {}
-    _announce(gz_node, specs, probes, out)
-    print(
-        f"Listening for {seconds:g} s: Gazebo ({gz_node.listening()}) and the ROS graph ...",
-        file=out,
-        flush=True,
-    )
-    deadline = time.monotonic() + seconds
-    asked = False
-    while time.monotonic() < deadline:
-        spin_once(timeout_sec=_SPIN_STEP)
-        if not asked and time.monotonic() > deadline - seconds / 2:
+    probes: dict[int, Publisher | None] = {}
+    try:
+        _announce(gz_node, specs, probes, out)
+        print(
+            f"Listening for {seconds:g} s: Gazebo ({gz_node.listening()}) and the ROS graph ...",
+            file=out,
+            flush=True,
+        )
+        listened = listen(seconds / 2, spin_once, stop)
+        if listened:
             gz_node.ask_subscribers()
-            asked = True
             specs += discovered()
             _announce(gz_node, specs, probes, out)
+            listened = listen(seconds / 2, spin_once, stop)
+        if not listened:
+            print(STOPPED, file=out)
+            return 0
+        reports = _reports(sides, specs, probes)
+    finally:
+        for probe in probes.values():
+            if probe is not None:
+                probe.close()
+    return _print_reports(reports, out)
+
+
+def _announce(
+    gz_node: GzNode, specs: Sequence[BridgeSpec], probes: dict[int, Publisher | None], out: TextIO
+) -> None:
+    """Announce to Gazebo the ROS->Gazebo entries not yet in ``probes`` (None: it failed)."""
+    for index, spec in enumerate(specs):
+        if (
+            isinstance(spec, TopicBridgeSpec)
+            and spec.direction is not Direction.GZ_TO_ROS
+            and index not in probes
+        ):
+            try:
+                probe = gz_node.advertise(spec.gz_topic, spec.gz_type)
+            except Exception as err:  # a bad name: reported with the entry below
+                probe = None
+                print(f"cannot announce {spec.gz_topic}: {err}", file=out)
+            probes[index] = probe
+
+
+def _reports(
+    sides: Sides, specs: Sequence[BridgeSpec], probes: dict[int, Publisher | None]
+) -> list[EntryReport]:
+    gz_topics = _other_topics(sides.gz_node)
     reports: list[EntryReport] = []
     for index, spec in enumerate(specs):
         if isinstance(spec, ServiceBridgeSpec):
-            reports.append(_service_report(gz_node, sides.registry, spec))
+            reports.append(_service_report(sides.gz_node, sides.registry, spec))
         else:
-            reports += _topic_reports(sides, spec, probes.get(index))
-    for probe in probes.values():
-        probe.close()
+            reports += _topic_reports(sides, spec, probes.get(index), gz_topics)
+    return reports
+
+
+def _print_reports(reports: Sequence[EntryReport], out: TextIO) -> int:
+    """Print ``reports`` and their count; 1 if any has a problem."""
     for report in reports:
         _print_report(report, out)
     failing = sum(1 for report in reports if report.problems)
@@ -106,22 +155,6 @@ def run_check(
         file=out,
     )
     return 1 if failing else 0
-
-
-def _announce(
-    gz_node: GzNode, specs: Sequence[BridgeSpec], probes: dict[int, Publisher], out: TextIO
-) -> None:
-    """Announce to Gazebo the ROS->Gazebo entries not yet in ``probes``."""
-    for index, spec in enumerate(specs):
-        if (
-            isinstance(spec, TopicBridgeSpec)
-            and spec.direction is not Direction.GZ_TO_ROS
-            and index not in probes
-        ):
-            try:
-                probes[index] = gz_node.advertise(spec.gz_topic, spec.gz_type)
-            except Exception as err:  # a bad name: reported with the entry below
-                print(f"cannot announce {spec.gz_topic}: {err}", file=out)
 
 
 def _print_report(report: EntryReport, out: TextIO) -> None:
@@ -134,8 +167,42 @@ def _print_report(report: EntryReport, out: TextIO) -> None:
         print("  ok: messages can flow", file=out)
 
 
+def _other_topics(gz_node: GzNode) -> list[str]:
+    """The topics other processes publish in the node's partition, those a "similar topics"
+    hint may name (``topic_list`` holds the check's own announcements too)."""
+    partition = gz_node.partition.strip("/")
+    return sorted(
+        {
+            endpoint.topic
+            for endpoint in gz_node.graph()
+            if endpoint.role == PUBLISHER and endpoint.partition.strip("/") == partition
+        }
+    )
+
+
+def _resolved_names(sides: Sides, spec: TopicBridgeSpec) -> tuple[str, str, str]:
+    """(ROS topic, Gazebo partition, Gazebo topic) as the bridge resolves ``spec``'s names.
+
+    Raises:
+        ConfigError: a name its side refuses, said as a normal run says it.
+    """
+    try:
+        ros_topic = str(sides.ros_node.resolve_topic_name(spec.ros_topic))
+    except RuntimeError as err:  # rclpy's RCLError
+        reason = _RCL_WHERE.sub("", str(err))
+        msg = f"invalid ROS topic name {spec.ros_topic!r}: {reason}"
+        raise ConfigError(msg) from None
+    try:
+        partition, name = gazebo_name(sides.gz_node, spec.gz_topic)
+    except TransportError as err:
+        hint = _TILDE_HINT if spec.gz_topic.startswith("~") else ""
+        msg = f"{err}{hint}"
+        raise ConfigError(msg) from None
+    return ros_topic, partition, name
+
+
 def _topic_reports(
-    sides: Sides, spec: TopicBridgeSpec, probe: Publisher | None
+    sides: Sides, spec: TopicBridgeSpec, probe: Publisher | None, gz_topics: Sequence[str]
 ) -> list[EntryReport]:
     ros_node, gz_node, registry = sides.ros_node, sides.gz_node, sides.registry
     own = {(ros_node.get_name(), ros_node.get_namespace())}
@@ -144,7 +211,8 @@ def _topic_reports(
         where = f" ({spec.source}, discovered: {spec.discovered_by})"
     try:
         registry.layouts(spec.ros_type, spec.gz_type)
-    except UnsupportedTypeError as err:
+        ros_topic, partition, name = _resolved_names(sides, spec)
+    except ConfigError as err:  # an unsupported pair of types, or an invalid name
         title = f"{spec.ros_topic} <-> {spec.gz_topic}{where}"
         return [EntryReport(title, (), (str(err.message),))]
     directions = [
@@ -152,8 +220,6 @@ def _topic_reports(
         for d in (Direction.GZ_TO_ROS, Direction.ROS_TO_GZ)
         if spec.direction in (d, Direction.BIDIRECTIONAL)
     ]
-    ros_topic = str(ros_node.resolve_topic_name(spec.ros_topic))
-    partition, name = gazebo_name(gz_node, spec.gz_topic)
     gz_endpoints = gz_node.observe(spec.gz_topic)
     reports = []
     for direction in directions:
@@ -171,7 +237,7 @@ def _topic_reports(
             gz_peers=gz_node.peer_processes(),
             listening=gz_node.listening(),
             gz_subscriber_registered=probe is not None and bool(probe.wire_types()),
-            gz_topics=gz_node.topic_list(),
+            gz_topics=gz_topics,
             discovered_by=spec.discovered_by,
         )
         arrow = (
@@ -199,12 +265,12 @@ def _gazebo_lines(situation: Situation, direction: Direction) -> list[str]:
     relevant = [e for e in situation.gz_endpoints if e.role == role]
     if not relevant:
         return [f"Gazebo: no {role} of {situation.gz_topic} in any partition"]
-    return [f"Gazebo: {_describe_gz(e)}" for e in relevant]
+    return [f"Gazebo: {_describe_gz(e, situation.gz_type)}" for e in relevant]
 
 
-def _describe_gz(endpoint: GraphEndpoint) -> str:
+def _describe_gz(endpoint: GraphEndpoint, gz_type: str) -> str:
     kind = endpoint.msg_type or "type not announced"
-    taken = ", takes ours" if endpoint.registered else ""
+    taken = ", takes ours" if endpoint.registered and takes_ours(endpoint, gz_type) else ""
     where = f" at {endpoint.location}" if endpoint.location else ""
     return (
         f"{endpoint.role} ({kind}{taken}), partition '{endpoint.partition}', "

@@ -6,7 +6,8 @@ discovery completes, explicit entries left out) and prints a YAML file on standa
 entry per topic, for the user to edit and commit. Logs go to standard error, so
 ``parameter_bridge --discover > bridge.yaml`` writes a file ``config_file`` takes as it is.
 Entries whose types were inferred from a ROS publisher (the Gazebo subscribers told none) carry
-a comment that says so: the Gazebo side was not seen to take that type.
+a comment that says so: the Gazebo side was not seen to take that type. SIGINT or SIGTERM end
+the listening at once; the YAML then holds what was heard until then.
 """
 
 from __future__ import annotations
@@ -19,10 +20,13 @@ from typing import TextIO
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.core.discovery_plan import BY_ROS_PUBLISHER
 from ros_gz_bridge_py.msgs.names import canonical_type
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 #: Seconds ``--discover`` listens by default: every peer re-announces within a second, and
 #: discovery counts as complete after two (docs/protocol-zmq-discovery.md §2.5).
 DEFAULT_SECONDS = 5.0
+#: Longest wait between two looks at the stop request: SIGINT and SIGTERM end within it.
+_STEP = 0.1
 
 #: Comments on the QoS of some ROS types and names, written above their entries.
 _HINTS_BY_NAME = {
@@ -40,14 +44,18 @@ _SENSOR_HINT = (
 )
 
 
-def listen(seconds: float, spin_once: object = None) -> None:
-    """Wait ``seconds`` (spinning ROS with ``spin_once(timeout_sec=...)`` when given)."""
+def listen(seconds: float, spin_once: object = None, stop: StopSignal | None = None) -> bool:
+    """Wait ``seconds`` (spinning ROS with ``spin_once(timeout_sec=...)`` when given), or less
+    when ``stop`` (the executable's SIGINT and SIGTERM) is requested: False then."""
     deadline = time.monotonic() + seconds
     while (remaining := deadline - time.monotonic()) > 0:
+        if stop is not None and stop.requested:
+            return False
         if callable(spin_once):
-            spin_once(timeout_sec=min(0.1, remaining))
+            spin_once(timeout_sec=min(_STEP, remaining))
         else:
-            time.sleep(min(0.1, remaining))
+            time.sleep(min(_STEP, remaining))
+    return stop is None or not stop.requested
 
 
 def write_yaml(specs: Sequence[TopicBridgeSpec], header: Sequence[str], out: TextIO) -> None:

@@ -140,10 +140,10 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 return 0
             if check_seconds is not None:
                 finish_start_up(node)
-                return check(node, cli, params, switches, check_seconds, values=values)
+                return check(node, cli, params, switches, check_seconds, values=values, stop=stop)
             if discover_seconds is not None:
                 finish_start_up(node)
-                return discover_yaml(node, cli, params, discover_seconds, values)
+                return discover_yaml(node, cli, params, discover_seconds, values, stop=stop)
             bridge, discovered = build_bridge(node, cli, params, switches, values)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
             one_cpu = start_one_cpu(node, bridge.carries_bulk, switches.one_cpu)
@@ -187,7 +187,7 @@ def split_seconds_option(
     """(``option``'s seconds or None, the other arguments): ``option [SECONDS]`` anywhere.
 
     Raises:
-        UsageError: the seconds are not a positive number.
+        UsageError: the seconds are not a finite number > 0.
     """
     rest = list(args)
     if option not in rest:
@@ -207,8 +207,8 @@ def split_seconds_option(
             seconds = float(text)
         except ValueError:
             seconds = -1.0
-        if not seconds > 0:
-            msg = f"{option} takes a number of seconds > 0 to listen for, not {text!r}"
+        if not 0 < seconds < float("inf"):  # nan and inf too: inf would never end
+            msg = f"{option} takes a number of seconds > 0 to listen for (finite), not {text!r}"
             raise UsageError(msg, f"argument '{option} {text}'")
     return seconds, rest
 
@@ -221,8 +221,10 @@ def check(
     seconds: float,
     *,
     values: templates.Placeholders,
+    stop: StopSignal,
 ) -> int:
-    """``--check``: report on every entry without bridging (:mod:`ros_gz_bridge_py.app.check`)."""
+    """``--check``: report on every entry without bridging (:mod:`ros_gz_bridge_py.app.check`);
+    ``stop`` ends its listening early."""
     sources = collect_sources(node, cli, params, values)
     specs = [spec for source in sources for spec in source.specs]
     errors = sum(len(source.errors) for source in sources)
@@ -249,7 +251,7 @@ def check(
         sides = Sides(node, gz_node, default_registry())
         status = run_check(
             sides, specs, seconds, out=sys.stdout, spin_once=executor.spin_once,
-            discovered=discovered,
+            discovered=discovered, stop=stop,
         )  # fmt: skip
     if errors:
         print(f"{errors} configuration entries could not be read (see the errors above)")
@@ -262,18 +264,21 @@ def discover_yaml(
     params: ParameterBridgeParameters,
     seconds: float,
     values: templates.Placeholders,
+    *,
+    stop: StopSignal,
 ) -> int:
     """``--discover``: print the YAML of what discovered bridging would bridge (``discover.py``);
-    1 when a configuration entry could not be read."""
+    1 when a configuration entry could not be read. ``stop`` ends its listening early: the YAML
+    then holds what was heard until then."""
     sources = collect_sources(node, cli, params, values)
     explicit = [spec for source in sources for spec in source.specs]
     patterns = [pattern for source in sources for pattern in source.patterns]
     rules = discovery_rules(node, params, enabled=True)
     with create_gz_node(params.shared.gz_node_options()) as gz_node:
         node.get_logger().info(f"Listening to Gazebo discovery for {seconds:g} s ...")
-        discover.listen(seconds / 2)
-        gz_node.ask_subscribers()  # gz-transport 13+ list their subscriptions with types
-        discover.listen(seconds / 2)
+        if discover.listen(seconds / 2, stop=stop):
+            gz_node.ask_subscribers()  # gz-transport 13+ list their subscriptions with types
+            discover.listen(seconds / 2, stop=stop)
         found, wanted = discovered_plan(node, gz_node, explicit, patterns, rules)
         listening = gz_node.listening()
     for topic, why in wanted.skipped.items():

@@ -142,7 +142,7 @@ def _wanted_role(situation: Situation) -> str:
     return PUBLISHER if situation.direction is Direction.GZ_TO_ROS else SUBSCRIBER
 
 
-def _takes_ours(endpoint: GraphEndpoint, gz_type: str) -> bool:
+def takes_ours(endpoint: GraphEndpoint, gz_type: str) -> bool:
     """Whether the endpoint takes ``gz_type``: a registration says the type it took, which
     is another entry's when two of ours share the Gazebo topic (Twist and String on /cmd)."""
     return endpoint.msg_type == GENERIC_TYPE or (
@@ -193,7 +193,7 @@ def _gazebo_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
 
 
 def _other_type(endpoint: GraphEndpoint, situation: Situation) -> bool:
-    return bool(endpoint.msg_type) and not _takes_ours(endpoint, situation.gz_type)
+    return bool(endpoint.msg_type) and not takes_ours(endpoint, situation.gz_type)
 
 
 def _type_finding(situation: Situation, hints: TypeHints, endpoint: GraphEndpoint) -> Finding:

@@ -1,16 +1,22 @@
-"""``parameter_bridge --discover``: its argument, and the YAML it writes reads back as the same
-bridges (the end-to-end run is in tests/bridge/test_discovered_e2e.py)."""
+"""``parameter_bridge --discover``: its argument, its listening's end at SIGINT, and the YAML it
+writes reads back as the same bridges (the end-to-end run is in
+tests/bridge/test_discovered_e2e.py)."""
 
 from __future__ import annotations
 
 import io
+import os
+import signal
+import threading
+import time
 
 import pytest
 
-from ros_gz_bridge_py.app.discover import header_lines, write_yaml
+from ros_gz_bridge_py.app.discover import header_lines, listen, write_yaml
 from ros_gz_bridge_py.app.parameter_bridge import DISCOVER_OPTION, split_seconds_option
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec, UsageError, parse_yaml
 from ros_gz_bridge_py.core.discovery_plan import AUTO_SOURCE, BY_ROS_PUBLISHER
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 SPECS = [
     TopicBridgeSpec(
@@ -82,3 +88,27 @@ def test_the_discover_option_takes_optional_seconds() -> None:
     )
     with pytest.raises(UsageError, match="--discover takes a number of seconds > 0"):
         split_seconds_option(["--discover", "soon"], DISCOVER_OPTION, 5.0)
+
+
+@pytest.mark.parametrize("text", ["inf", "Infinity", "nan", "-inf", "0"])
+def test_the_seconds_are_a_finite_number_above_0(text: str) -> None:
+    with pytest.raises(UsageError, match=f"a number of seconds > 0 .*, not '{text}'"):
+        split_seconds_option(["--discover", text], DISCOVER_OPTION, 5.0)
+
+
+def test_listening_ends_at_sigint_when_a_stop_signal_is_installed() -> None:
+    interrupt = threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT))
+    with StopSignal() as stop:
+        started = time.monotonic()
+        interrupt.start()
+        listened = listen(30.0, stop=stop)
+        took = time.monotonic() - started
+        interrupt.join()
+    assert listened is False
+    assert took < 1.0
+
+
+def test_listening_runs_its_time_without_a_stop_request() -> None:
+    started = time.monotonic()
+    assert listen(0.3) is True
+    assert time.monotonic() - started >= 0.3
