@@ -32,6 +32,7 @@ from ros_gz_bridge_py.core.diagnosis import (
 from ros_gz_bridge_py.core.explain import (
     as_the_graph_shows,
     gazebo_name,
+    published_by_others,
     ros_endpoints,
     type_hints,
 )
@@ -40,7 +41,7 @@ from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.qos import endpoint_qos, gz_to_ros_publisher_qos
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, Publisher
-from ros_gz_bridge_py.transport.api import PUBLISHER, GraphEndpoint
+from ros_gz_bridge_py.transport.api import GraphEndpoint
 
 #: Seconds ``--check`` listens by default: discovery re-announces every second, the ROS graph
 #: settles within about two.
@@ -134,7 +135,7 @@ def _announce(
 def _reports(
     sides: Sides, specs: Sequence[BridgeSpec], probes: dict[int, Publisher | None]
 ) -> list[EntryReport]:
-    gz_topics = _other_topics(sides.gz_node)
+    gz_topics = published_by_others(sides.gz_node)
     reports: list[EntryReport] = []
     for index, spec in enumerate(specs):
         if isinstance(spec, ServiceBridgeSpec):
@@ -165,19 +166,6 @@ def _print_report(report: EntryReport, out: TextIO) -> None:
         print(f"  PROBLEM: {problem}", file=out)
     if not report.problems:
         print("  ok: messages can flow", file=out)
-
-
-def _other_topics(gz_node: GzNode) -> list[str]:
-    """The topics other processes publish in the node's partition, those a "similar topics"
-    hint may name (``topic_list`` holds the check's own announcements too)."""
-    partition = gz_node.partition.strip("/")
-    return sorted(
-        {
-            endpoint.topic
-            for endpoint in gz_node.graph()
-            if endpoint.role == PUBLISHER and endpoint.partition.strip("/") == partition
-        }
-    )
 
 
 def _resolved_names(sides: Sides, spec: TopicBridgeSpec) -> tuple[str, str, str]:

@@ -31,7 +31,7 @@ from ros_gz_bridge_py.core.diagnosis import (
 )
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.transport import GzNode
-from ros_gz_bridge_py.transport.api import GraphEndpoint
+from ros_gz_bridge_py.transport.api import PUBLISHER, GraphEndpoint
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 
 #: Seconds between two evaluations of every channel.
@@ -92,6 +92,19 @@ def ros_endpoints(
         problem = qos_errors(reason) if compatibility == QoSCompatibility.ERROR else ""
         found.append(RosEndpoint(node, info.topic_type, problem, describe_qos(info.qos_profile)))
     return found
+
+
+def published_by_others(gz_node: GzNode) -> list[str]:
+    """The topics other processes publish in the node's partition: those a "similar topics"
+    hint may name (``topic_list`` has the bridge's own too)."""
+    partition = gz_node.partition.strip("/")
+    return sorted(
+        {
+            endpoint.topic
+            for endpoint in gz_node.graph()
+            if endpoint.role == PUBLISHER and endpoint.partition.strip("/") == partition
+        }
+    )
 
 
 def qos_errors(reason: str) -> str:
@@ -207,7 +220,7 @@ class Explainer:
                 self._ask_subscribers(now)
             found = findings(situation, self._hints)
             if any(f.key.startswith("gz-absent") for f in found):
-                topics = self._gz.topic_list() if topics is None else topics
+                topics = published_by_others(self._gz) if topics is None else topics
                 situation = dataclasses.replace(situation, gz_topics=topics)
                 found = findings(situation, self._hints)
             channel.flow = flow(situation)

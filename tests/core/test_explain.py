@@ -217,6 +217,7 @@ def test_no_gazebo_at_all_is_said_once_for_the_bridge(rig: Rig) -> None:
 def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> None:
     stem = f"odom_{uuid.uuid4().hex[:8]}"
     channel = gz_to_ros(rig.add(string_spec(f"/{stem}", Direction.GZ_TO_ROS)))
+    rig.add(string_spec(f"/{stem}_cmd", Direction.ROS_TO_GZ))  # the bridge's own: not suggested
     rig.gazebo().advertise(f"/robot/{stem}", STRING)
     Judge(rig).evaluate()
     assert texts(channel) == [
@@ -224,7 +225,7 @@ def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> N
         f"(1 Gazebo processes heard); similar topics: /robot/{stem}"
     ]
     # A side that is not there yet is explained, not warned about.
-    (status,) = StatusTracker(rig.bridge).snapshot()
+    status = StatusTracker(rig.bridge).snapshot()[0]
     assert (status.level, status.message()) == (OK, f"waiting for Gazebo: {texts(channel)[0]}")
 
 
