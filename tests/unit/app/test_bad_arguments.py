@@ -26,7 +26,9 @@ MISPLACED = "put {program}'s own arguments before --ros-args, or after a -- that
 
 
 def run(program: str, *args: str, env: dict[str, str] | None = None) -> tuple[int, list[str]]:
-    """(exit status, the lines on stderr but rcl's warnings about ROS_LOCALHOST_ONLY)."""
+    """(exit status, the lines on stderr but rcl's warnings about ROS_LOCALHOST_ONLY and the
+    bridge's INFO lines: on a busy machine it may first say that it removed the shared-memory
+    segments of processes killed before it)."""
     done = subprocess.run(
         [str(BIN / program), *args],
         capture_output=True,
@@ -35,7 +37,9 @@ def run(program: str, *args: str, env: dict[str, str] | None = None) -> tuple[in
         check=False,
         env={**os.environ, **(env or {})},
     )
-    lines = [line for line in done.stderr.splitlines() if "[rcl]:" not in line]
+    lines = [
+        line for line in done.stderr.splitlines() if "[rcl]:" not in line and "[INFO]" not in line
+    ]
     return done.returncode, lines
 
 
