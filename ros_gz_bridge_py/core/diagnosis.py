@@ -263,13 +263,19 @@ def _no_peer_finding(situation: Situation) -> Finding:
     )
 
 
+def _heard(processes: int) -> str:
+    """How many Gazebo processes discovery hears, whatever their partition."""
+    counted = "1 Gazebo process" if processes == 1 else f"{processes} Gazebo processes"
+    return f"{counted} heard in any partition"
+
+
 def _absent_finding(situation: Situation, role: str) -> Finding:
     similar = _similar_topics(situation.gz_topic, situation.gz_topics)
     hint = f"; similar topics: {', '.join(similar)}" if similar else ""
     return Finding(
         f"gz-absent:{role}",
         f"no Gazebo {role} of {situation.gz_topic} in partition '{situation.partition}' "
-        f"({situation.gz_peers} Gazebo processes heard){hint}",
+        f"({_heard(situation.gz_peers)}){hint}",
         fault=False,
     )
 

@@ -152,7 +152,9 @@ def wait_for_counters(setup: Setup, name: str, expected: tuple[int, int, int]) -
 
 def heard_gazebo(status: Any) -> bool:
     """The explainer judged the channel while the bridge heard a Gazebo process."""
-    heard = re.search(r"\((\d+) Gazebo processes heard\)", values(status)["why"])
+    heard = re.search(
+        r"\((\d+) Gazebo process(es)? heard in any partition\)", values(status)["why"]
+    )
     return heard is not None and int(heard.group(1)) > 0
 
 

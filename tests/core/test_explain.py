@@ -222,7 +222,7 @@ def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> N
     Judge(rig).evaluate()
     assert texts(channel) == [
         f"no Gazebo publisher of /{stem} in partition '{rig.gz.partition}' "
-        f"(1 Gazebo processes heard); similar topics: /robot/{stem}"
+        f"(1 Gazebo process heard in any partition); similar topics: /robot/{stem}"
     ]
     # A side that is not there yet is explained, not warned about.
     status = StatusTracker(rig.bridge).snapshot()[0]

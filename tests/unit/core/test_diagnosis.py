@@ -95,7 +95,7 @@ def test_no_peer_is_no_fault_before_discovery_listened_long_enough() -> None:
     (finding,) = findings(early, HINTS)
     assert finding.key == "gz-absent:publisher"
     assert not finding.fault
-    assert "(0 Gazebo processes heard)" in finding.text
+    assert "(0 Gazebo processes heard in any partition)" in finding.text
     assert flow(early) is Flow.WAITING_GAZEBO
     (settled,) = findings(dataclasses.replace(early, peers_settled=True), HINTS)
     assert (settled.key, settled.fault) == ("no-peer", True)
