@@ -46,3 +46,15 @@ def ros_context() -> Iterator[Any]:
         yield context
     finally:
         rclpy.try_shutdown(context=context)
+
+
+@pytest.fixture
+def network() -> Iterator[Any]:
+    """An in-memory Gazebo network of the test's own; its nodes are closed after it. Imported
+    here, as rclpy above, once the environment is set."""
+    from ros_gz_bridge_py.transport.memory.network import MemoryNetwork  # noqa: PLC0415
+
+    network = MemoryNetwork()
+    yield network
+    for node in list(network.nodes):
+        node.close()

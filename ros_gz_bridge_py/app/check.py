@@ -12,7 +12,6 @@ work. SIGINT or SIGTERM end the check at once, without a report (exit status 0).
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, TextIO
@@ -20,6 +19,7 @@ from typing import Any, TextIO
 from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.app.discover import listen
+from ros_gz_bridge_py.app.settings import RCL_SOURCE_LOCATION
 from ros_gz_bridge_py.config import BridgeSpec, Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Registry
 from ros_gz_bridge_py.core.diagnosis import (
@@ -49,8 +49,6 @@ DEFAULT_SECONDS = 5.0
 #: What a check stopped by SIGINT or SIGTERM prints instead of its report: the report of a
 #: shorter listen would show as missing what it had no time to hear.
 STOPPED = "Stopped (SIGINT or SIGTERM) before the end of listening: nothing checked"
-#: The source location rcl appends to its messages.
-_RCL_WHERE = re.compile(r", at \S+:\d+$")
 _TILDE_HINT = "; -p expand_gz_topic_names:=true expands '~' in YAML entries as in ROS names"
 
 
@@ -177,7 +175,7 @@ def _resolved_names(sides: Sides, spec: TopicBridgeSpec) -> tuple[str, str, str]
     try:
         ros_topic = str(sides.ros_node.resolve_topic_name(spec.ros_topic))
     except RuntimeError as err:  # rclpy's RCLError
-        reason = _RCL_WHERE.sub("", str(err))
+        reason = RCL_SOURCE_LOCATION.sub("", str(err))
         msg = f"invalid ROS topic name {spec.ros_topic!r}: {reason}"
         raise ConfigError(msg) from None
     try:

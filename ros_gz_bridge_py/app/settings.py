@@ -411,7 +411,7 @@ _ROS_ARGUMENT_FIXES = (
 )
 _ROS_ARGUMENTS_GUIDE = "see 'Passing ROS arguments to nodes' in the ROS 2 documentation"
 #: Where in rcl's C sources an error was raised (", at /src/rcl/arguments.c:352").
-_SOURCE_LOCATION = re.compile(r", at \S+:\d+")
+RCL_SOURCE_LOCATION = re.compile(r", at \S+:\d+")
 
 
 def ros_arguments_problem(program: str, argv: Sequence[str]) -> str:
@@ -439,6 +439,6 @@ def ros_arguments_problem(program: str, argv: Sequence[str]) -> str:
 def _rcl_reason(message: str) -> str:
     """rcl's ``message`` without its prefix and source locations, and for a rule without the
     state of rcl's lexer, which names nothing the user wrote."""
-    reason = _SOURCE_LOCATION.sub("", message).removeprefix("Failed to parse ROS arguments: ")
+    reason = RCL_SOURCE_LOCATION.sub("", message).removeprefix("Failed to parse ROS arguments: ")
     head = reason.partition(". Error: ")[0]
     return (head if " rule: " in head else reason).rstrip(".")

@@ -29,14 +29,6 @@ LISTEN = 0.2
 
 
 @pytest.fixture
-def network() -> Iterator[MemoryNetwork]:
-    network = MemoryNetwork()
-    yield network
-    for node in list(network.nodes):
-        node.close()
-
-
-@pytest.fixture
 def sides(ros_context: Any, network: MemoryNetwork) -> Iterator[Sides]:
     import rclpy  # noqa: PLC0415 - rclpy is loaded by the tests that need it only
 

@@ -11,7 +11,6 @@ message once, in the spelling each line takes (§9.2). What every backend shares
 from __future__ import annotations
 
 import uuid
-from collections.abc import Iterator
 
 import pytest
 
@@ -35,14 +34,6 @@ class Inbox:
 
 def topic() -> str:
     return f"/memory_{uuid.uuid4().hex[:8]}"
-
-
-@pytest.fixture
-def network() -> Iterator[MemoryNetwork]:
-    network = MemoryNetwork()
-    yield network
-    for node in list(network.nodes):
-        node.close()
 
 
 def test_a_native_node_announces_and_asks_for_its_own_spelling(network: MemoryNetwork) -> None:
