@@ -172,10 +172,8 @@ def test_closing_answers_the_waiting_calls(make_rig: Callable[..., Rig], world: 
     wait_until(client.service_is_ready, f"the service {service}")
     future = world.run(lambda: client.call_async(control_request()))
     wait_until(lambda: bridge.waiting == 1, "the call waiting for Gazebo")
-    started = time.monotonic()
     world.run(rig.bridge.close)
-    wait_until(future.done, "the waiting call's answer")
-    assert time.monotonic() - started < 5.0
+    wait_until(future.done, "the waiting call's answer")  # within WAIT, well before the 30 s
     assert future.result().success is False
     assert bridge.failures_by_reason == {"shutting down": 1}
     rig.gz.close()  # ends the call Gazebo never answered
