@@ -134,7 +134,9 @@ def as_bool(key: str, value: object) -> bool:
 
 #: The deepest ``publisher_queue``/``subscriber_queue``. A channel's native queue allocates a
 #: slot per message of its ROS depth when it starts, and ``native/pump.c`` refuses more than
-#: ``1 << 24`` slots; a deeper ROS history would only reserve memory nobody reads.
+#: ``1 << 24`` slots; a deeper ROS history would only reserve memory nobody reads. A deeper
+#: ``qos_overrides`` depth (rclpy applies those) keeps its ROS history, and the channel's queue
+#: stops at this bound (``core.channel.delivery_capacity``).
 MAX_QUEUE_DEPTH = 1 << 24
 
 

@@ -41,6 +41,7 @@ from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.bulk.path import BulkPath
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.config.model import MAX_QUEUE_DEPTH
 from ros_gz_bridge_py.config.names import renamed
 from ros_gz_bridge_py.converters.registry import Pair
 from ros_gz_bridge_py.core.diagnosis import Finding, Flow
@@ -57,6 +58,13 @@ ERROR_LOG_PERIOD = 5.0
 #: Fewest messages a Gazebo->ROS delivery queue holds: ZeroMQ's default high-water mark, so
 #: 200 ms at 5 kHz (measured: with 100, a 5 kHz Odometry channel dropped 5-9% on 2 busy cores).
 MIN_DELIVERY_QUEUE = 1000
+
+
+def delivery_capacity(depth: int) -> int:
+    """The messages a channel's delivery queue holds for a ROS endpoint of ``depth``: at least
+    :data:`MIN_DELIVERY_QUEUE`, at most ``MAX_QUEUE_DEPTH`` (a ``qos_overrides.*.depth``
+    deeper than that keeps its ROS history; the bridge's own queue stops there)."""
+    return min(max(depth, MIN_DELIVERY_QUEUE), MAX_QUEUE_DEPTH)
 
 
 #: What a warning about each kind of error adds: where to look.

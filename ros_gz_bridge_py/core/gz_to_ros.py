@@ -24,7 +24,7 @@ from ros_gz_bridge_py.bulk.path import gz_to_ros_cdr
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.census import census_for
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext
+from ros_gz_bridge_py.core.channel import Channel, ChannelContext, delivery_capacity
 from ros_gz_bridge_py.errors import ConversionError, UndecodableError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.native.channel import native_programs
@@ -140,7 +140,7 @@ class GzToRosChannel(Channel):
                 topic=self.ctx.gz_node.fqn(self.spec.gz_topic),
                 publisher=self._publisher,
                 programs=self._programs,
-                capacity=max(self._qos.depth, MIN_DELIVERY_QUEUE),
+                capacity=delivery_capacity(self._qos.depth),
                 max_bytes=self.ctx.options.max_queued_bytes,
                 max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
                 refused=self._convert_and_publish,
@@ -174,7 +174,7 @@ class GzToRosChannel(Channel):
             self._publisher = None
 
     def _open_input(self) -> None:
-        depth = max(self._qos.depth, MIN_DELIVERY_QUEUE)
+        depth = delivery_capacity(self._qos.depth)
         bulk = self.bulk is not None
         self._subscription = self.ctx.gz_node.subscribe(
             self.spec.gz_topic,

@@ -18,7 +18,7 @@ from rclpy.serialization import deserialize_message
 from ros_gz_bridge_py.bulk.path import ros_cdr_to_gz
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Pair
-from ros_gz_bridge_py.core.channel import MIN_DELIVERY_QUEUE, Channel, ChannelContext, ChannelState
+from ros_gz_bridge_py.core.channel import Channel, ChannelContext, ChannelState, delivery_capacity
 from ros_gz_bridge_py.native.abi import rmw_layout_fits, ros_functions
 from ros_gz_bridge_py.native.channel import native_encoders
 from ros_gz_bridge_py.native.ros_pump import RosChannelPump
@@ -150,7 +150,7 @@ class RosToGzChannel(Channel):
             encoders=self._encoders,
             max_rate=1.0 / self._limiter.period if self._limiter is not None else 0.0,
             refused=self._convert_and_publish,
-            capacity=max(self._qos.depth, MIN_DELIVERY_QUEUE),
+            capacity=delivery_capacity(self._qos.depth),
             max_bytes=self.ctx.options.max_queued_bytes,
             counted=self._counted,
             lost=self._lost,

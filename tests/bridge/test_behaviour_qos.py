@@ -15,8 +15,10 @@ from typing import Any
 import pytest
 from geometry_msgs.msg import PoseStamped
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 
+from ros_gz_bridge_py.config.model import MAX_QUEUE_DEPTH
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.transport import GzNode
 from testing.behaviour_harness import (
@@ -49,7 +51,8 @@ LAST_X = 1000.0
 @pytest.fixture(scope="module")
 def qos_topics(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]]:
     require_peer()
-    topics = {key: unique_name(f"qos_{key}") for key in ("best_effort", "reliable", "frame")}
+    keys = ("best_effort", "reliable", "frame", "deep")
+    topics = {key: unique_name(f"qos_{key}") for key in keys}
     topics["yaml_frame"] = unique_name("qos_yaml_frame")
     config = Path(tmp_path_factory.mktemp("qos") / "frames.yaml")
     config.write_text(
@@ -64,13 +67,15 @@ def qos_topics(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, s
         f"{topics['best_effort']}@std_msgs/msg/String[{STRING}",
         f"{topics['reliable']}@std_msgs/msg/String[{STRING}",
         f"{topics['frame']}@geometry_msgs/msg/PoseStamped[{POSE}",
+        f"{topics['deep']}@std_msgs/msg/String[{STRING}",
         ros_args=[
             "-p", f"qos_overrides.{topics['best_effort']}.publisher.reliability:=best_effort",
+            "-p", f"qos_overrides.{topics['deep']}.publisher.depth:={MAX_QUEUE_DEPTH + 1}",
             "-p", f"override_frame_id:={OVERRIDE_FRAME}",
             "-p", "override_timestamps_with_wall_time:=true",
             "-p", f"config_file:={config}",
         ],
-        creating=5,
+        creating=6,
     )  # fmt: skip
     yield topics
     bridge.stop()
@@ -170,6 +175,24 @@ def test_qos_override_parameter_sets_the_publisher_reliability(
     reliable = endpoint_qos(ros_side, qos_topics["reliable"])
     assert reliable.reliability == ReliabilityPolicy.RELIABLE
     assert reliable.durability == DurabilityPolicy.VOLATILE
+
+
+def test_a_publisher_depth_deeper_than_the_bridge_queue_still_carries(
+    qos_topics: dict[str, str], ros_side: RosSide, gz_node: GzNode
+) -> None:
+    """The ROS history takes the override; the bridge's own queue stops at MAX_QUEUE_DEPTH
+    (the channel was refused with the native queue's 'capacity out of range' before)."""
+    topic = qos_topics["deep"]
+    publisher = gz_node.advertise(topic, STRING)
+    inbox, subscription = ros_side.subscribe(String, topic)
+    try:
+        wait_until(publisher.has_connections, WAIT, f"the bridge's subscription to {topic}")
+        publish_until(lambda _: publisher.publish(message_class(STRING)(data="deep")),
+                      lambda: bool(inbox.items()), f"{topic} arrives")  # fmt: skip
+        assert inbox.items()[0][0].data == "deep"
+    finally:
+        ros_side.destroy(subscription)
+        publisher.close()
 
 
 @pytest.mark.parametrize(("key", "frame"), [("frame", OVERRIDE_FRAME), ("yaml_frame", YAML_FRAME)])
