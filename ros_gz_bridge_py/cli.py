@@ -3,7 +3,10 @@
 
 from __future__ import annotations
 
+import os
 import sys
+from collections.abc import Callable
+from typing import NoReturn
 
 from ros_gz_bridge_py.app.rclpy_check import rclpy_problem
 from ros_gz_bridge_py.app.startup import one_blas_thread, pause_collector
@@ -18,6 +21,19 @@ def _exit_without_rclpy(program: str) -> None:
         sys.exit(1)
 
 
+def _exit_with(main: Callable[[], int]) -> NoReturn:
+    """Exit with ``main()``'s code. A reader that closed the pipe early (``--help | head -1``)
+    ends the output: no traceback."""
+    try:
+        code = main()
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # Python flushes stdout once more at exit; /dev/null takes what is left.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        code = 1
+    sys.exit(code)
+
+
 def parameter_bridge_main() -> None:
     one_blas_thread()
     pause_collector()
@@ -25,7 +41,7 @@ def parameter_bridge_main() -> None:
     with StopSignal() as stop:
         from ros_gz_bridge_py.app import parameter_bridge  # noqa: PLC0415 - imports rclpy
 
-        sys.exit(parameter_bridge.main(stop=stop))
+        _exit_with(lambda: parameter_bridge.main(stop=stop))
 
 
 def bridge_node_main() -> None:
@@ -35,13 +51,14 @@ def bridge_node_main() -> None:
     with StopSignal() as stop:
         from ros_gz_bridge_py.app import bridge_node  # noqa: PLC0415 - imports rclpy
 
-        sys.exit(bridge_node.main(stop=stop))
+        _exit_with(lambda: bridge_node.main(stop=stop))
 
 
 def bridge_types_main() -> None:
-    from ros_gz_bridge_py.app import bridge_types  # noqa: PLC0415
+    _exit_without_rclpy("bridge_types")  # the pairs are built from ROS message classes
+    from ros_gz_bridge_py.app import bridge_types  # noqa: PLC0415 - imports rclpy
 
-    sys.exit(bridge_types.main())
+    _exit_with(bridge_types.main)
 
 
 def image_bridge_main() -> None:
@@ -51,4 +68,4 @@ def image_bridge_main() -> None:
     with StopSignal() as stop:
         from ros_gz_bridge_py.app import image_bridge  # noqa: PLC0415 - imports rclpy
 
-        sys.exit(image_bridge.main(stop=stop))
+        _exit_with(lambda: image_bridge.main(stop=stop))

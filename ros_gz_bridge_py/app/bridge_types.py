@@ -4,8 +4,9 @@ Options and their texts and exit codes follow docs/behaviour.md §1.2: one optio
 argument second. Differences: each pair is listed once (with its ``gz.msgs.X`` name;
 ``ignition.msgs.X`` is accepted wherever a Gazebo type is read), types are listed once each
 and sorted, services get their own heading, ``--json`` prints everything as one JSON document,
-converter modules that could not load are named on stderr, and arguments after the option
-are refused with one line (exit 1) where C++ ignores them.
+why pairs are missing from a listing or a failed lookup (a converter module that could not
+load) is said once per reason on stderr, and arguments after the option are refused with one
+line (exit 1) where C++ ignores them.
 """
 
 from __future__ import annotations
@@ -83,8 +84,10 @@ def _as_json(registry: Registry) -> str:
 
 
 def _report_unavailable(registry: Registry, err: TextIO) -> None:
-    for name, reason in registry.unavailable.items():
-        print(f"bridge_types: converters '{name}' could not load: {reason}", file=err)
+    """Why pairs are missing from a listing or a lookup: each reason once (a package's
+    several converter modules fail for one reason)."""
+    for reason in dict.fromkeys(registry.unavailable.values()):
+        print(f"bridge_types: not listed: {reason}", file=err)
 
 
 def _extra_arguments_problem(used: Sequence[str], extra: Sequence[str]) -> str:
@@ -121,7 +124,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
 
     registry = build_registry()
-    _report_unavailable(registry, err)
+    if option in listings:
+        _report_unavailable(registry, err)
     if option == "--print-pairs":
         _print_pairs(registry, out)
     elif option == "--print-ros":
@@ -137,6 +141,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         else:
             found, listing = registry.ros_types_for(wanted), "--print-gz"
         if not found:
+            _report_unavailable(registry, err)
             print(f"Type [{wanted}] has no mapping, use {listing} to see supported types", file=err)
             return 1
         print(found[0], file=out)

@@ -22,7 +22,7 @@ def test_the_venv_rclpy_is_accepted() -> None:
     assert rclpy_problem() is None
 
 
-@pytest.mark.parametrize("program", ["parameter_bridge", "image_bridge"])
+@pytest.mark.parametrize("program", ["parameter_bridge", "image_bridge", "bridge_types"])
 def test_without_rclpy_the_executables_say_what_is_needed(program: str) -> None:
     if sys.prefix == sys.base_prefix or not BASE_PYTHON.exists():
         pytest.skip("no interpreter outside a venv to run without rclpy")

@@ -180,3 +180,26 @@ def test_a_zenoh_router_not_there_is_one_error_line(program: str) -> None:
         "start the router it connects to, or set its endpoints (ZENOH_CONFIG, "
         "GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE; docs/zenoh.md)"
     )
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["parameter_bridge", "--help"],
+        ["image_bridge", "--help"],
+        ["bridge_types", "--print-pairs"],
+        ["bridge_types", "--json"],
+    ],
+)
+def test_a_reader_that_closed_the_pipe_gets_no_traceback(argv: list[str]) -> None:
+    """``parameter_bridge --help | head -1``: the reader goes before the output is written."""
+    program, *args = argv
+    with subprocess.Popen(
+        [str(BIN / program), *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    ) as process:
+        assert process.stdout is not None
+        process.stdout.close()
+        _, stderr = process.communicate(timeout=30)
+    assert "Traceback" not in stderr
+    assert "BrokenPipeError" not in stderr
+    assert process.returncode == 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import pytest
 
@@ -129,3 +130,32 @@ def test_arguments_after_the_option_are_refused_not_ignored(
         f"bridge_types: unexpected {extra!r} after {used!r}: give one option per run "
         "(--json alone prints every pair and service as JSON; bridge_types -h lists the options)\n"
     )
+
+
+@pytest.fixture
+def without_ros_gz_interfaces(monkeypatch: pytest.MonkeyPatch) -> str:
+    """The interface package not installed; returns the start of the reason given for it."""
+    for module in ("ros_gz_interfaces", "ros_gz_interfaces_messages", "ros_gz_interfaces_sensors"):
+        monkeypatch.delitem(sys.modules, f"ros_gz_bridge_py.converters.{module}", raising=False)
+    monkeypatch.setitem(sys.modules, "ros_gz_interfaces.msg", None)
+    monkeypatch.setitem(sys.modules, "ros_gz_interfaces.srv", None)
+    return "bridge_types: not listed: the ROS interface package ros_gz_interfaces is not installed"
+
+
+def test_a_missing_package_is_said_once_in_a_listing(
+    capsys: pytest.CaptureFixture[str], without_ros_gz_interfaces: str
+) -> None:
+    code, out, err = run(capsys, "--print-pairs")
+    assert code == 0
+    assert "'gz.msgs.Twist'" in out
+    assert "ros_gz_interfaces/" not in out
+    assert err.count(without_ros_gz_interfaces) == 1, err  # three converter modules, one line
+
+
+def test_a_lookup_that_finds_its_type_says_nothing_of_missing_packages(
+    capsys: pytest.CaptureFixture[str], without_ros_gz_interfaces: str
+) -> None:
+    assert run(capsys, "--get-ros-to-gz", "tf2_msgs/msg/TFMessage") == (0, "gz.msgs.Pose_V\n", "")
+    code, _, err = run(capsys, "--get-ros-to-gz", "ros_gz_interfaces/msg/Contacts")
+    assert code == 1
+    assert err.startswith(without_ros_gz_interfaces), err
