@@ -57,12 +57,13 @@ def why_unavailable(name: str, err: ImportError) -> str:
     """Why converter module ``name`` (named after its ROS package) could not be imported, and
     where the missing package comes from when it is one the source tree builds."""
     missing = (err.name or "").partition(".")[0]
-    if missing != name or name not in BUILT_FROM_SOURCE:
+    ours = name == missing or name.startswith(f"{missing}_")  # ros_gz_interfaces_sensors
+    if not ours or missing not in BUILT_FROM_SOURCE:
         return str(err)
-    dashed = name.replace("_", "-")
+    dashed = missing.replace("_", "-")
     return (
-        f"the ROS interface package {name} is not installed; build it with "
-        f"`tools/setup_interfaces.sh <venv> {name}` from the source tree (`make setup` builds "
+        f"the ROS interface package {missing} is not installed; build it with "
+        f"`tools/setup_interfaces.sh <venv> {missing}` from the source tree (`make setup` builds "
         f"them all), or install ros-jazzy-{dashed} in a ROS install"
     )
 
@@ -291,6 +292,13 @@ class Registry:
             service = self._services_by_type.get(ros_type)
         if service is not None:
             return service
+        pkg = ros_type.partition("/")[0]
+        if pkg in self.unavailable:
+            msg = (
+                f"service type [{ros_type}] is not supported here: converters for {pkg} could "
+                f"not load: {self.unavailable[pkg]}"
+            )
+            raise UnsupportedTypeError(msg)
         known = ", ".join(sorted(self._services_by_type)) or "none"
         msg = f"service type [{ros_type}] is not supported; supported: {known}"
         raise UnsupportedTypeError(msg)

@@ -149,6 +149,28 @@ def test_a_missing_interface_package_is_recorded_and_the_rest_keeps_working(
         found.get("gps_msgs/msg/GPSFix", "gz.msgs.NavSat")
 
 
+def test_a_missing_package_is_named_by_each_of_its_modules_and_by_its_services(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """ros_gz_interfaces has three converter modules; a service entry of it said "supported:
+    none" where a topic entry named the package and the command that builds it."""
+    modules = ["ros_gz_interfaces", "ros_gz_interfaces_messages", "ros_gz_interfaces_sensors"]
+    for module in modules:
+        monkeypatch.delitem(sys.modules, f"{CONVERTERS}.{module}", raising=False)
+    monkeypatch.setitem(sys.modules, "ros_gz_interfaces.msg", None)
+    monkeypatch.setitem(sys.modules, "ros_gz_interfaces.srv", None)
+    found = build_registry(modules_of(CONVERTERS))
+    assert sorted(found.unavailable) == modules
+    missing = "the ROS interface package ros_gz_interfaces is not installed; build it with "
+    assert all(reason.startswith(missing) for reason in found.unavailable.values())
+    with pytest.raises(
+        UnsupportedTypeError,
+        match=r"service type \[ros_gz_interfaces/srv/ControlWorld\] is not supported here: "
+        f"converters for ros_gz_interfaces could not load: {missing}",
+    ):
+        found.get_service("ros_gz_interfaces/srv/ControlWorld")
+
+
 def test_other_import_failures_are_recorded_as_they_were_raised() -> None:
     inner = ModuleNotFoundError("No module named 'numpy'", name="numpy")
     assert registry.why_unavailable("gps_msgs", inner) == "No module named 'numpy'"
