@@ -8,9 +8,10 @@ The program owns the rclpy node and the executor; ``Bridge`` only adds channels 
 3. bridges ``--second`` the same way and prints its first message,
 4. closes the bridge and shuts rclpy down.
 
-Run it next to any Gazebo publisher, for example::
+Run it next to Gazebo publishers of both topics that keep publishing, for example::
 
-    gz topic -t /first -m gz.msgs.StringMsg -p 'data: "hello"'   # in another shell
+    while sleep 0.5; do gz topic -t /first -m gz.msgs.StringMsg -p 'data: "hello"'; done &
+    while sleep 0.5; do gz topic -t /second -m gz.msgs.StringMsg -p 'data: "again"'; done &
     python examples/embed_bridge.py --first /first --second /second
 
 It prints one line per step (``RECEIVED <topic> <data>``, ``REMOVED <topic>``, ``DONE``) and
@@ -65,7 +66,7 @@ def main() -> int:
     parser.add_argument("--first", default="/first", help="Gazebo topic bridged first")
     parser.add_argument("--second", default="/second", help="Gazebo topic bridged after it")
     parser.add_argument("--gz-type", default="gz.msgs.StringMsg",
-                        help="Gazebo type name (ignition.msgs.StringMsg for Fortress)")  # fmt: skip
+                        help="Gazebo type name (either spelling matches every line)")  # fmt: skip
     parser.add_argument("--timeout", type=float, default=20.0, help="seconds per message")
     args = parser.parse_args()
 

@@ -29,7 +29,7 @@ die() { echo "setup_interfaces: $*" >&2; exit 1; }
 
 CHECK=0
 if [ "${1:-}" = --check ]; then CHECK=1; shift; fi
-[ $# -ge 1 ] || die "usage: $0 [--check] VENV [PACKAGE...]"
+[ $# -ge 1 ] && [ -n "$1" ] || die "usage: $0 [--check] VENV [PACKAGE...] (VENV empty: is \$VIRTUAL_ENV set? activate the venv or give its path)"
 VENV=$(realpath "$1"); shift
 PY=$VENV/bin/python
 [ -x "$PY" ] || die "$PY not found: VENV must be a Python venv with ros-jazzy-rclpy installed"

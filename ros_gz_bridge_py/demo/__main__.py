@@ -84,7 +84,10 @@ class BridgeCommand:
 def bridge_commands() -> list[BridgeCommand]:
     """parameter_bridge with the TurtleBot3 configuration, and image_bridge for the camera."""
     if not topics.CONFIG_FILE.is_file():
-        msg = f"the bridge configuration {topics.CONFIG_FILE} is missing; run from the repository"
+        msg = (
+            f"the bridge configuration {topics.CONFIG_FILE} is missing; run the demo from the "
+            "source tree or reinstall the package (it installs the file there)"
+        )
         raise DemoSetupError(msg)
     executable = Path(sys.executable).with_name("parameter_bridge")
     if not executable.exists():

@@ -6,10 +6,15 @@ World and client both import these, so a rename happens in one place.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-CONFIG_FILE = Path(__file__).resolve().parents[2] / "config" / "turtlebot3_waffle_bridge.yaml"
+_CONFIG_NAME = "turtlebot3_waffle_bridge.yaml"
+_IN_SOURCE_TREE = Path(__file__).resolve().parents[2] / "config" / _CONFIG_NAME
+#: Where an installed wheel puts it (setup.cfg's data_files).
+INSTALLED_CONFIG_FILE = Path(sys.prefix) / "share" / "ros_gz_bridge_py" / "config" / _CONFIG_NAME
+CONFIG_FILE = _IN_SOURCE_TREE if _IN_SOURCE_TREE.exists() else INSTALLED_CONFIG_FILE
 
 CLOCK = "clock"
 JOINT_STATES = "joint_states"

@@ -5,6 +5,7 @@ test_colcon.py's."""
 
 from __future__ import annotations
 
+import configparser
 import json
 import os
 import subprocess
@@ -13,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from ros_gz_bridge_py.demo import topics
 from testing.gzpeer import ROOT
 
 
@@ -31,3 +33,15 @@ def test_pip_reads_the_metadata_without_a_deprecation_warning(tmp_path: Path) ->
     (metadata,) = [entry["metadata"] for entry in json.loads(report.read_text())["install"]]
     assert metadata["license"] == "Apache-2.0"
     assert metadata["requires_python"] == ">=3.11"
+
+
+def test_the_demo_finds_its_configuration_where_a_wheel_installs_it() -> None:
+    """``python -m ros_gz_bridge_py.demo`` from an installed wheel, away from the source tree."""
+    data_files = configparser.ConfigParser()
+    data_files.read(ROOT / "setup.cfg")
+    installed = data_files["options.data_files"]["share/ros_gz_bridge_py/config"]
+    assert installed.strip() == "config/*.yaml"
+    name = topics.CONFIG_FILE.name
+    assert (ROOT / "config" / name).is_file()
+    expected = Path(sys.prefix) / "share/ros_gz_bridge_py/config" / name
+    assert expected == topics.INSTALLED_CONFIG_FILE
