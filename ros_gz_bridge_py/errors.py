@@ -9,6 +9,12 @@ decides between "log and skip" and "fail".
 
 from __future__ import annotations
 
+import re
+
+#: Where in rcl's C sources an error was raised (", at /src/rcl/arguments.c:352"): rclpy's
+#: errors end with it, and it names nothing the user wrote; messages drop it.
+RCL_SOURCE_LOCATION = re.compile(r", at \S+:\d+")
+
 
 class BridgeError(Exception):
     """Root of every error raised by ros_gz_bridge_py."""

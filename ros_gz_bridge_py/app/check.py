@@ -19,7 +19,6 @@ from typing import Any, TextIO
 from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.app.discover import listen
-from ros_gz_bridge_py.app.settings import RCL_SOURCE_LOCATION
 from ros_gz_bridge_py.config import BridgeSpec, Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.converters.registry import Registry
 from ros_gz_bridge_py.core.diagnosis import (
@@ -36,7 +35,7 @@ from ros_gz_bridge_py.core.explain import (
     ros_endpoints,
     type_hints,
 )
-from ros_gz_bridge_py.errors import ConfigError, TransportError
+from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION, ConfigError, TransportError
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.qos import endpoint_qos, gz_to_ros_publisher_qos
 from ros_gz_bridge_py.ros.stop_signal import StopSignal

@@ -18,7 +18,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import re
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -33,7 +32,7 @@ from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV
 from ros_gz_bridge_py.config.model import as_rate
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE, BridgeOptions
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
-from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION, ConfigError
 from ros_gz_bridge_py.transport import BACKENDS, NodeOptions
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
@@ -410,8 +409,6 @@ _ROS_ARGUMENT_FIXES = (
     ("log level", "write --log-level LEVEL: debug, info, warn, error or fatal"),
 )
 _ROS_ARGUMENTS_GUIDE = "see 'Passing ROS arguments to nodes' in the ROS 2 documentation"
-#: Where in rcl's C sources an error was raised (", at /src/rcl/arguments.c:352").
-RCL_SOURCE_LOCATION = re.compile(r", at \S+:\d+")
 
 
 def ros_arguments_problem(program: str, argv: Sequence[str]) -> str:

@@ -42,7 +42,12 @@ from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
-from ros_gz_bridge_py.errors import BridgeError, ConfigError, UnsupportedTypeError
+from ros_gz_bridge_py.errors import (
+    RCL_SOURCE_LOCATION,
+    BridgeError,
+    ConfigError,
+    UnsupportedTypeError,
+)
 from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.ros.runtime import steady_clock
@@ -324,7 +329,8 @@ def _checked(spec: object) -> BridgeSpec:
 def _failed_text(spec: TopicBridgeSpec, why: str) -> str:
     return (
         f"Failed to create a bridge for topic [{spec.ros_topic}] with ROS2 type [{spec.ros_type}] "
-        f"to topic [{spec.gz_topic}] with Gazebo Transport type [{spec.gz_type}]: {why}"
+        f"to topic [{spec.gz_topic}] with Gazebo Transport type [{spec.gz_type}]: "
+        f"{RCL_SOURCE_LOCATION.sub('', why)}"
     )
 
 

@@ -377,6 +377,16 @@ def test_a_direction_in_its_yaml_spelling_is_taken(rig: Rig) -> None:
     assert handle.spec.direction is Direction.GZ_TO_ROS
 
 
+def test_a_name_ros_refuses_is_said_without_rcl_source_locations(rig: Rig) -> None:
+    """rclpy's error ended with ', at /project/src/rcl/expand_topic_name.c:73'."""
+    topic = unique("refused") + "/0/cmd_pos"
+    with pytest.raises(ConfigError) as raised:
+        rig.add(string_spec(topic, Direction.ROS_TO_GZ))
+    assert "topic name token must not start with a number" in str(raised.value)
+    assert ", at " not in str(raised.value)
+    assert str(raised.value).startswith(f"Failed to create a bridge for topic [{topic}]")
+
+
 def test_an_entry_that_cannot_be_bridged_is_refused_whole(rig: Rig) -> None:
     topic = unique("refused")
     unpaired = TopicBridgeSpec(topic, topic, "std_msgs/msg/String", "gz.msgs.Twist")
