@@ -19,7 +19,7 @@ import sys
 from collections.abc import Sequence
 
 from ros_gz_bridge_py.app import parameter_bridge
-from ros_gz_bridge_py.app.settings import ros_arguments_problem
+from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 
 PROGRAM = "bridge_node"

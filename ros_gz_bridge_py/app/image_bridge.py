@@ -40,6 +40,7 @@ from ros_gz_bridge_py.app.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
+from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem
 from ros_gz_bridge_py.app.settings import (
     ImageBridgeParameters,
     Switches,
@@ -47,7 +48,6 @@ from ros_gz_bridge_py.app.settings import (
     checked_max_rate,
     declare_image_bridge_parameters,
     read_switches,
-    ros_arguments_problem,
 )
 from ros_gz_bridge_py.app.startup import finish_start_up
 from ros_gz_bridge_py.config import (

@@ -28,6 +28,7 @@ from ros_gz_bridge_py.app import discover
 from ros_gz_bridge_py.app.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
 from ros_gz_bridge_py.app.check import Sides, run_check
 from ros_gz_bridge_py.app.one_cpu import OneCpu, start_one_cpu
+from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem
 from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
     Switches,
@@ -35,7 +36,6 @@ from ros_gz_bridge_py.app.settings import (
     checked_max_rate,
     declare_parameter_bridge_parameters,
     read_switches,
-    ros_arguments_problem,
 )
 from ros_gz_bridge_py.app.sources import (
     collect_sources,

@@ -6,7 +6,6 @@
 (:class:`SharedParameters`) with one name, type and default. The executables then hand the
 library :class:`~ros_gz_bridge_py.core.bridge.Bridge` its :class:`BridgeOptions` and the runtime
 helpers plain arguments (docs/configuration.md: "Node parameters", "Speed settings and switches").
-Their ROS arguments are checked here too, before rclpy reads them (:func:`ros_arguments_problem`).
 
 One rule per kind of value: a switch is off when set to ``off``, ``0``, ``false`` or ``no``; a
 choice compares its value case-blind; an integer that is not one is reported (variable, value,
@@ -18,21 +17,19 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.parameter import Parameter
-from rclpy.utilities import remove_ros_args
 
 from ros_gz_bridge_py.config.gz_version import GZ_VERSION_ENV
 from ros_gz_bridge_py.config.model import as_rate
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE, BridgeOptions
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
-from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION, ConfigError
+from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.transport import BACKENDS, NodeOptions
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
@@ -252,6 +249,17 @@ _WRITTEN_AS = {
 }
 
 
+#: Parameters are read once, at start: a set at run time is refused ("Trying to set a read-only
+#: parameter"), not accepted and ignored; ``ros2 param describe`` says why.
+READ_AT_START = "read once, at start: restart the bridge with the new value to change it"
+
+
+def read_only(*, dynamic_typing: bool = False) -> ParameterDescriptor:
+    return ParameterDescriptor(
+        read_only=True, dynamic_typing=dynamic_typing, description=READ_AT_START
+    )
+
+
 def _declare(
     node: Any, name: str, default: object, descriptor: ParameterDescriptor | None = None
 ) -> Any:
@@ -263,7 +271,7 @@ def _declare(
         ConfigError: the value given for ``name`` has the wrong type.
     """
     try:
-        return node.declare_parameter(name, default, descriptor or ParameterDescriptor()).value
+        return node.declare_parameter(name, default, descriptor or read_only()).value
     except InvalidParameterTypeException as err:
         said = str(err.args[0]).removesuffix(f": {name}")  # "Trying to set parameter ..."
         expected = (
@@ -294,7 +302,7 @@ def declare_shared_parameters(node: Any, env: Mapping[str, str] | None = None) -
     declared = _declare_fields(node, defaults, ("max_rate",))
     check_heartbeat(declared.subscription_heartbeat)
     check_transport_implementation(declared.gz_transport_implementation, env)
-    any_type = ParameterDescriptor(dynamic_typing=True)
+    any_type = read_only(dynamic_typing=True)
     max_rate = _declare(node, "max_rate", defaults.max_rate, any_type)
     return dataclasses.replace(declared, max_rate=max_rate)
 
@@ -312,7 +320,7 @@ def declare_parameter_bridge_parameters(
     lists: dict[str, Any] = {
         name: tuple(_declare(node, name, Parameter.Type.STRING_ARRAY) or ()) for name in arrays
     }
-    any_type = ParameterDescriptor(dynamic_typing=True)
+    any_type = read_only(dynamic_typing=True)
     timeout = _declare(node, "service_timeout", declared.service_timeout, any_type)
     period = _declare(node, "status_period", declared.status_period, any_type)
     return dataclasses.replace(
@@ -399,43 +407,3 @@ def declare_image_bridge_parameters(
     """Declare ``image_bridge``'s parameters on ``node`` and return their values."""
     shared = declare_shared_parameters(node, env)
     return _declare_fields(node, ImageBridgeParameters(shared), ("shared",))
-
-
-#: rcl's words for a kind of ROS argument, and how to write one.
-_ROS_ARGUMENT_FIXES = (
-    ("parameter override", "write -p NAME:=VALUE with a value, e.g. -p config_file:=bridge.yaml"),
-    ("params", "give --params-file the path of a readable parameters YAML file"),
-    ("remap", "write -r FROM:=TO, e.g. -r __ns:=/robot1"),
-    ("log level", "write --log-level LEVEL: debug, info, warn, error or fatal"),
-)
-_ROS_ARGUMENTS_GUIDE = "see 'Passing ROS arguments to nodes' in the ROS 2 documentation"
-
-
-def ros_arguments_problem(program: str, argv: Sequence[str]) -> str:
-    """What rcl cannot read in the ROS arguments of ``argv`` (with the program name), as one
-    line naming the argument and the fix; '' when it reads them all.
-
-    Checked before ``rclpy.init``: rclpy raises these from it and from ``remove_ros_args``,
-    which ended the process with a traceback.
-    """
-    try:
-        remove_ros_args(list(argv))
-    except _rclpy.UnknownROSArgsError as err:
-        unknown = str(err).removeprefix("[").removesuffix("]")
-        return (
-            f"{program}: not ROS arguments, yet after --ros-args: {unknown}; put {program}'s "
-            "own arguments before --ros-args, or after a -- that ends the ROS arguments"
-        )
-    except _rclpy.RCLInvalidROSArgsError as err:
-        reason = _rcl_reason(str(err))
-        fix = next((fix for words, fix in _ROS_ARGUMENT_FIXES if words in reason), None)
-        return f"{program}: bad ROS argument: {reason}; {fix or _ROS_ARGUMENTS_GUIDE}"
-    return ""
-
-
-def _rcl_reason(message: str) -> str:
-    """rcl's ``message`` without its prefix and source locations, and for a rule without the
-    state of rcl's lexer, which names nothing the user wrote."""
-    reason = RCL_SOURCE_LOCATION.sub("", message).removeprefix("Failed to parse ROS arguments: ")
-    head = reason.partition(". Error: ")[0]
-    return (head if " rule: " in head else reason).rstrip(".")

@@ -9,10 +9,9 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 
-from ros_gz_bridge_py.app.settings import ParameterBridgeParameters
+from ros_gz_bridge_py.app.settings import ParameterBridgeParameters, read_only
 from ros_gz_bridge_py.config import (
     BridgeSpec,
     Direction,
@@ -46,7 +45,7 @@ BRIDGE_PARAMETER_KEYS = (
 
 def parameter_bridge_specs(node: Node, names: Sequence[str]) -> ParseResult:
     """The ``bridges.<name>.*`` bridges (Jazzy 1.0.15+ form)."""
-    dynamic = ParameterDescriptor(dynamic_typing=True)
+    dynamic = read_only(dynamic_typing=True)
     for name in names:
         for key in BRIDGE_PARAMETER_KEYS:
             node.declare_parameter(f"bridges.{name}.{key}", None, dynamic)

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from ros_gz_bridge_py.app.settings import TRANSPORT_IMPLEMENTATION_ENV, ros_arguments_problem
+from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem
+from ros_gz_bridge_py.app.settings import TRANSPORT_IMPLEMENTATION_ENV
 
 USAGE_EXIT = 255
 #: The console scripts of the venv running the tests (beside the interpreter).

@@ -23,6 +23,7 @@ from ros_gz_bridge_py.app.settings import (
     MESSAGE_PATH_SWITCHES,
     NATIVE_ENV,
     ONE_CPU_ENV,
+    READ_AT_START,
     SERIALIZED_PUBLISH_ENV,
     ImageBridgeParameters,
     ParameterBridgeParameters,
@@ -298,6 +299,27 @@ def test_status_period_takes_any_type(ros_context: Context) -> None:
     node = make_node(ros_context, [Parameter("status_period", value="often")])
     try:
         assert declare_parameter_bridge_parameters(node, {}).status_period == "often"
+    finally:
+        node.destroy_node()
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize("name", ["config_file", "lazy", "subscription_heartbeat", "max_rate"])
+def test_a_parameter_set_at_run_time_is_refused_with_the_reason(
+    ros_context: Context, name: str
+) -> None:
+    """It was accepted (successful=True) and ignored: every one is read once, at start."""
+    given = Parameter("config_file", value="first.yaml")
+    node = make_node(ros_context, [given])
+    try:
+        declare_parameter_bridge_parameters(node, {})
+        before = node.get_parameter(name).value
+        (result,) = node.set_parameters([Parameter(name, value="other.yaml")])
+        assert not result.successful
+        assert result.reason == f"Trying to set a read-only parameter: {name}."
+        assert node.get_parameter(name).value == before
+        assert node.describe_parameter(name).description == READ_AT_START
+        assert node.get_parameter("config_file").value == "first.yaml"
     finally:
         node.destroy_node()
 
