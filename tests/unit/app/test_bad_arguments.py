@@ -137,7 +137,7 @@ def test_each_executable_names_a_topic_after_the_ros_arguments(program: str) -> 
             ["-p", "gz_transport_implementation:=foo"],
             {},
             "parameter gz_transport_implementation is 'foo', not a Gazebo Transport "
-            "implementation; use one of memory, zenoh, zeromq",
+            "implementation; use one of zenoh, zeromq",
         ),
         (
             [],

@@ -90,7 +90,7 @@ def test_the_parameter_decides_before_the_variable() -> None:
         check_transport_implementation("foo", {TRANSPORT_IMPLEMENTATION_ENV: "zenoh"})
     assert str(raised.value) == (
         "parameter gz_transport_implementation is 'foo', not a Gazebo Transport implementation; "
-        "use one of memory, zenoh, zeromq, or leave it out to follow "
+        "use one of zenoh, zeromq, or leave it out to follow "
         f"{TRANSPORT_IMPLEMENTATION_ENV}"
     )
 
@@ -100,5 +100,15 @@ def test_an_unknown_variable_value_is_named() -> None:
         check_transport_implementation("", {TRANSPORT_IMPLEMENTATION_ENV: "foo"})
     assert str(raised.value) == (
         f"{TRANSPORT_IMPLEMENTATION_ENV} is 'foo', not a Gazebo Transport implementation; "
-        "use one of memory, zenoh, zeromq, or unset it (zeromq)"
+        "use one of zenoh, zeromq, or unset it (zeromq)"
     )
+
+
+@pytest.mark.parametrize("where", ["parameter", "variable"])
+def test_the_tests_in_process_backend_is_refused(where: str) -> None:
+    """``memory`` reaches no Gazebo: a bridge on it ran and carried nothing, without a word."""
+    parameter, env = (
+        ("memory", {}) if where == "parameter" else ("", {TRANSPORT_IMPLEMENTATION_ENV: "memory"})
+    )
+    with pytest.raises(ConfigError, match="'memory', not a Gazebo Transport implementation"):
+        check_transport_implementation(parameter, env)
