@@ -128,14 +128,12 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -
     for message in (problem, queue_problem):
         if message:
             logger.error(message)
+    options = params.shared.bridge_options(
+        switches, gz_version=gz_version, max_rate=max_rate, max_queued_bytes=max_queued_bytes
+    )
     bridge = Bridge(
         node,
-        options=params.shared.bridge_options(
-            switches,
-            gz_version=gz_version,
-            max_rate=max_rate,
-            max_queued_bytes=max_queued_bytes,
-        ),
+        options=dataclasses.replace(options, types_fixed_by=PROGRAM),
         gz_options=params.shared.gz_node_options(),
     )
     bridge.add_all(specs)

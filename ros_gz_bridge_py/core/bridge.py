@@ -118,7 +118,11 @@ class Bridge:
         self._explain_timer: Any = None
         if self.options.explain:
             self._explainer = Explainer(
-                self.gz_node, self.registry, self._ctx.own_nodes, self._logger.warning
+                self.gz_node,
+                self.registry,
+                self._ctx.own_nodes,
+                self._logger.warning,
+                types_fixed_by=self.options.types_fixed_by,
             )
             self._explain_timer = ros_node.create_timer(EXPLAIN_PERIOD, self.explain, clock=steady)
 

@@ -68,6 +68,9 @@ class TypeHints:
     ros_types_for: Callable[[str], list[str]]
     #: ROS type -> the Gazebo types it pairs with.
     gz_types_for: Callable[[str], list[str]]
+    #: The executable that chose the channels' types, where the user cannot ("image_bridge"):
+    #: a fix that changes them points to parameter_bridge. "" when entries name their types.
+    types_fixed_by: str = ""
 
 
 @dataclass(frozen=True)
@@ -201,20 +204,31 @@ def _type_finding(situation: Situation, hints: TypeHints, endpoint: GraphEndpoin
     verb = "publishes" if endpoint.role == PUBLISHER else "subscribes"
     # Either spelling works; propose the one the configuration already uses.
     written = respell(seen, spelling_of(situation.gz_type) or Spelling.GZ)
+    ros_types = hints.ros_types_for(seen)
     if hints.pairs(situation.ros_type, seen):
-        fix = f"set the Gazebo type (gz_type_name) to {written}"
-    else:
-        ros_types = hints.ros_types_for(seen)
-        fix = (
+        fix = _retyped(hints, f"set the Gazebo type (gz_type_name) to {written}")
+    elif ros_types:
+        fix = _retyped(
+            hints,
             f"{written} pairs with {', '.join(ros_types)}: set the Gazebo type to {written} and "
-            "the ROS type to one of those"
-            if ros_types
-            else f"no converter takes {seen} (bridge_types --print-pairs lists the pairs)"
+            "the ROS type to one of those",
         )
+    else:
+        fix = f"no converter takes {seen} (bridge_types --print-pairs lists the pairs)"
     return Finding(
         f"gz-type:{endpoint.role}:{seen}",
         f"the Gazebo {endpoint.role} of {situation.gz_topic} ({_where(endpoint)}) {verb} "
         f"{seen}, but {_chosen(situation, situation.gz_type)}; {fix}",
+    )
+
+
+def _retyped(hints: TypeHints, fix: str) -> str:
+    """``fix``, which changes an entry's types, where the executable lets the user do so."""
+    if not hints.types_fixed_by:
+        return fix
+    return (
+        f"{hints.types_fixed_by} cannot take other types: bridge the topic with "
+        f"parameter_bridge ({fix})"
     )
 
 
@@ -321,11 +335,12 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
             if situation.discovered_by:
                 fix = _discovered_fix(situation, endpoint.msg_type, hints)
             elif hints.pairs(endpoint.msg_type, situation.gz_type):
-                fix = f"set the ROS type (ros_type_name) to {endpoint.msg_type}"
+                fix = _retyped(hints, f"set the ROS type (ros_type_name) to {endpoint.msg_type}")
             elif others:
-                fix = (
+                fix = _retyped(
+                    hints,
                     f"{endpoint.msg_type} pairs with {', '.join(others)}: set the ROS and "
-                    "Gazebo types to such a pair"
+                    "Gazebo types to such a pair",
                 )
             else:
                 fix = f"no converter takes {endpoint.msg_type}"

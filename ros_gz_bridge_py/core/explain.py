@@ -53,12 +53,13 @@ ROS_ENDPOINTS_REFRESH = 10.0
 BRIDGE_WIDE = frozenset({"no-peer"})
 
 
-def type_hints(registry: Registry) -> TypeHints:
+def type_hints(registry: Registry, types_fixed_by: str = "") -> TypeHints:
     """The registry's answers about types, as the findings' fixes need them."""
     return TypeHints(
         pairs=lambda ros_type, gz_type: registry.find(ros_type, gz_type) is not None,
         ros_types_for=registry.ros_types_for,
         gz_types_for=registry.gz_types_for,
+        types_fixed_by=types_fixed_by,
     )
 
 
@@ -177,9 +178,11 @@ class Explainer:
         own_nodes: Iterable[tuple[str, str]],
         log: Callable[[str], None],
         now: Callable[[], float] = time.monotonic,
+        *,
+        types_fixed_by: str = "",
     ) -> None:
         self._gz = gz_node
-        self._hints = type_hints(registry)
+        self._hints = type_hints(registry, types_fixed_by)
         self._own = frozenset(own_nodes)
         self._log = log
         self._now = now

@@ -52,6 +52,9 @@ class BridgeOptions:
     #: Payload bytes each Gazebo->ROS channel's queue holds at most (beyond its count of
     #: messages); past it the oldest are dropped and counted (one message is always kept).
     max_queued_bytes: int = MAX_QUEUED_BYTES
+    #: The executable that chose every entry's types ("image_bridge"): explanations then send a
+    #: topic of other types to parameter_bridge instead of proposing types it cannot take.
+    types_fixed_by: str = ""
 
     @property
     def garden(self) -> bool:

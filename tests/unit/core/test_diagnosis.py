@@ -72,6 +72,38 @@ def test_a_pairing_type_is_proposed_alone() -> None:
     assert "set the Gazebo type (gz_type_name) to ignition.msgs.Odometry" in finding.text
 
 
+def test_image_bridge_sends_a_topic_of_other_types_to_parameter_bridge() -> None:
+    """image_bridge takes no ROS or Gazebo type: its fix cannot be to set them."""
+    hints = dataclasses.replace(HINTS, types_fixed_by="image_bridge")
+    camera = situation(
+        Direction.GZ_TO_ROS,
+        ros_type="sensor_msgs/msg/Image",
+        gz_type="gz.msgs.Image",
+        gz_endpoints=[endpoint(PUBLISHER, "ignition.msgs.StringMsg")],
+        ros_endpoints=[RosEndpoint("/viewer", "std_msgs/msg/String")],
+    )
+    ros_side, gz_side = findings(camera, hints)
+    assert gz_side.text.endswith(
+        "; image_bridge cannot take other types: bridge the topic with parameter_bridge "
+        "(gz.msgs.StringMsg pairs with std_msgs/msg/String: set the Gazebo type to "
+        "gz.msgs.StringMsg and the ROS type to one of those)"
+    )
+    assert ros_side.text.endswith(
+        "; image_bridge cannot take other types: bridge the topic with parameter_bridge "
+        "(std_msgs/msg/String pairs with gz.msgs.StringMsg: set the ROS and Gazebo types to "
+        "such a pair)"
+    )
+    (unpaired,) = findings(
+        dataclasses.replace(
+            camera, gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Nope")], ros_endpoints=()
+        ),
+        hints,
+    )
+    assert unpaired.text.endswith(
+        "no converter takes gz.msgs.Nope (bridge_types --print-pairs lists the pairs)"
+    )
+
+
 def test_other_partition_no_peer_and_absent_are_told_apart() -> None:
     elsewhere = situation(
         Direction.GZ_TO_ROS, gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Odometry", "vm:root")]
