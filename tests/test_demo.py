@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ros_gz_bridge_py.demo import __main__ as demo_main
 from ros_gz_bridge_py.demo import sim
 from ros_gz_bridge_py.demo.report import Pose2D, Row, TopicStats, verdict
 from ros_gz_bridge_py.demo.topics import GZ_TO_ROS
@@ -169,6 +170,20 @@ def rows_by_topic(lines: list[str]) -> dict[str, tuple[float, int]]:
         if match := ROW.match(line):
             found[match[1]] = (float(match[3]), int(match[5]))
     return found
+
+
+@pytest.mark.parametrize(("argv", "status"), [(["--help"], 0), (["-h"], 0), (["--fast"], 2)])
+def test_an_argument_gets_the_help_or_one_line_not_a_demo(
+    argv: list[str], status: int, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``python -m ros_gz_bridge_py.demo --help`` started the whole demo."""
+    assert demo_main.main(argv) == status
+    out, err = capsys.readouterr()
+    if status == 0:
+        assert "DEMO_SECONDS" in out
+        assert err == ""
+    else:
+        assert err == "demo: takes no arguments, not '--fast' (-h tells more)\n"
 
 
 @pytest.mark.slow

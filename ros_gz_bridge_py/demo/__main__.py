@@ -4,7 +4,7 @@ Starts the Python world (the Gazebo side), ``parameter_bridge`` with the TurtleB
 configuration, an image bridge for the camera, and runs the ROS client in this process. It
 stops on Ctrl-C or after ``DEMO_SECONDS`` of live table (0 or unset: until Ctrl-C), stops every
 child, and prints a summary with a PASS/FAIL line. Exit status: 0 on PASS, 1 on FAIL, 2 on a bad
-``DEMO_SECONDS``.
+``DEMO_SECONDS`` or an argument (it takes none but ``-h``).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import signal
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
@@ -245,7 +245,14 @@ def watch_with_ros(children: list[Child], stop: StopFlag, seconds: float) -> Out
     return outcome
 
 
-def main() -> int:
+def main(argv: Sequence[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else list(argv)
+    if args in (["-h"], ["--help"]):
+        print(__doc__)
+        return 0
+    if args:
+        print(f"demo: takes no arguments, not {' '.join(args)!r} (-h tells more)", file=sys.stderr)
+        return 2
     try:
         seconds = demo_seconds()
     except DemoSetupError as err:
