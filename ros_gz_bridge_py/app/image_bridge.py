@@ -104,7 +104,9 @@ def bridge_specs(
     return list(with_qos(specs, profile))
 
 
-def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -> Bridge | None:
+def build_bridge(
+    node: Node, topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal
+) -> Bridge | None:
     """The running bridge, or None (logged) when the parameters leave nothing to bridge."""
     logger = node.get_logger()
     for warning in switches.warnings:
@@ -134,7 +136,7 @@ def build_bridge(node: Node, topics: Sequence[ImageTopic], switches: Switches) -
     bridge = Bridge(
         node,
         options=dataclasses.replace(options, types_fixed_by=PROGRAM),
-        gz_options=params.shared.gz_node_options(),
+        gz_options=params.shared.gz_node_options(stop),
     )
     bridge.add_all(specs)
     return bridge
@@ -145,7 +147,7 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
     node = BridgeNode(NODE_NAME)
     bridge: Bridge | None = None
     try:
-        bridge = build_bridge(node, topics, switches)
+        bridge = build_bridge(node, topics, switches, stop)
         if bridge is None:
             return USAGE_EXIT
         if stop.requested:
@@ -159,6 +161,8 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
             dds_event_batch=switches.dds_event_batch,
         )
     except TransportError as err:
+        if stop.requested:  # Ctrl-C while the node started (a Zenoh client's wait)
+            return 0
         node.get_logger().error(str(err))
         return TRANSPORT_EXIT
     finally:

@@ -144,7 +144,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             if discover_seconds is not None:
                 finish_start_up(node)
                 return discover_yaml(node, cli, params, discover_seconds, values, stop=stop)
-            bridge, discovered = build_bridge(node, cli, params, switches, values)
+            bridge, discovered = build_bridge(node, cli, params, switches, values, stop=stop)
             diagnostics = start_diagnostics(node, bridge, params.status_period)
             one_cpu = start_one_cpu(node, bridge.carries_bulk, switches.one_cpu)
             finish_start_up(node)
@@ -156,6 +156,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 dds_event_batch=switches.dds_event_batch,
             )
         except TransportError as err:
+            if stop.requested:  # Ctrl-C while the node started (a Zenoh client's wait)
+                return 0
             node.get_logger().error(str(err))
             return TRANSPORT_EXIT
         finally:
@@ -238,7 +240,7 @@ def check(
         return USAGE_EXIT
     executor = make_executor(events=switches.events_executor)
     executor.add_node(node)
-    with create_gz_node(params.shared.gz_node_options()) as gz_node:
+    with create_gz_node(params.shared.gz_node_options(stop)) as gz_node:
 
         def discovered() -> list[TopicBridgeSpec]:
             if not patterns and not rules.enabled:
@@ -274,7 +276,7 @@ def discover_yaml(
     explicit = [spec for source in sources for spec in source.specs]
     patterns = [pattern for source in sources for pattern in source.patterns]
     rules = discovery_rules(node, params, enabled=True)
-    with create_gz_node(params.shared.gz_node_options()) as gz_node:
+    with create_gz_node(params.shared.gz_node_options(stop)) as gz_node:
         node.get_logger().info(f"Listening to Gazebo discovery for {seconds:g} s ...")
         if discover.listen(seconds / 2, stop=stop):
             gz_node.ask_subscribers()  # gz-transport 13+ list their subscriptions with types
@@ -321,6 +323,8 @@ def build_bridge(
     params: ParameterBridgeParameters,
     switches: Switches,
     values: templates.Placeholders,
+    *,
+    stop: StopSignal,
 ) -> tuple[Bridge, DiscoveredBridges | None]:
     """Collect every configuration source, report its problems, and create the bridges; and
     what follows discovery, when entries or ``auto_bridge`` ask for it."""
@@ -338,7 +342,7 @@ def build_bridge(
     for message in (problem, queue_problem):
         if message:
             logger.error(message)
-    gz_options = params.shared.gz_node_options(gz_subscriptions(sources))
+    gz_options = params.shared.gz_node_options(stop, gz_subscriptions(sources))
     bridge = Bridge(
         node,
         options=params.shared.bridge_options(

@@ -36,6 +36,8 @@ from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
 
+    from ros_gz_bridge_py.ros.stop_signal import StopSignal
+
 #: Values (any case, surrounding spaces ignored) that turn a switch off.
 OFF_VALUES = frozenset({"off", "0", "false", "no"})
 
@@ -174,10 +176,12 @@ class SharedParameters:
     #: :func:`checked_max_queued_bytes` reads it.
     max_queued_bytes: int = MAX_QUEUED_BYTES
 
-    def gz_node_options(self, planned_subscriptions: int = 0) -> NodeOptions:
+    def gz_node_options(self, stop: StopSignal, planned_subscriptions: int = 0) -> NodeOptions:
+        """The node's options; ``stop`` (the executable's) can end its start."""
         return NodeOptions(
             implementation=self.gz_transport_implementation or None,
             planned_subscriptions=planned_subscriptions,
+            stop_requested=lambda: stop.requested,
         )
 
     def bridge_options(

@@ -268,12 +268,19 @@ def _partition_finding(situation: Situation, elsewhere: Sequence[GraphEndpoint])
 
 
 def _no_peer_finding(situation: Situation) -> Finding:
+    compare = (
+        "the same GZ_TRANSPORT_IMPLEMENTATION (zenoh), and Zenoh sessions that reach each "
+        "other: the router both connect to running and reached at its endpoint, or peers that "
+        "connect or listen where the other does (ZENOH_CONFIG, "
+        "GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE; docs/zenoh.md)"
+        if situation.listening.startswith("Zenoh")
+        else "the same GZ_PARTITION (IGN_PARTITION on Fortress), GZ_IP/IGN_IP on a network both "
+        "reach, and the same GZ_TRANSPORT_IMPLEMENTATION (zeromq or zenoh)"
+    )
     return Finding(
         "no-peer",
         f"no Gazebo Transport process is heard at all; the bridge listens with "
-        f"{situation.listening}. Compare with the simulator's environment: the same "
-        "GZ_PARTITION (IGN_PARTITION on Fortress), GZ_IP/IGN_IP on a network both reach, and "
-        "the same GZ_TRANSPORT_IMPLEMENTATION (zeromq or zenoh)",
+        f"{situation.listening}. Compare with the simulator's environment: {compare}",
     )
 
 

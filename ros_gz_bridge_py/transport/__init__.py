@@ -10,6 +10,7 @@ so the ZeroMQ path never imports zenoh.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 
 from ros_gz_bridge_py.errors import TransportError
@@ -24,6 +25,7 @@ from ros_gz_bridge_py.transport.api import (
 )
 from ros_gz_bridge_py.transport.handles import Publisher, ServiceOffer, Subscription
 from ros_gz_bridge_py.transport.node import GzNode
+from ros_gz_bridge_py.transport.node_start import start_unless_stopped
 from ros_gz_bridge_py.transport.settings import TransportSettings
 
 __all__ = [
@@ -79,5 +81,9 @@ def create_gz_node(options: NodeOptions | None = None) -> GzNode:
     settings = TransportSettings.from_env(planned_subscriptions=options.planned_subscriptions)
     if options.legacy_spelling is not None:
         settings = dataclasses.replace(settings, legacy_spelling=options.legacy_spelling)
-    node_class = backend_class(options.implementation or settings.implementation)
-    return node_class(options.partition, options.namespace, settings)
+    implementation = options.implementation or settings.implementation
+    node_class = backend_class(implementation)
+    start = functools.partial(node_class, options.partition, options.namespace, settings)
+    if options.stop_requested is None:
+        return start()
+    return start_unless_stopped(start, options.stop_requested, implementation)

@@ -50,6 +50,8 @@ class NodeOptions:
     ``planned_subscriptions``: how many Gazebo topics the caller will subscribe at its start;
     where GZ_TRANSPORT_RCVHWM is unset, each one's receive queue is smaller the more there are
     (``settings.planned_rcvhwm``).
+    ``stop_requested``: asked every 0.1 s while the node starts, which can wait (a Zenoh client
+    for its router); True gives the start up (``node_start.py``). None: started in the caller.
     """
 
     partition: str | None = None
@@ -57,6 +59,7 @@ class NodeOptions:
     implementation: str | None = None
     legacy_spelling: Spelling | None = None
     planned_subscriptions: int = 0
+    stop_requested: Callable[[], bool] | None = None
 
 
 @dataclass(frozen=True, slots=True)

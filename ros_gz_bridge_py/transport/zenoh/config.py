@@ -142,8 +142,18 @@ def describe_session(config: zenoh.Config) -> str:
 
     mode = value("mode").strip('"')
     mode = "peer" if mode in ("null", "?") else mode
+
+    def endpoints(key: str) -> str:
+        """Zenoh's defaults are per mode ({"router": [...], "peer": [...]}): this mode's."""
+        text = value(key)
+        try:
+            given = json.loads(text)
+        except ValueError:
+            return text
+        return json.dumps(given.get(mode, [])) if isinstance(given, dict) else text
+
     scouting = "off" if value("scouting/multicast/enabled") == "false" else "on"
     return (
-        f"Zenoh {mode}, connect {value('connect/endpoints')}, listen "
-        f"{value('listen/endpoints')}, multicast scouting {scouting}"
+        f"Zenoh {mode}, connect {endpoints('connect/endpoints')}, listen "
+        f"{endpoints('listen/endpoints')}, multicast scouting {scouting}"
     )

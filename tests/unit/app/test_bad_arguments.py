@@ -8,8 +8,10 @@ The real console scripts run here: rclpy raised these errors from ``rclpy.init``
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -204,3 +206,41 @@ def test_a_reader_that_closed_the_pipe_gets_no_traceback(argv: list[str]) -> Non
     assert "Traceback" not in stderr
     assert "BrokenPipeError" not in stderr
     assert process.returncode == 1
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize("program", ["parameter_bridge", "image_bridge"])
+def test_ctrl_c_ends_the_wait_for_a_zenoh_router(program: str) -> None:
+    """A Zenoh client told to wait for its router for ever (docs/zenoh.md: connect/timeout_ms)
+    blocked in Zenoh's native code: SIGINT and SIGTERM did nothing until a router came."""
+    env = {
+        **os.environ,
+        TRANSPORT_IMPLEMENTATION_ENV: "zenoh",
+        "GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE": (
+            'mode="client";connect/endpoints=["tcp/127.0.0.1:1"];connect/timeout_ms=-1;'
+            "scouting/multicast/enabled=false"
+        ),
+    }
+    with subprocess.Popen(
+        [str(BIN / program), TOPICS[program]],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    ) as process:
+        assert process.stderr is not None
+        waiting = "node has not started after 2 s (a Zenoh client waits for its router)"
+        lines = []
+        watchdog = threading.Timer(60.0, process.kill)  # should the line never come
+        watchdog.start()
+        for line in process.stderr:  # the line comes after 2 s; the process waits for ever
+            lines.append(line)
+            if waiting in line:
+                break
+        process.send_signal(signal.SIGINT)
+        _, rest = process.communicate(timeout=30)
+        watchdog.cancel()
+    assert any(waiting in line for line in lines), lines
+    assert process.returncode == 0, rest
+    assert "[ERROR]" not in rest
+    assert "Traceback" not in rest

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import signal
 import uuid
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -38,6 +39,7 @@ from ros_gz_bridge_py.app.settings import (
 from ros_gz_bridge_py.core.bridge import BridgeOptions
 from ros_gz_bridge_py.core.options import BULK_THREAD_NICE
 from ros_gz_bridge_py.errors import ConfigError
+from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import NodeOptions
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
@@ -188,7 +190,15 @@ def test_bridge_options_from_parameters_and_switches() -> None:
 @pytest.mark.parametrize(("value", "implementation"), [("", None), ("zenoh", "zenoh")])
 def test_gz_node_options(value: str, implementation: str | None) -> None:
     shared = SharedParameters(gz_transport_implementation=value)
-    assert shared.gz_node_options() == NodeOptions(implementation=implementation)
+    stop = StopSignal()
+    options = shared.gz_node_options(stop)
+    assert options.stop_requested is not None
+    assert dataclasses.replace(options, stop_requested=None) == NodeOptions(
+        implementation=implementation
+    )
+    assert options.stop_requested() is False  # asks the executable's stop signal
+    stop._request(signal.SIGINT, None)
+    assert options.stop_requested() is True
 
 
 # The node parameters, declared on a real rclpy node.

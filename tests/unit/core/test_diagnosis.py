@@ -122,6 +122,24 @@ def test_other_partition_no_peer_and_absent_are_told_apart() -> None:
     assert "similar topics: /model/robot/odom, /odometry" in finding.text
 
 
+def test_no_peer_over_zenoh_points_to_the_sessions_not_to_gz_ip() -> None:
+    """GZ_IP and the partition cannot keep Zenoh sessions apart; the router and the
+    endpoints can (the ZeroMQ advice was given for both)."""
+    zeromq = findings(situation(Direction.GZ_TO_ROS, gz_peers=0), HINTS)[0].text
+    assert "GZ_IP/IGN_IP on a network both reach" in zeromq
+    listening = 'Zenoh client, connect ["tcp/10.0.0.5:7447"], listen [], multicast scouting off'
+    (finding,) = findings(situation(Direction.GZ_TO_ROS, gz_peers=0, listening=listening), HINTS)
+    assert finding.key == "no-peer"
+    assert "GZ_IP" not in finding.text
+    assert "GZ_PARTITION" not in finding.text
+    assert finding.text.endswith(
+        "Compare with the simulator's environment: the same GZ_TRANSPORT_IMPLEMENTATION "
+        "(zenoh), and Zenoh sessions that reach each other: the router both connect to running "
+        "and reached at its endpoint, or peers that connect or listen where the other does "
+        "(ZENOH_CONFIG, GZ_TRANSPORT_ZENOH_CONFIG_OVERRIDE; docs/zenoh.md)"
+    )
+
+
 def test_no_peer_is_no_fault_before_discovery_listened_long_enough() -> None:
     early = situation(Direction.GZ_TO_ROS, gz_peers=0, peers_settled=False)
     (finding,) = findings(early, HINTS)
