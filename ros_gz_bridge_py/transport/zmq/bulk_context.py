@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import os
 import threading
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -31,6 +32,8 @@ import zmq
 #: What the names of the bulk contexts' libzmq threads begin with.
 THREAD_NAME_PREFIX = 6
 _IO_THREAD_NAME = f"{THREAD_NAME_PREFIX}/ZMQbg/IO/"
+#: How long a delivery thread looks for the I/O thread of its context at its start.
+NAMED_WITHIN = 2.0
 
 
 class BulkContext:
@@ -47,7 +50,11 @@ class BulkContext:
         def start() -> None:
             if on_start is not None:
                 on_start()
-            follow_priority(threading.get_native_id())
+            # libzmq's I/O thread names itself once it runs, which on a busy machine can be
+            # after this thread starts: until then it is not found by its name.
+            deadline = time.monotonic() + NAMED_WITHIN
+            while not follow_priority(threading.get_native_id()) and time.monotonic() < deadline:
+                time.sleep(0.01)
 
         return start
 
@@ -56,15 +63,20 @@ class BulkContext:
         self.context.destroy(linger=0)
 
 
-def follow_priority(tid: int) -> None:
+def follow_priority(tid: int) -> bool:
     """The bulk contexts' I/O threads at thread ``tid``'s CPU priority (Linux; elsewhere, or
-    where a priority cannot be raised back without privilege, nothing changes)."""
-    with contextlib.suppress(OSError, AttributeError):
+    where a priority cannot be raised back without privilege, nothing changes). False when
+    no I/O thread was found (yet)."""
+    try:
         nice = os.getpriority(os.PRIO_PROCESS, tid)
-        for io_tid in io_threads():
-            with contextlib.suppress(OSError):
-                if os.getpriority(os.PRIO_PROCESS, io_tid) != nice:
-                    os.setpriority(os.PRIO_PROCESS, io_tid, nice)
+        found = io_threads()
+    except (OSError, AttributeError):  # no per-thread priorities here
+        return True
+    for io_tid in found:
+        with contextlib.suppress(OSError):
+            if os.getpriority(os.PRIO_PROCESS, io_tid) != nice:
+                os.setpriority(os.PRIO_PROCESS, io_tid, nice)
+    return bool(found)
 
 
 def io_threads() -> list[int]:
