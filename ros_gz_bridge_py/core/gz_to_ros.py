@@ -81,6 +81,9 @@ class GzToRosChannel(Channel):
             else {}
         )
         self._pump: ChannelPump | None = None
+        #: Converted messages ROS did not publish (``_unpublished``).
+        self._not_published = 0
+        self._said_shut_down = False
 
     @property
     def native(self) -> bool:
@@ -93,7 +96,8 @@ class GzToRosChannel(Channel):
 
     @property
     def dropped(self) -> int:
-        return self._subscription.dropped if self._subscription is not None else 0
+        taken = self._subscription.dropped if self._subscription is not None else 0
+        return taken + self._not_published
 
     @property
     def qos(self) -> QoSProfile:
@@ -234,8 +238,7 @@ class GzToRosChannel(Channel):
         except Exception as err:
             self._conversion_failed(err)
             return
-        self._publish(ros_msg)
-        self.stats.published += 1
+        self._publish_counted(ros_msg)
 
     def _on_gz_payload(self, payload: Any, info: MessageInfo) -> None:
         """The bulk path: Gazebo payload straight to a serialized ROS message."""
@@ -248,8 +251,37 @@ class GzToRosChannel(Channel):
         except Exception as err:
             self._conversion_failed(err)
             return
-        self._publish(cdr)
+        self._publish_counted(cdr)
+
+    def _publish_counted(self, msg: Any) -> None:
+        """Publish one converted message, or count it as dropped when ROS does not take it."""
+        try:
+            self._publish(msg)
+        except Exception as err:
+            self._unpublished(err)
+            return
         self.stats.published += 1
+
+    def _unpublished(self, err: Exception) -> None:
+        """A message ROS would not publish: dropped, and said once when ROS was shut down
+        under the bridge (``rclpy.shutdown`` before :meth:`Bridge.close`: every message fails
+        from then on), else at most every ERROR_LOG_PERIOD s."""
+        with self._error_lock:
+            self._not_published += 1
+            count = self._not_published
+            say = self._error_log.ready("publish")
+        if not self.ctx.ros_node.context.ok():
+            if not self._said_shut_down:
+                self._said_shut_down = True
+                self._logger.warning(
+                    f"{self.describe()}: ROS was shut down before the bridge was closed; "
+                    "messages from Gazebo are dropped until it is (close the bridge before "
+                    "rclpy.shutdown)"
+                )
+        elif say:
+            self._logger.warning(
+                f"{self.describe()}: ROS did not publish a message: {err} ({count} dropped so far)"
+            )
 
 
 def yield_cpu_to_light_topics(nice: int) -> None:

@@ -1,4 +1,5 @@
-"""Embedding ``Bridge`` in a program: the example end to end, and add/remove in-process.
+"""Embedding ``Bridge`` in a program: the example end to end, a program that shuts ROS down
+first, and add/remove in-process.
 
 ``examples/embed_bridge.py`` runs as a subprocess next to two real ign-transport 11
 publishers. In-process, ``Bridge.add``/``remove`` are checked from the outside: a removed
@@ -17,9 +18,8 @@ from typing import Any
 import pytest
 import rclpy
 
-from ros_gz_bridge_py import Bridge
+from ros_gz_bridge_py import Bridge, BridgeOptions
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
-from ros_gz_bridge_py.core.bridge import BridgeOptions
 from ros_gz_bridge_py.transport import GzNode
 from testing.behaviour_harness import (
     STRING,
@@ -69,6 +69,54 @@ def test_example_bridges_removes_and_bridges_again(started: list[PeerProcess]) -
     wait_for_line(example, r"^DONE$")
     assert example.wait(WAIT) == 0, example.output()
     assert "Traceback" not in example.output()
+
+
+#: A program that shuts ROS down before it closes its bridge, as a Ctrl-C handler often does.
+SHUTDOWN_FIRST = """
+import sys, time
+import rclpy
+from ros_gz_bridge_py import Bridge
+from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+
+topic, gz_type = sys.argv[1], sys.argv[2]
+rclpy.init()
+node = rclpy.create_node("shut_down_first")
+bridge = Bridge(node)
+handle = bridge.add(TopicBridgeSpec(topic, topic, "std_msgs/msg/String", gz_type,
+                                    Direction.GZ_TO_ROS))
+channel = handle.channels[0]
+while channel.stats.published < 20:
+    time.sleep(0.01)
+rclpy.shutdown()
+while channel.dropped < 100:  # 0.5 s of the publisher's 200 Hz, every one refused by ROS
+    time.sleep(0.01)
+bridge.close()
+print("CLOSED", flush=True)
+"""
+
+
+def test_ros_shut_down_before_the_bridge_closes_is_one_warning(
+    started: list[PeerProcess],
+) -> None:
+    """A program that calls ``rclpy.shutdown()`` before ``Bridge.close()`` (what its Ctrl-C
+    handler often does): every later Gazebo message was a traceback on stderr."""
+    require_peer()
+    topic = unique_name("embed_shutdown")
+    publisher = start_peer("pub", topic, STRING, "200", "0", 'data: "tick"', "--wait", "60")
+    started.append(publisher)
+    wait_for_line(publisher, r"^READY$")
+    program = start_process([sys.executable, "-c", SHUTDOWN_FIRST, topic, STRING])
+    started.append(program)
+    wait_for_line(program, r"^CLOSED$", timeout=WAIT + 10)
+    assert program.wait(WAIT) == 0, program.output()
+    output = program.output()
+    assert "Traceback" not in output
+    warnings = [line for line in output.splitlines() if "[WARN]" in line and topic in line]
+    assert len(warnings) == 1, output
+    assert warnings[0].endswith(
+        "ROS was shut down before the bridge was closed; messages from Gazebo are dropped "
+        "until it is (close the bridge before rclpy.shutdown)"
+    )
 
 
 @pytest.fixture(scope="module")
