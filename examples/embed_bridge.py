@@ -29,9 +29,8 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from std_msgs.msg import String
 
-from ros_gz_bridge_py import Bridge
+from ros_gz_bridge_py import Bridge, BridgeOptions
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
-from ros_gz_bridge_py.core.bridge import BridgeOptions
 
 
 def first_message(node: Any, topic: str, timeout: float) -> str | None:

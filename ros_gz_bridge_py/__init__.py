@@ -1,7 +1,7 @@
 """ros_gz_bridge_py: the ROS 2 <-> Gazebo bridge in Python, with its own Gazebo Transport peer.
 
 Importing this package is cheap; the rclpy-facing classes load on first use:
-``from ros_gz_bridge_py import Bridge``.
+``from ros_gz_bridge_py import Bridge, BridgeOptions``.
 """
 
 from __future__ import annotations
@@ -23,16 +23,16 @@ if sys.version_info < (3, 11):  # noqa: UP036 - the one place that runs on older
     raise ImportError(msg)
 
 __version__ = "0.1.0"
-__all__ = ["Bridge", "__version__"]
+__all__ = ["Bridge", "BridgeOptions", "__version__"]
 
 if TYPE_CHECKING:
-    from ros_gz_bridge_py.core.bridge import Bridge
+    from ros_gz_bridge_py.core.bridge import Bridge, BridgeOptions
 
 
 def __getattr__(name: str) -> Any:
-    if name == "Bridge":
-        from ros_gz_bridge_py.core.bridge import Bridge  # noqa: PLC0415 - keeps `import` free of rclpy
+    if name in ("Bridge", "BridgeOptions"):
+        from ros_gz_bridge_py.core import bridge  # noqa: PLC0415 - keeps `import` free of rclpy
 
-        return Bridge
+        return getattr(bridge, name)
     msg = f"module {__name__!r} has no attribute {name!r}"
     raise AttributeError(msg)

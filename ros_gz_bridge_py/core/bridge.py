@@ -35,6 +35,7 @@ from ros_gz_bridge_py.config import (
     ServiceBridgeSpec,
     TopicBridgeSpec,
 )
+from ros_gz_bridge_py.config.model import DEPRECATED_DIRECTIONS
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.core.channel import Channel, ChannelContext
 from ros_gz_bridge_py.core.explain import EXPLAIN_PERIOD, Explainer
@@ -42,6 +43,13 @@ from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
+from ros_gz_bridge_py.core.spec_checks import (
+    Key,
+    checked_spec,
+    refuse_twice,
+    service_key,
+    topic_keys,
+)
 from ros_gz_bridge_py.errors import (
     RCL_SOURCE_LOCATION,
     BridgeError,
@@ -83,6 +91,11 @@ class Bridge:
         registry: Registry | None = None,
         gz_options: NodeOptions | None = None,
     ) -> None:
+        """Bridge on ``ros_node`` (an rclpy node the caller spins and, after :meth:`close`,
+        destroys) and ``gz_node`` (None: one of its own, made from ``gz_options`` and closed
+        with the bridge). The channels' ROS endpoints go on ``ros_node``: a lazy channel does
+        not count that node's other endpoints. ``registry``: the pairs (None: every pair).
+        Close the bridge before ``rclpy.shutdown()``."""
         self.options = options or BridgeOptions()
         self.ros_node = ros_node
         self.registry = registry or default_registry()
@@ -133,11 +146,13 @@ class Bridge:
 
     @property
     def handles(self) -> list[BridgeHandle]:
+        """What every :meth:`add` still open created, in order (a copy)."""
         with self._lock:
             return list(self._handles)
 
     @property
     def channels(self) -> list[Channel]:
+        """Every topic bridge's channels (one per direction); each has its ``stats``."""
         return [channel for handle in self.handles for channel in handle.channels]
 
     def carries_bulk(self) -> bool:
@@ -146,24 +161,38 @@ class Bridge:
 
     @property
     def services(self) -> list[ServiceBridge]:
+        """Every service bridge."""
         return [h.service for h in self.handles if h.service is not None]
 
     def add(self, spec: BridgeSpec) -> BridgeHandle:
         """Create the channels (or service bridge) of ``spec`` and start them.
 
+        ``spec``'s fields are checked as the YAML parser checks an entry's; its direction may
+        be the YAML spelling (``"GZ_TO_ROS"``, the deprecated ``"IGN_TO_ROS"`` with a warning).
+
         Raises:
-            ConfigError: the spec cannot be bridged (unsupported type pair, bad name, ...);
+            ConfigError: the spec cannot be bridged (a field of the wrong type or value, an
+                unsupported type pair, a bad name, what an earlier entry bridges already);
                 nothing of it is left open.
+            BridgeError: the bridge is closed.
         """
-        spec = _checked(spec)
+        checked = checked_spec(spec)
         with self._lock:
             if self._closed:
-                msg = "the bridge is closed"
+                msg = f"the bridge is closed; {spec!r} was not added"
                 raise BridgeError(msg)
+            refuse_twice(checked, self._keys(checked), self._taken())
+            if isinstance(spec, TopicBridgeSpec) and isinstance(checked, TopicBridgeSpec):
+                old = spec.direction
+                if isinstance(old, str) and old in DEPRECATED_DIRECTIONS:
+                    self._logger.warning(
+                        f"{checked.source or checked.ros_topic}: direction {old} is "
+                        f"deprecated, use {checked.direction.value}"
+                    )
             handle = (
-                self._add_service(spec)
-                if isinstance(spec, ServiceBridgeSpec)
-                else self._add_topic(spec)
+                self._add_service(checked)
+                if isinstance(checked, ServiceBridgeSpec)
+                else self._add_topic(checked)
             )
             self._handles.append(handle)
             return handle
@@ -225,9 +254,11 @@ class Bridge:
             self.gz_node.close()
 
     def __enter__(self) -> Bridge:
+        """``with Bridge(node) as bridge:`` closes it at the end of the block."""
         return self
 
     def __exit__(self, *_exc: object) -> None:
+        """:meth:`close`; an exception of the block goes on."""
         self.close()
 
     def _add_topic(self, spec: TopicBridgeSpec) -> BridgeHandle:
@@ -256,6 +287,29 @@ class Bridge:
             _close_handle(handle)
             raise ConfigError(_failed_text(spec, str(err)), spec.source or None) from err
         return handle
+
+    def _keys(self, spec: BridgeSpec) -> list[Key]:
+        """What ``spec`` would bridge (none when a name does not resolve: building says why)."""
+        try:
+            if isinstance(spec, ServiceBridgeSpec):
+                return [service_key(self.ros_node.resolve_service_name(spec.service))]
+            ros_topic = self._ctx.resolve(spec.ros_topic)
+            return topic_keys(spec, ros_topic, self.gz_node.fqn(spec.gz_topic))
+        except Exception:
+            return []
+
+    def _taken(self) -> dict[Key, BridgeSpec]:
+        """What the bridges bridge now, and the spec of each."""
+        taken: dict[Key, BridgeSpec] = {}
+        for handle in self._handles:
+            if handle.service is not None:
+                taken[service_key(handle.service.service_name)] = handle.spec
+            for channel in handle.channels:
+                assert isinstance(handle.spec, TopicBridgeSpec)
+                gz_topic = self.gz_node.fqn(handle.spec.gz_topic)
+                for key in topic_keys(handle.spec, channel.ros_topic, gz_topic):
+                    taken[key] = handle.spec
+        return taken
 
     def _native_node(self) -> Any:
         with self._lock:
@@ -303,31 +357,6 @@ class Bridge:
         for line in service.creation_lines():
             self._logger.info(line)
         return BridgeHandle(spec, service=service)
-
-
-def _checked(spec: object) -> BridgeSpec:
-    """``spec`` as the bridge takes it: a spec of the config layer, its direction a
-    :class:`Direction` (the YAML spelling, ``"GZ_TO_ROS"``, is taken too).
-
-    Raises:
-        ConfigError: not a spec, or a direction that is none.
-    """
-    if isinstance(spec, ServiceBridgeSpec):
-        return spec
-    if not isinstance(spec, TopicBridgeSpec):
-        msg = (
-            f"Bridge.add takes a TopicBridgeSpec or a ServiceBridgeSpec, not "
-            f"{type(spec).__name__}; parse_cli_args and parse_yaml make them from text"
-        )
-        raise ConfigError(msg)
-    if isinstance(spec.direction, Direction):
-        return spec
-    try:
-        return dataclasses.replace(spec, direction=Direction(spec.direction))
-    except ValueError:
-        names = ", ".join(direction.value for direction in Direction)
-        msg = f"direction {spec.direction!r} is none of {names}"
-        raise ConfigError(msg, spec.source or None) from None
 
 
 def _failed_text(spec: TopicBridgeSpec, why: str) -> str:

@@ -97,7 +97,9 @@ class ChannelState(enum.Enum):
 
 @dataclass
 class ChannelStats:
-    """Counters of one channel; plain ints updated from one thread each, read from any.
+    """Counters of one channel; plain ints updated from one thread each, read from any. A
+    channel on the native data plane adds its loop's counts about once a second
+    (``native/loop.py``), so they may trail the messages by that much.
 
     Every message the channel could not use counts once in ``errors_by_reason`` under what
     was wrong (:class:`~ros_gz_bridge_py.transport.Rejection`); those the converter refused

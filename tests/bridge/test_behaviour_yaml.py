@@ -2,7 +2,8 @@
 
 An invalid entry is skipped with its index, its line and the C++ error text, and the valid
 entries of the same file bridge; a value C++ cannot convert (``lazy: maybe``) is one more
-invalid entry here, where it kills the C++ process. A missing file is one error, once.
+invalid entry here, where it kills the C++ process, and so is an entry that bridges what an
+earlier one bridges (C++ builds it: every message twice). A missing file is one error, once.
 """
 
 from __future__ import annotations
@@ -16,13 +17,15 @@ from ros_gz_bridge_py.transport import GzNode
 from testing.behaviour_harness import (
     STRING,
     WAIT,
+    RosSide,
     gz_node,
+    ros_side,
     start_bridge,
     started,
 )
 from testing.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
 
-__all__ = ["gz_node", "started"]
+__all__ = ["gz_node", "ros_side", "started"]
 
 pytestmark = [pytest.mark.ros, pytest.mark.peer]
 
@@ -30,7 +33,7 @@ HEARTBEAT_MS = 200
 
 
 def test_invalid_entries_are_reported_and_valid_ones_bridge(
-    tmp_path: Path, gz_node: GzNode, started: list[PeerProcess]
+    tmp_path: Path, gz_node: GzNode, ros_side: RosSide, started: list[PeerProcess]
 ) -> None:
     require_peer()
     first, last = unique_name("yaml_first"), unique_name("yaml_last")
@@ -53,6 +56,9 @@ def test_invalid_entries_are_reported_and_valid_ones_bridge(
         "  ros_type_name: std_msgs/msg/String\n"
         f"  gz_type_name: {STRING}\n"
         "  direction: GZ_TO_ROS\n"
+        f"- topic_name: {first}\n"  # entry 5, line 18: entry 1 again, in both directions
+        "  ros_type_name: std_msgs/msg/String\n"
+        "  gz_type_name: ignition.msgs.StringMsg\n"
     )
     bridge = start_bridge(ros_args=["-p", f"config_file:={config}"])
     started.append(bridge)
@@ -65,6 +71,10 @@ def test_invalid_entries_are_reported_and_valid_ones_bridge(
     unconvertible = wait_for_line(bridge, r"\[ERROR\].*entry 3", timeout=WAIT).string
     assert f"{config} entry 3 (line 13): Could not parse entry: lazy " in unconvertible
     assert "'maybe'" in unconvertible
+    # C++ builds entry 5 too: a second ROS publisher, every message of entry 1 twice.
+    twice = wait_for_line(bridge, r"\[ERROR\].*entry 5", timeout=WAIT).string
+    assert f"{config} entry 5 (line 18): ROS {first} (std_msgs/msg/String) and Gazebo " in twice
+    assert f"is bridged already by {config} entry 1 (line 1); a second bridge" in twice
 
     for topic in (first, last):
         publisher = gz_node.advertise(topic, STRING)
@@ -72,6 +82,10 @@ def test_invalid_entries_are_reported_and_valid_ones_bridge(
             wait_until(publisher.has_connections, WAIT, f"the bridge of {topic}")
         finally:
             publisher.close()
+    # one participant announces its publishers together: the second would show with the first
+    wait_until(lambda: ros_side.count_publishers(first) > 0, WAIT, "the ROS publisher")
+    assert ros_side.count_publishers(first) == 1
+    assert ros_side.count_subscribers(first) == 0  # nothing of entry 5 stayed
     assert "Traceback" not in bridge.output()
 
 

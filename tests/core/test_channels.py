@@ -7,7 +7,6 @@ processes (``native=Spelling.IGNITION``: a Fortress one, which announces and tak
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections import Counter
 from typing import Any
@@ -19,7 +18,6 @@ from std_msgs.msg import String
 
 from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
 from ros_gz_bridge_py.core.channel import ChannelState
-from ros_gz_bridge_py.errors import BridgeError, ConfigError
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.msgs.names import Spelling
 from tests.core.harness import (
@@ -363,50 +361,6 @@ def test_a_removed_bridge_leaves_nothing_open(rig: Rig, world: RosWorld) -> None
     wait_until(lambda: not world.publishers(topic), "the ROS publisher gone")
     wait_until(lambda: not world.subscribers(topic), "the ROS subscription gone")
     rig.remove(handle)  # twice is harmless
-
-
-def test_a_direction_in_its_yaml_spelling_is_taken(rig: Rig) -> None:
-    """An embedding user's ``TopicBridgeSpec(..., "GZ_TO_ROS")`` bridges, as the YAML does
-    (it made a handle with no channel, silently)."""
-    topic = unique("spelled")
-    spec = string_spec(topic, Direction.GZ_TO_ROS)
-    spelled = dataclasses.replace(spec, direction="GZ_TO_ROS")  # type: ignore[arg-type]
-    handle = rig.add(spelled)
-    assert [type(channel) for channel in handle.channels] == [type(gz_to_ros(handle))]
-    assert isinstance(handle.spec, TopicBridgeSpec)
-    assert handle.spec.direction is Direction.GZ_TO_ROS
-
-
-def test_a_name_ros_refuses_is_said_without_rcl_source_locations(rig: Rig) -> None:
-    """rclpy's error ended with ', at /project/src/rcl/expand_topic_name.c:73'."""
-    topic = unique("refused") + "/0/cmd_pos"
-    with pytest.raises(ConfigError) as raised:
-        rig.add(string_spec(topic, Direction.ROS_TO_GZ))
-    assert "topic name token must not start with a number" in str(raised.value)
-    assert ", at " not in str(raised.value)
-    assert str(raised.value).startswith(f"Failed to create a bridge for topic [{topic}]")
-
-
-def test_an_entry_that_cannot_be_bridged_is_refused_whole(rig: Rig) -> None:
-    topic = unique("refused")
-    unpaired = TopicBridgeSpec(topic, topic, "std_msgs/msg/String", "gz.msgs.Twist")
-    with pytest.raises(ConfigError, match=r"Failed to create a bridge for topic .*gz.msgs.Twist"):
-        rig.add(unpaired)
-    bad_profile = TopicBridgeSpec(topic, topic, "std_msgs/msg/String", STRING,
-                                  qos_profile="NOT_A_PROFILE")  # fmt: skip
-    with pytest.raises(ConfigError, match="unknown QoS profile"):
-        rig.add(bad_profile)
-    spec = string_spec(topic, Direction.GZ_TO_ROS)
-    no_direction = dataclasses.replace(spec, direction="BOTH")  # type: ignore[arg-type]
-    with pytest.raises(ConfigError, match="direction 'BOTH' is none of BIDIRECTIONAL, "):
-        rig.add(no_direction)
-    with pytest.raises(ConfigError, match="not str; parse_cli_args and parse_yaml"):
-        rig.add(f"{topic}@std_msgs/msg/String@{STRING}")  # type: ignore[arg-type]
-    assert rig.bridge.handles == []
-    assert rig.gazebo().topic_info(topic) == []
-    rig.world.run(rig.bridge.close)
-    with pytest.raises(BridgeError, match="closed"):
-        rig.add(string_spec(topic, Direction.GZ_TO_ROS))
 
 
 @pytest.mark.parametrize(("max_queued_bytes", "dropping"), [(3_000_000, True), (64 << 20, False)])
