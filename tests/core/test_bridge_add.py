@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 from std_msgs.msg import String
 
-from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.config import Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.errors import BridgeError, ConfigError
 from tests.core.harness import Rig, gz_to_ros, unique
 
@@ -139,3 +139,18 @@ def test_what_a_bridge_carries_already_is_refused_a_second_time(rig: Rig) -> Non
     rig.remove(first)
     replaced = rig.add(again)
     assert rig.bridge.handles == [other_way, elsewhere, replaced]
+
+
+def test_a_service_bridged_already_is_refused_a_second_time(rig: Rig) -> None:
+    """A second ROS server of the name would answer every call again, whatever its types."""
+    name = unique("control")
+    first = rig.add(ServiceBridgeSpec(name, "ros_gz_interfaces/srv/ControlWorld"))
+    again = ServiceBridgeSpec(name.lstrip("/"), "ros_gz_interfaces/srv/ControlWorld",
+                              "gz.msgs.WorldControl", "gz.msgs.Boolean", "argument 2")  # fmt: skip
+    with pytest.raises(ConfigError) as raised:
+        rig.add(again)
+    assert str(raised.value).startswith(
+        f"argument 2: the ROS service {name} is bridged already by an earlier Bridge.add; "
+        "a second bridge would pass every call twice."
+    )
+    assert rig.bridge.handles == [first]
