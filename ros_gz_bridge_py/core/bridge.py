@@ -124,6 +124,8 @@ class Bridge:
         self._logger = quick_logger(ros_node.get_logger())
         self._lock = threading.RLock()
         self._handles: list[BridgeHandle] = []
+        #: What each open handle bridges (``spec_checks.py``), to refuse a second bridge of it.
+        self._claims: dict[Key, BridgeSpec] = {}
         self._closed = False
         steady = steady_clock()
         self._timer = ros_node.create_timer(self.options.heartbeat, self.heartbeat, clock=steady)
@@ -181,7 +183,8 @@ class Bridge:
             if self._closed:
                 msg = f"the bridge is closed; {spec!r} was not added"
                 raise BridgeError(msg)
-            refuse_twice(checked, self._keys(checked), self._taken())
+            keys = self._keys(checked)
+            refuse_twice(checked, keys, self._claims)
             if isinstance(spec, TopicBridgeSpec) and isinstance(checked, TopicBridgeSpec):
                 old = spec.direction
                 if isinstance(old, str) and old in DEPRECATED_DIRECTIONS:
@@ -195,6 +198,7 @@ class Bridge:
                 else self._add_topic(checked)
             )
             self._handles.append(handle)
+            self._claims.update(dict.fromkeys(keys, handle.spec))
             return handle
 
     def add_all(self, specs: Iterable[BridgeSpec]) -> list[ConfigError]:
@@ -214,6 +218,9 @@ class Bridge:
             if handle not in self._handles:
                 return
             self._handles.remove(handle)
+            for key in self._keys(handle.spec):
+                if self._claims.get(key) is handle.spec:
+                    del self._claims[key]
         _close_handle(handle)
 
     def heartbeat(self) -> None:
@@ -241,6 +248,7 @@ class Bridge:
                 return
             self._closed = True
             handles, self._handles = self._handles, []
+            self._claims.clear()
         self.ros_node.destroy_timer(self._timer)
         if self._explain_timer is not None:
             self.ros_node.destroy_timer(self._explain_timer)
@@ -297,19 +305,6 @@ class Bridge:
             return topic_keys(spec, ros_topic, self.gz_node.fqn(spec.gz_topic))
         except Exception:
             return []
-
-    def _taken(self) -> dict[Key, BridgeSpec]:
-        """What the bridges bridge now, and the spec of each."""
-        taken: dict[Key, BridgeSpec] = {}
-        for handle in self._handles:
-            if handle.service is not None:
-                taken[service_key(handle.service.service_name)] = handle.spec
-            for channel in handle.channels:
-                assert isinstance(handle.spec, TopicBridgeSpec)
-                gz_topic = self.gz_node.fqn(handle.spec.gz_topic)
-                for key in topic_keys(handle.spec, channel.ros_topic, gz_topic):
-                    taken[key] = handle.spec
-        return taken
 
     def _native_node(self) -> Any:
         with self._lock:
