@@ -8,8 +8,10 @@ from __future__ import annotations
 import configparser
 import json
 import os
+import shutil
 import subprocess
 import sys
+import tarfile
 from pathlib import Path
 
 import pytest
@@ -45,3 +47,29 @@ def test_the_demo_finds_its_configuration_where_a_wheel_installs_it() -> None:
     assert (ROOT / "config" / name).is_file()
     expected = Path(sys.prefix) / "share/ros_gz_bridge_py/config" / name
     assert expected == topics.INSTALLED_CONFIG_FILE
+
+
+def test_the_source_distribution_carries_the_set_up_steps_and_the_docs(tmp_path: Path) -> None:
+    """Before MANIFEST.in, an sdist held the package alone: the README's
+    ``tools/setup_interfaces.sh``, the interface packages and docs/ were not in it."""
+    tree = tmp_path / "tree"
+    skipped = shutil.ignore_patterns(
+        ".git", ".venv*", ".build", "__pycache__", "*.egg-info", "*.so", ".*_cache"
+    )
+    shutil.copytree(ROOT, tree, ignore=skipped)
+    done = subprocess.run(
+        [sys.executable, "setup.py", "-q", "sdist", "-d", str(tmp_path / "dist")],
+        cwd=tree, capture_output=True, text=True, timeout=300, check=False,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr
+    (archive,) = (tmp_path / "dist").glob("*.tar.gz")
+    with tarfile.open(archive) as sdist:
+        names = {name.split("/", 1)[1] for name in sdist.getnames() if "/" in name}
+    assert {
+        "tools/setup_interfaces.sh",
+        "docs/configuration.md",
+        "examples/embed_bridge.py",
+        "config/diff_car_bridge.yaml",
+    } <= names
+    assert any(name.startswith("interfaces/") and name.endswith("package.xml") for name in names)
+    assert not [name for name in names if "__pycache__" in name or name.startswith("tests/")]
