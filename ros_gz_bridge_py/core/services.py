@@ -293,8 +293,9 @@ class ServiceBridge:
             types = ", ".join(sorted(f"{request}/{reply}" for request, reply in offered))
             return (
                 f"no reply within {waited}: the Gazebo providers of {service} take {types}, not "
-                f"{self.gz_req_type}/{self.gz_rep_type}; set gz_req_type_name and "
-                "gz_rep_type_name to theirs"
+                f"{self.gz_req_type}/{self.gz_rep_type}, the only types {self.spec.ros_type} "
+                "converts to; bridge the service with the ROS type of theirs (bridge_types "
+                "--print-pairs lists the service pairs) or make the provider take these"
             )
         return f"no reply from Gazebo within {waited}"
 

@@ -235,7 +235,8 @@ def channel_status(channel: Channel) -> ChannelStatus:
 
 def service_status(service: ServiceBridge) -> ChannelStatus:
     """A service bridge: calls are "received", answered calls "published", failures errors,
-    responses given up for a client never discovered "dropped"."""
+    responses given up for a client never discovered "dropped"; calls still waiting for
+    Gazebo are none of these yet."""
     return ChannelStatus(
         direction="service",
         ros_name=service.service_name,
@@ -244,7 +245,7 @@ def service_status(service: ServiceBridge) -> ChannelStatus:
         gz_type=f"{service.gz_req_type}/{service.gz_rep_type}",
         state=ChannelState.ACTIVE.value,
         received=service.calls,
-        published=service.calls - service.failures - service.unanswered,
+        published=service.calls - service.failures - service.unanswered - service.waiting,
         errors=service.failures,
         dropped=service.unanswered,
         rate=0.0,

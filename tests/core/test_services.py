@@ -155,8 +155,9 @@ def test_a_provider_of_other_types_is_named_when_nothing_answers(rig: Rig, world
     (status,) = StatusTracker(rig.bridge).snapshot()
     assert status.last_error == (
         f"no reply within {SERVICE_TIMEOUT:g} s: the Gazebo providers of {service} take "
-        "gz.msgs.Pose/gz.msgs.Boolean, not gz.msgs.WorldControl/gz.msgs.Boolean; set "
-        "gz_req_type_name and gz_rep_type_name to theirs"
+        "gz.msgs.Pose/gz.msgs.Boolean, not gz.msgs.WorldControl/gz.msgs.Boolean, the only "
+        f"types {CONTROL_WORLD} converts to; bridge the service with the ROS type of theirs "
+        "(bridge_types --print-pairs lists the service pairs) or make the provider take these"
     )
 
 
@@ -172,6 +173,9 @@ def test_closing_answers_the_waiting_calls(make_rig: Callable[..., Rig], world: 
     wait_until(client.service_is_ready, f"the service {service}")
     future = world.run(lambda: client.call_async(control_request()))
     wait_until(lambda: bridge.waiting == 1, "the call waiting for Gazebo")
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    # a waiting call is not answered yet (it counted as published before it failed)
+    assert (status.received, status.published, status.errors) == (1, 0, 0)
     world.run(rig.bridge.close)
     wait_until(future.done, "the waiting call's answer")  # within WAIT, well before the 30 s
     assert future.result().success is False
