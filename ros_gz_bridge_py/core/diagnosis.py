@@ -189,7 +189,8 @@ def _gazebo_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
         return found
     elsewhere = [e for e in situation.gz_endpoints if e.partition != situation.partition]
     if elsewhere:
-        return [_partition_finding(situation, elsewhere)]
+        needed = [e for e in elsewhere if e.role == role]
+        return [_partition_finding(situation, needed or elsewhere, needed=bool(needed))]
     if situation.gz_peers == 0 and situation.peers_settled:
         return [_no_peer_finding(situation)]
     return [_absent_finding(situation, role)]
@@ -249,7 +250,12 @@ def _declined_finding(situation: Situation, endpoint: GraphEndpoint) -> Finding:
     )
 
 
-def _partition_finding(situation: Situation, elsewhere: Sequence[GraphEndpoint]) -> Finding:
+def _partition_finding(
+    situation: Situation, elsewhere: Sequence[GraphEndpoint], *, needed: bool
+) -> Finding:
+    """``elsewhere``: the endpoints of other partitions the channel needs (``needed``), else
+    any of the topic there, which only suggest where the simulator runs (a Fortress subscriber
+    is not seen until it has a publisher to connect to)."""
     partitions = sorted({e.partition for e in elsewhere})
     seen = "; ".join(
         f"'{p}': "
@@ -258,10 +264,11 @@ def _partition_finding(situation: Situation, elsewhere: Sequence[GraphEndpoint])
         for p in partitions
     )  # fmt: skip
     first = partitions[0]
+    start = "start" if needed else "if the simulator runs there, start"
     return Finding(
         f"partition:{','.join(partitions)}",
         f"the Gazebo topic {situation.gz_topic} is alive in another partition ({seen}), but "
-        f"the bridge uses partition '{situation.partition}'; start the bridge with "
+        f"the bridge uses partition '{situation.partition}'; {start} the bridge with "
         f"GZ_PARTITION={first} (and IGN_PARTITION={first} for Fortress), or give the "
         "simulator the bridge's partition",
     )

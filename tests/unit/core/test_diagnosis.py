@@ -122,6 +122,28 @@ def test_other_partition_no_peer_and_absent_are_told_apart() -> None:
     assert "similar topics: /model/robot/odom, /odometry" in finding.text
 
 
+def test_the_partition_of_the_endpoints_a_channel_needs_is_proposed_first() -> None:
+    """A Gazebo -> ROS channel needs a publisher: the partition of one is named (before, a
+    subscriber's partition elsewhere was proposed as readily, another user's bridge there)."""
+    both = situation(
+        Direction.GZ_TO_ROS,
+        gz_endpoints=[
+            endpoint(SUBSCRIBER, "gz.msgs.Odometry", "another:bridge"),
+            endpoint(PUBLISHER, "gz.msgs.Odometry", "vm:root"),
+        ],
+    )
+    (finding,) = findings(both, HINTS)
+    assert finding.key == "partition:vm:root"
+    assert "; start the bridge with GZ_PARTITION=vm:root" in finding.text
+    only_other_role = situation(
+        Direction.ROS_TO_GZ, gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Odometry", "vm:root")]
+    )
+    (finding,) = findings(only_other_role, HINTS)
+    assert "; if the simulator runs there, start the bridge with GZ_PARTITION=vm:root" in (
+        finding.text
+    )
+
+
 def test_no_peer_over_zenoh_points_to_the_sessions_not_to_gz_ip() -> None:
     """GZ_IP and the partition cannot keep Zenoh sessions apart; the router and the
     endpoints can (the ZeroMQ advice was given for both)."""
