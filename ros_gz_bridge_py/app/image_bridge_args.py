@@ -107,13 +107,21 @@ def parse_topic_args(args: Sequence[str]) -> tuple[ImageTopic, ...]:
     """The topic arguments (ROS arguments already removed), in order, without repeats.
 
     Raises:
-        UsageError: an option we do not know, or a rename with an empty side.
+        UsageError: an option we do not know, a rename with an empty side, or a topic with
+            types (parameter_bridge's syntax).
     """
     topics: list[ImageTopic] = []
     for index, arg in enumerate(args, start=1):
         source = f"argument {index} '{arg}'"
         if arg.startswith("-"):
             msg = "unknown option; topics cannot start with '-' (image_bridge -h shows usage)"
+            raise UsageError(msg, source)
+        typed = min((arg.find(c) for c in "@[]" if c in arg), default=-1)
+        if typed >= 0:
+            msg = (
+                "image_bridge takes topic names only, each an image topic: write "
+                f"'{arg[:typed] or 'TOPIC'}' (TOPIC@ROS_TYPE@GZ_TYPE is parameter_bridge's syntax)"
+            )
             raise UsageError(msg, source)
         gz_topic, rename, ros_topic = arg.partition(RENAME)
         if not rename:
@@ -136,7 +144,11 @@ def qos_profile_name(value: str) -> str | None:
     try:
         return QOS_CHOICES[value]
     except KeyError:
-        msg = f"Invalid QoS profile {value} specified. Using default profile."
+        choices = ", ".join(QOS_CHOICES)
+        msg = (
+            f"Invalid QoS profile {value} specified. Using default profile. "
+            f"(qos is one of {choices})"
+        )
         raise ConfigError(msg) from None
 
 

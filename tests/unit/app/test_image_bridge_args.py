@@ -65,6 +65,22 @@ def test_bad_arguments_name_the_argument(arg: str) -> None:
     assert arg in str(raised.value)
 
 
+@pytest.mark.parametrize(
+    ("arg", "topic"),
+    [("/camera@sensor_msgs/msg/Image@gz.msgs.Image", "/camera"),
+     ("/cam[gz.msgs.Image", "/cam"), ("@sensor_msgs/msg/Image", "TOPIC")],
+)  # fmt: skip
+def test_parameter_bridge_syntax_is_refused_naming_the_topic_to_write(arg: str, topic: str) -> None:
+    """Before, the whole text became the topic: 'failed to resolve name', and the process
+    stayed up with nothing bridged."""
+    with pytest.raises(UsageError) as raised:
+        parse_topic_args([arg])
+    assert str(raised.value) == (
+        f"argument 1 '{arg}': image_bridge takes topic names only, each an image topic: write "
+        f"'{topic}' (TOPIC@ROS_TYPE@GZ_TYPE is parameter_bridge's syntax)"
+    )
+
+
 def test_help_flags() -> None:
     assert wants_help(["/a", "-h"])
     assert wants_help(["--help"])
@@ -93,7 +109,10 @@ def test_qos_values(value: str, profile: str | None) -> None:
 def test_unknown_qos_has_the_ros_gz_image_text() -> None:
     with pytest.raises(ConfigError) as raised:
         qos_profile_name("SENSOR_DATA")
-    assert str(raised.value) == "Invalid QoS profile SENSOR_DATA specified. Using default profile."
+    assert str(raised.value) == (
+        "Invalid QoS profile SENSOR_DATA specified. Using default profile. "
+        "(qos is one of default, sensor_data, system_default)"
+    )
 
 
 def test_gz_type_accepts_both_spellings() -> None:
