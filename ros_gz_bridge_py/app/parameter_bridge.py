@@ -364,7 +364,7 @@ def build_bridge(
             f"socket the native channels of small messages share {settings.shared_rcvhwm} per "
             'publisher (GZ_TRANSPORT_RCVHWM sets both; docs/many-topics.md, "A fleet\'s memory")'
         )
-    bridge.add_all(spec for source in sources for spec in source.specs)
+    failures = bridge.add_all(spec for source in sources for spec in source.specs)
     patterns: list[TopicPattern] = [p for source in sources for p in source.patterns]
     rules = discovery_rules(node, params, enabled=params.auto_bridge)
     discovered = None
@@ -373,6 +373,11 @@ def build_bridge(
         what = ["auto_bridge"] if rules.enabled else []
         what += [f"{len(patterns)} YAML entries completed by discovery"] if patterns else []
         logger.info(f"Following Gazebo discovery: {' and '.join(what)}")
+    elif not bridge.handles and failures:
+        logger.warning(
+            f"No bridges are running: no entry could be bridged ({len(failures)} failed; the "
+            "errors above say why and what to write)"
+        )
     elif not bridge.handles:
         logger.warning(
             "No bridges are running: give topic arguments, or -p config_file:=<yaml>, "

@@ -117,3 +117,16 @@ def test_unsupported_pair_is_reported_and_the_other_bridges_run(
     finally:
         publisher.close()
     assert bridge.poll() is None
+
+
+def test_when_every_entry_fails_the_warning_says_so(started: list[PeerProcess]) -> None:
+    """It said 'give topic arguments, or -p config_file...' to a user who had given some."""
+    topic = unique_name("cli_all_wrong")
+    bridge = start_bridge(f"{topic}@std_msgs/msg/String@gz.msgs.Twist")
+    started.append(bridge)
+    wait_for_line(bridge, r"\[ERROR\].*Failed to create a bridge", timeout=30)
+    warning = wait_for_line(bridge, r"\[WARN\].*No bridges are running", timeout=WAIT).string
+    assert warning.endswith(
+        "No bridges are running: no entry could be bridged (1 failed; the errors above say "
+        "why and what to write)"
+    )
