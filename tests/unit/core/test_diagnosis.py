@@ -231,7 +231,13 @@ def test_ros_endpoints_of_another_type_or_qos_are_named_even_while_flowing() -> 
     ]
     assert "uses geometry_msgs/msg/PoseStamped, but the bridge is configured with " in found[0].text
     assert "ERROR: Best effort publisher" in found[1].text
+    assert "; set the entry's qos_profile (or qos_overrides./odom.*) to what" in found[1].text
     assert flow(flowing) is Flow.FLOWING
+    # image_bridge has no entries: its qos parameter (before, the fix named entries)
+    imaged = findings(flowing, dataclasses.replace(HINTS, types_fixed_by="image_bridge"))
+    assert "; set image_bridge's qos parameter (default, sensor_data or system_default) (or " in (
+        imaged[1].text
+    )
 
 
 def test_a_discovered_bridge_names_the_rule_that_chose_its_types() -> None:
