@@ -55,6 +55,14 @@ PIXEL_FORMATS: dict[int, tuple[str, int]] = {
     fmt: (encoding, channels * depth) for encoding, (fmt, channels, depth) in ENCODINGS.items()
 }
 
+#: gz PixelFormatType value -> its name (RGB_INT8), as the message schema declares them.
+_FORMAT_NAMES: dict[int, str] = {
+    number: value.name
+    for number, value in GzImage.DESCRIPTOR.fields_by_name[
+        "pixel_format_type"
+    ].enum_type.values_by_number.items()
+}
+
 #: ROS distortion_model <-> gz CameraInfo.Distortion.DistortionModelType value.
 DISTORTION_MODELS: dict[str, int] = {"plumb_bob": 0, "rational_polynomial": 1, "equidistant": 2}
 _DISTORTION_NAMES = {value: name for name, value in DISTORTION_MODELS.items()}
@@ -122,7 +130,13 @@ def image_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
     """
     entry = PIXEL_FORMATS.get(gz.pixel_format_type)
     if entry is None:
-        msg = f"gz.msgs.Image pixel_format_type {gz.pixel_format_type} has no ROS encoding"
+        value = gz.pixel_format_type
+        name = _FORMAT_NAMES.get(value)
+        spelled = f"{value} ({name})" if name else str(value)
+        supported = ", ".join(_FORMAT_NAMES.get(fmt, str(fmt)) for fmt in PIXEL_FORMATS)
+        msg = (
+            f"gz.msgs.Image pixel_format_type {spelled} has no ROS encoding; supported: {supported}"
+        )
         raise ConversionError(msg)
     encoding, bytes_per_pixel = entry
     width, height = gz.width, gz.height

@@ -168,7 +168,7 @@ def test_conversion_errors_are_counted_and_warn_for_one_period(rig: Rig, world: 
     status = tracker.snapshot()[0]
     assert (status.received, status.published, status.errors) == (warm + 5, warm + 3, 2)
     assert (status.new_problems, status.level) == (2, WARN)
-    assert "pixel_format_type 0 has no ROS encoding" in status.last_error
+    assert "pixel_format_type 0 (UNKNOWN_PIXEL_FORMAT) has no ROS encoding" in status.last_error
     assert status.message().startswith("2 errors/drops in the last period: gz.msgs.Image")
     clock.advance(1.0)
     calm = tracker.snapshot()[0]

@@ -178,7 +178,11 @@ def test_finish_edits_the_header_before_serialization() -> None:
 @pytest.mark.parametrize(
     ("gz", "text"),
     [
-        (_gz_image(45, fmt=99), "gz.msgs.Image pixel_format_type 99 has no ROS encoding"),
+        (
+            _gz_image(45, fmt=99),
+            "gz.msgs.Image pixel_format_type 99 has no ROS encoding; supported: L_INT8, "
+            "L_INT16, RGB_INT8, RGBA_INT8, BGRA_INT8, RGB_INT16, BGR_INT8, BGR_INT16, R_FLOAT32",
+        ),
         (
             _gz_image(44),
             "gz.msgs.Image data has 44 bytes, fewer than height*step = 3*15 = 45 for 5x3 bgr8 "

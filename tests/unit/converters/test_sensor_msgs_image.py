@@ -50,8 +50,11 @@ def test_unknown_encoding_and_short_data_are_rejected() -> None:
         ConversionError, match=r"data has 3 bytes, fewer than height\*step = 2\*2 = 4 for 2x2"
     ):
         image_to_gz(Image(width=2, height=2, encoding="mono8", step=2, data=b"abc"))
-    with pytest.raises(ConversionError, match="pixel_format_type 7"):
+    with pytest.raises(ConversionError, match=r"pixel_format_type 7 \(RGB_INT32\) has no ROS"):
         image_to_ros(GzImage(width=1, height=1, pixel_format_type=7))
+    # by name, as the ROS -> Gazebo direction lists encodings (it said "15" alone)
+    with pytest.raises(ConversionError, match=r"15 \(BAYER_RGGB8\) .*; supported: L_INT8, "):
+        image_to_ros(GzImage(width=1, height=1, pixel_format_type=15))
 
 
 def test_ros_step_shorter_than_a_row_is_rejected() -> None:
