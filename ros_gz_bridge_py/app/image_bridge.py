@@ -58,7 +58,7 @@ from ros_gz_bridge_py.config import (
 )
 from ros_gz_bridge_py.config.gz_version import check_gz_version
 from ros_gz_bridge_py.core.bridge import Bridge
-from ros_gz_bridge_py.core.status import serve
+from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError, TransportError
 from ros_gz_bridge_py.ros.bridge_node import BridgeNode
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings
@@ -146,12 +146,14 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
     """Bridge until ``stop`` or rclpy shutdown; the node and bridge are closed on the way out."""
     node = BridgeNode(NODE_NAME)
     bridge: Bridge | None = None
+    diagnostics: DiagnosticsPublisher | None = None
     try:
         bridge = build_bridge(node, topics, switches, stop)
         if bridge is None:
             return USAGE_EXIT
         if stop.requested:
             return 0
+        diagnostics = start_diagnostics(node, bridge, node.get_parameter("status_period").value)
         finish_start_up(node)
         serve(
             node,
@@ -166,6 +168,8 @@ def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> i
         node.get_logger().error(str(err))
         return TRANSPORT_EXIT
     finally:
+        if diagnostics is not None:
+            diagnostics.close()
         if bridge is not None:
             bridge.close()
         node.destroy_node()

@@ -57,6 +57,7 @@ Parameters (--ros-args -p NAME:=VALUE):
   lazy:=true              subscribe to Gazebo only while ROS has subscribers
   expand_gz_topic_names:=true   relative Gazebo names get the node namespace (-r __ns:=/robot1)
   max_rate:=HZ            pass at most HZ images per second per topic (the rest is dropped)
+  status_period:=S        publish each topic's status on /diagnostics every S seconds
   subscription_heartbeat:=MS   how often lazy bridges check for subscribers (default 1000)
   gz_type:=TYPE           the Gazebo type (default gz.msgs.Image; either spelling takes the
                           publishers of every Gazebo line, Fortress's ignition.msgs.Image too)

@@ -145,7 +145,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
                 finish_start_up(node)
                 return discover_yaml(node, cli, params, discover_seconds, values, stop=stop)
             bridge, discovered = build_bridge(node, cli, params, switches, values, stop=stop)
-            diagnostics = start_diagnostics(node, bridge, params.status_period)
+            diagnostics = start_diagnostics(node, bridge, params.shared.status_period)
             one_cpu = start_one_cpu(node, bridge.carries_bulk, switches.one_cpu)
             finish_start_up(node)
             serve(

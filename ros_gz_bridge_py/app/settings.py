@@ -175,6 +175,9 @@ class SharedParameters:
     #: Ours: payload bytes each Gazebo->ROS channel's queue holds at most (beyond its count);
     #: :func:`checked_max_queued_bytes` reads it.
     max_queued_bytes: int = MAX_QUEUED_BYTES
+    #: Ours: seconds between two /diagnostics status messages (0 = none). Any type may be
+    #: given; ``start_diagnostics`` takes an int or a float and reports anything else.
+    status_period: object = 0.0
 
     def gz_node_options(self, stop: StopSignal, planned_subscriptions: int = 0) -> NodeOptions:
         """The node's options; ``stop`` (the executable's) can end its start."""
@@ -218,9 +221,6 @@ class ParameterBridgeParameters:
     service_timeout: float = DEFAULT_TIMEOUT
     #: The ``bridges.<name>.*`` groups to read (a string array parameter with no default).
     bridge_names: tuple[str, ...] = ()
-    #: Ours: seconds between two /diagnostics status messages (0 = none). Any type may be
-    #: given; ``start_diagnostics`` takes an int or a float and reports anything else.
-    status_period: object = 0.0
     #: Ours: bridge every Gazebo topic discovery shows (docs/many-topics.md, "Discovered bridging").
     auto_bridge: bool = False
     #: Ours: regular expressions on Gazebo names: only matching topics are auto-bridged
@@ -303,12 +303,13 @@ def declare_shared_parameters(node: Any, env: Mapping[str, str] | None = None) -
     ``env`` (default: the process's environment)."""
     env = os.environ if env is None else env
     defaults = SharedParameters(gz_version=env.get(GZ_VERSION_ENV, ""))
-    declared = _declare_fields(node, defaults, ("max_rate",))
+    declared = _declare_fields(node, defaults, ("max_rate", "status_period"))
     check_heartbeat(declared.subscription_heartbeat)
     check_transport_implementation(declared.gz_transport_implementation, env)
     any_type = read_only(dynamic_typing=True)
     max_rate = _declare(node, "max_rate", defaults.max_rate, any_type)
-    return dataclasses.replace(declared, max_rate=max_rate)
+    period = _declare(node, "status_period", defaults.status_period, any_type)
+    return dataclasses.replace(declared, max_rate=max_rate, status_period=period)
 
 
 def declare_parameter_bridge_parameters(
@@ -319,20 +320,14 @@ def declare_parameter_bridge_parameters(
     declared = _declare_fields(
         node,
         ParameterBridgeParameters(declare_shared_parameters(node, env)),
-        ("shared", "service_timeout", "status_period", *arrays),
+        ("shared", "service_timeout", *arrays),
     )
     lists: dict[str, Any] = {
         name: tuple(_declare(node, name, Parameter.Type.STRING_ARRAY) or ()) for name in arrays
     }
     any_type = read_only(dynamic_typing=True)
     timeout = _declare(node, "service_timeout", declared.service_timeout, any_type)
-    period = _declare(node, "status_period", declared.status_period, any_type)
-    return dataclasses.replace(
-        declared,
-        service_timeout=checked_service_timeout(timeout),
-        status_period=period,
-        **lists,
-    )
+    return dataclasses.replace(declared, service_timeout=checked_service_timeout(timeout), **lists)
 
 
 def check_heartbeat(milliseconds: int) -> None:

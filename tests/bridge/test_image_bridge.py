@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from diagnostic_msgs.msg import DiagnosticArray
 from sensor_msgs.msg import CameraInfo, Image
 
 from ros_gz_bridge_py.transport import GzNode
@@ -116,6 +117,7 @@ def bridge(tmp_path_factory: pytest.TempPathFactory) -> Iterator[SharedBridge]:
             "-p", "camera_info:=true",
             "-p", "qos:=bogus",
             "-p", f"config_file:={config}",
+            "-p", "status_period:=0.5",
         ],
     )  # fmt: skip
     process = start_process(command)
@@ -250,6 +252,33 @@ def test_bad_frames_are_reported_and_skipped(
     )
     for msg, _ in inbox.items():
         _assert_pattern_image(msg, "")
+
+
+def test_status_period_publishes_each_topic_on_diagnostics(
+    bridge: SharedBridge, ros_side: RosSide
+) -> None:
+    """image_bridge took status_period without a word and published nothing."""
+    arrays = Inbox()
+    subscription = ros_side.run(
+        lambda: ros_side.node.create_subscription(
+            DiagnosticArray, "/diagnostics", lambda m: arrays(m, None), 10
+        )
+    )
+    renamed = f"/{bridge.topics.renamed_ros}"
+
+    def names() -> set[str]:
+        return {
+            status.name
+            for array, _ in arrays.items()
+            for status in array.status
+            if status.hardware_id == "/ros_gz_image"
+        }
+
+    try:
+        wait_until(lambda: any(n.endswith(f" {renamed}") for n in names()), WAIT, "its status")
+    finally:
+        ros_side.destroy(subscription)
+    assert any(name.endswith(f" {bridge.topics.peer}") for name in names())
 
 
 def _skipped_lines(process: PeerProcess) -> str:

@@ -228,10 +228,10 @@ def test_parameter_bridge_defaults(ros_context: Context) -> None:
             gz_version="",
             expand_gz_topic_names=False,
             max_rate=0.0,
+            status_period=0.0,
         ),
         service_timeout=5.0,
         bridge_names=(),
-        status_period=0.0,
         auto_bridge=False,
         auto_bridge_allow=(),
         auto_bridge_deny=(),
@@ -269,11 +269,10 @@ def test_parameter_bridge_values(ros_context: Context) -> None:
         node.destroy_node()
     assert params == ParameterBridgeParameters(
         SharedParameters(
-            "/b.yaml", True, 200, True, "base", "zenoh", "fortress", True, 10, 8_000_000
+            "/b.yaml", True, 200, True, "base", "zenoh", "fortress", True, 10, 8_000_000, 2
         ),
         service_timeout=0.5,
         bridge_names=("a", "b"),
-        status_period=2,
         auto_bridge=True,
         auto_bridge_allow=("^/model/",),
         auto_bridge_deny=("camera", "lidar"),
@@ -308,7 +307,7 @@ def test_status_period_takes_any_type(ros_context: Context) -> None:
     """Checked and reported by start_diagnostics, not refused at declaration."""
     node = make_node(ros_context, [Parameter("status_period", value="often")])
     try:
-        assert declare_parameter_bridge_parameters(node, {}).status_period == "often"
+        assert declare_parameter_bridge_parameters(node, {}).shared.status_period == "often"
     finally:
         node.destroy_node()
 
