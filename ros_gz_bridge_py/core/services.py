@@ -278,26 +278,38 @@ class ServiceBridge:
 
     def _no_reply(self) -> str:
         """Why Gazebo did not answer in time, as far as discovery knows."""
-        service, waited = self.spec.service, f"{self.timeout:g} s"
+        waited = f"{self.timeout:g} s"
+        why, _ = self.provider_problem()
+        return (
+            f"no reply within {waited}: {why}" if why else f"no reply from Gazebo within {waited}"
+        )
+
+    def provider_problem(self) -> tuple[str, bool]:
+        """What discovery says keeps calls from being answered: ("", False) when a provider
+        of the bridge's types is known; (why, True) when the providers take other types (a
+        misconfiguration), (why, False) when there is none yet."""
+        service = self.spec.service
         providers = self._gz_node.service_info(service)
         if not providers:
-            return (
-                f"no reply within {waited}: no Gazebo provider of {service} is known (gz service "
-                "-l lists the services there are)"
+            why = (
+                f"no Gazebo provider of {service} is known (gz service -l lists the services "
+                "there are)"
             )
+            return why, False
         offered = {(p.request_type, p.response_type) for p in providers}
-        if not any(
+        if any(
             same_message(request, self.gz_req_type) and same_message(reply, self.gz_rep_type)
             for request, reply in offered
         ):
-            types = ", ".join(sorted(f"{request}/{reply}" for request, reply in offered))
-            return (
-                f"no reply within {waited}: the Gazebo providers of {service} take {types}, not "
-                f"{self.gz_req_type}/{self.gz_rep_type}, the only types {self.spec.ros_type} "
-                "converts to; bridge the service with the ROS type of theirs (bridge_types "
-                "--print-pairs lists the service pairs) or make the provider take these"
-            )
-        return f"no reply from Gazebo within {waited}"
+            return "", False
+        types = ", ".join(sorted(f"{request}/{reply}" for request, reply in offered))
+        why = (
+            f"the Gazebo providers of {service} take {types}, not "
+            f"{self.gz_req_type}/{self.gz_rep_type}, the only types {self.spec.ros_type} "
+            "converts to; bridge the service with the ROS type of theirs (bridge_types "
+            "--print-pairs lists the service pairs) or make the provider take these"
+        )
+        return why, True
 
     def _settle(self, future: Future, outcome: tuple[bool | None, bytes]) -> None:
         """The call's outcome, once (a reply, its timeout, or closing: whichever is first)."""

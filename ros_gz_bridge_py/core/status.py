@@ -40,6 +40,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
 from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.core.channel import Channel, ChannelState
+from ros_gz_bridge_py.core.diagnosis import Flow
 from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import NOT_CONVERTED, ServiceBridge
@@ -83,7 +84,8 @@ class ChannelStatus:
     #: Errors plus drops during the period.
     new_problems: int
     last_error: str = ""
-    #: The explainer's flow state ("" before its first evaluation, and for services).
+    #: The explainer's flow state ("" before its first evaluation, and for a service that
+    #: has a Gazebo provider).
     flow: str = ""
     #: Why the channel carries nothing, one cause per line ("" when nothing is wrong).
     why: str = ""
@@ -236,8 +238,13 @@ def channel_status(channel: Channel) -> ChannelStatus:
 def service_status(service: ServiceBridge) -> ChannelStatus:
     """A service bridge: calls are "received", answered calls "published", failures errors,
     responses given up for a client never discovered "dropped"; calls still waiting for
-    Gazebo are none of these yet."""
+    Gazebo are none of these yet. Without a Gazebo provider of its types it is "waiting for
+    Gazebo", and says why (WARN when the providers take other types)."""
+    why, fault = service.provider_problem()
     return ChannelStatus(
+        flow=Flow.WAITING_GAZEBO.value if why else "",
+        why=why,
+        fault=fault,
         direction="service",
         ros_name=service.service_name,
         gz_name=service.spec.service,

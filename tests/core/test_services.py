@@ -95,6 +95,8 @@ def test_a_call_reaches_gazebo_and_the_reply_comes_back(
     (seen,) = provider.requests
     assert (seen.pause, seen.multi_step, seen.reset.model_only) == (True, 7, True)
     assert not seen.reset.all
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert (status.level_name, status.flow, status.why) == ("OK", "", "")
 
 
 def test_the_reply_value_is_converted(rig: Rig, world: RosWorld) -> None:
@@ -147,12 +149,21 @@ def test_no_provider_gives_success_false_after_the_timeout(rig: Rig, world: RosW
 def test_a_provider_of_other_types_is_named_when_nothing_answers(rig: Rig, world: RosWorld) -> None:
     service = unique("other_types")
     rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    # before any call, the status says what it waits for (it said "ok" with no provider)
+    (waiting,) = StatusTracker(rig.bridge).snapshot()
+    assert (waiting.level_name, waiting.flow) == ("OK", "waiting for Gazebo")
+    assert waiting.message() == (
+        f"waiting for Gazebo: no Gazebo provider of {service} is known (gz service -l lists the "
+        "services there are)"
+    )
     provider = Provider(GzPose, GzBoolean(data=True))
     rig.gazebo().advertise_service(service, "gz.msgs.Pose", "gz.msgs.Boolean", provider)
     wait_until(lambda: bool(rig.gz.service_info(service)), "the provider in discovery")
     assert call(world, ControlWorld, service, control_request()).success is False
     assert provider.requests == []
     (status,) = StatusTracker(rig.bridge).snapshot()
+    assert (status.level_name, status.fault) == ("WARN", True)  # a misconfiguration
+    assert status.why.startswith(f"the Gazebo providers of {service} take gz.msgs.Pose/")
     assert status.last_error == (
         f"no reply within {SERVICE_TIMEOUT:g} s: the Gazebo providers of {service} take "
         "gz.msgs.Pose/gz.msgs.Boolean, not gz.msgs.WorldControl/gz.msgs.Boolean, the only "
