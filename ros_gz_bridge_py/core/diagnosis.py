@@ -131,11 +131,10 @@ def flow(situation: Situation) -> Flow:
 
 
 def findings(situation: Situation, hints: TypeHints) -> list[Finding]:
-    """Every cause that keeps ``situation``'s channel from carrying messages."""
-    found = [*_ros_findings(situation, hints)]
-    if not _gazebo_side_ready(situation):
-        found += _gazebo_findings(situation, hints)
-    return found
+    """Every cause that keeps ``situation``'s channel from carrying messages: the Gazebo
+    side's first, as :func:`flow` names the side it waits for first."""
+    found = [] if _gazebo_side_ready(situation) else _gazebo_findings(situation, hints)
+    return found + _ros_findings(situation, hints)
 
 
 # --- the Gazebo side -------------------------------------------------------------------------
