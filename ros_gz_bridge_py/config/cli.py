@@ -142,6 +142,13 @@ def _parse_arg(arg: str, position: int) -> tuple[BridgeSpec, list[str]]:
     if "/srv/" in ros_type:
         return _parse_service(name, ros_type, direction, after, source=source, fail=fail), warnings
     if direction is None:
+        stray = next((c for c in ros_type if not (c.isalnum() or c in "_/")), None)
+        if stray is not None:  # '/clock@rosgraph_msgs/msg/Clock<gz.msgs.Clock'
+            msg = (
+                f"'{stray}' is no direction symbol; between the ROS and the Gazebo type write "
+                "@ (both ways), [ (Gazebo->ROS) or ] (ROS->Gazebo)"
+            )
+            raise UsageError(msg, fail)
         msg = f"no Gazebo type; write {arg}@gz.msgs.X ([ for Gazebo->ROS, ] for ROS->Gazebo)"
         raise UsageError(msg, fail)
     if not after:

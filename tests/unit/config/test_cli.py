@@ -120,6 +120,18 @@ def test_missing_gz_type_is_an_error_with_the_fix() -> None:
     )
 
 
+@pytest.mark.parametrize("symbol", ["<", ">", "|", "-"])
+def test_a_symbol_that_is_no_direction_is_named(symbol: str) -> None:
+    """The hint was to append '@gz.msgs.X' to the whole argument, the bad symbol kept."""
+    arg = f"/clock@rosgraph_msgs/msg/Clock{symbol}gz.msgs.Clock"
+    with pytest.raises(UsageError) as caught:
+        parse_cli_args([arg])
+    assert str(caught.value) == (
+        f"argument 1 '{arg}': '{symbol}' is no direction symbol; between the ROS and the "
+        "Gazebo type write @ (both ways), [ (Gazebo->ROS) or ] (ROS->Gazebo)"
+    )
+
+
 def test_ros_type_without_msg_is_kept_with_a_hint() -> None:
     result = parse_cli_args(["/t@std_msgs/String@gz.msgs.StringMsg"])
     (spec,) = result.specs
