@@ -137,7 +137,7 @@ class ServiceBridge:
         self._host = host
         self._ros_node = host.node
         self._gz_node = gz_node
-        self._logger = quick_logger(host.node.get_logger())
+        self._logger = quick_logger(host.owner.get_logger())  # the bridge's name, not the side's
         self.calls = 0
         self.failures = 0
         #: Failed calls by what went wrong, and the last one's reason in full.

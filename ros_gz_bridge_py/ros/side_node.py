@@ -78,6 +78,8 @@ class SideNode:
     THREADS = 4
 
     def __init__(self, owner: Any) -> None:
+        #: The bridge's node, whose name the bridge's log lines carry.
+        self.owner = owner
         self.node = _helper_node(side_node_name(owner), owner)
         self.reentrant = ReentrantCallbackGroup()
         self.late_responses = LateResponses(self.node)

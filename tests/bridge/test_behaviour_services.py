@@ -49,8 +49,10 @@ CLI_SERVICES = {
 
 
 @pytest.fixture(scope="module")
-def services(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]]:
-    """Service names by key ("control", ..., "yaml") of one running bridge."""
+def service_bridge(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> Iterator[tuple[dict[str, str], PeerProcess]]:
+    """Service names by key ("control", ..., "yaml") of one running bridge, and the bridge."""
     require_peer()
     names = {key: unique_name(f"svc_{key}") for key in (*CLI_SERVICES, "yaml")}
     config = Path(tmp_path_factory.mktemp("services") / "services.yaml")
@@ -69,8 +71,13 @@ def services(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str
         ros_args=["-p", f"config_file:={config}", "-p", f"service_timeout:={SERVICE_TIMEOUT}"],
         creating=len(names),
     )
-    yield names
+    yield names, bridge
     bridge.stop()
+
+
+@pytest.fixture(scope="module")
+def services(service_bridge: tuple[dict[str, str], PeerProcess]) -> dict[str, str]:
+    return service_bridge[0]
 
 
 def start_replier(
@@ -139,14 +146,20 @@ def test_control_world_reaches_gazebo_and_succeeds(
 
 
 def test_control_world_failure_in_gazebo_is_success_false(
-    services: dict[str, str], ros_side: RosSide, started: list[PeerProcess]
+    service_bridge: tuple[dict[str, str], PeerProcess],
+    ros_side: RosSide,
+    started: list[PeerProcess],
 ) -> None:
+    services, bridge = service_bridge
     peer = start_replier(started, services["control_fail"], WORLD_CONTROL, "--fail")
     response, request = call_until_served(
         ros_side, peer, ControlWorld, services["control_fail"], control_request()
     )
     assert response.success is False
     assert "multi_step: 7" in request
+    # under the bridge's node name (it was its side node's, _ros_gz_bridge_side)
+    said = wait_for_line(bridge, rf"{services['control_fail']} .*Gazebo reported failure").string
+    assert "[ros_gz_bridge]: ROS->GZ service [" in said
 
 
 def test_no_gazebo_service_gives_exactly_one_failure_response(
