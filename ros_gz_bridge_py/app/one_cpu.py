@@ -87,7 +87,7 @@ class OneCpuPolicy:
         seconds = now.time - last.time
         load = (now.cpu - last.cpu) / seconds
         shares = _busy_shares(last.cpu_ticks, now.cpu_ticks)
-        figures = f"{load:.0%} of a core"
+        figures = f"the bridge used {load:.0%} of a core"
         if self.pinned is not None:
             why = _release_reason(now.bulk, load, self.pinned, shares)
             if why is None:
@@ -112,8 +112,9 @@ def _release_reason(
     if load > RELEASE_LOAD:
         return "a heavy load"
     others = [share for cpu, share in shares.items() if cpu != pinned]
-    if shares.get(pinned, 0.0) >= FULL_CPU and others and min(others) <= ROOMY_CPU:
-        return f"CPU {pinned} full while another has room"
+    busy = shares.get(pinned, 0.0)
+    if busy >= FULL_CPU and others and min(others) <= ROOMY_CPU:
+        return f"CPU {pinned} {busy:.0%} busy, mostly with other work, another {min(others):.0%}"
     return None
 
 

@@ -63,21 +63,21 @@ class Feed:
 def test_a_light_load_goes_to_the_least_busy_cpu() -> None:
     feed = Feed()
     move = feed.second(0.2, shares=(0.9, 0.3))
-    assert move == Move(1, "a light load (20% of a core)")
+    assert move == Move(1, "a light load (the bridge used 20% of a core)")
     assert feed.policy.pinned == 1
     assert feed.second(0.2, shares=(0.2, 0.9)) is None  # stays where it is
     assert feed.policy.pinned == 1
 
 
 def test_equal_cpus_take_the_lowest_number() -> None:
-    assert Feed().second(0.1) == Move(0, "a light load (10% of a core)")
+    assert Feed().second(0.1) == Move(0, "a light load (the bridge used 10% of a core)")
 
 
 def test_a_heavy_load_is_not_pinned() -> None:
     feed = Feed()
     assert feed.second(0.51) is None
     assert feed.policy.pinned is None
-    assert feed.second(0.5) == Move(0, "a light load (50% of a core)")
+    assert feed.second(0.5) == Move(0, "a light load (the bridge used 50% of a core)")
 
 
 def test_a_bulk_channel_is_not_pinned() -> None:
@@ -91,7 +91,9 @@ def test_a_bulk_channel_releases_and_holds() -> None:
     assert is_pin(feed.second(0.1))
     move = feed.second(0.1, bulk=True)
     assert move == Move(
-        None, f"an image or point cloud channel (10% of a core); spread for {FIRST_HOLD:.0f} s"
+        None,
+        "an image or point cloud channel (the bridge used 10% of a core); "
+        f"spread for {FIRST_HOLD:.0f} s",
     )
     assert feed.policy.pinned is None
 
@@ -103,18 +105,23 @@ def test_a_heavy_load_releases() -> None:
     move = feed.second(0.71)
     assert move is not None
     assert move.cpu is None  # a release
-    assert move.why.startswith("a heavy load (71% of a core)")
+    assert move.why.startswith("a heavy load (the bridge used 71% of a core)")
 
 
 def test_a_full_cpu_releases_only_while_another_has_room() -> None:
     feed = Feed()
-    assert feed.second(0.2, shares=(0.5, 0.4)) == Move(1, "a light load (20% of a core)")
+    assert feed.second(0.2, shares=(0.5, 0.4)) == Move(
+        1, "a light load (the bridge used 20% of a core)"
+    )
     assert feed.second(0.2, shares=(0.94, 1.0)) is None  # nowhere better to go
     assert feed.second(0.2, shares=(0.76, 1.0)) is None
     move = feed.second(0.2, shares=(0.75, 0.95))
     assert move is not None
     assert move.cpu is None  # a release
-    assert move.why.startswith("CPU 1 full while another has room")
+    # it read "CPU 1 full while another has room (20% of a core)": the bridge's own share
+    assert move.why.startswith(
+        "CPU 1 95% busy, mostly with other work, another 75% (the bridge used 20% of a core)"
+    )
 
 
 def test_the_hold_doubles_at_each_release_up_to_its_longest() -> None:
@@ -137,7 +144,7 @@ def test_a_clock_that_did_not_move_decides_nothing() -> None:
     feed = Feed()
     feed.time -= 1.0
     assert feed.second(0.1) is None
-    assert feed.second(0.1) == Move(0, "a light load (10% of a core)")
+    assert feed.second(0.1) == Move(0, "a light load (the bridge used 10% of a core)")
 
 
 def test_a_single_cpu_is_never_pinned() -> None:
