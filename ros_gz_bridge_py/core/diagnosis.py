@@ -123,9 +123,11 @@ def flow(situation: Situation) -> Flow:
     recent = max(FLOWING_WINDOW, 3 * (situation.interval or 0.0))
     if not _gazebo_side_ready(situation):
         return Flow.WAITING_GAZEBO
+    if not situation.input_open:  # lazy, nobody reads: whatever it passed before
+        return Flow.WAITING_ROS
     if situation.since_message is not None and situation.since_message <= recent:
         return Flow.FLOWING
-    if not situation.input_open or not _ros_side_ready(situation):
+    if not _ros_side_ready(situation):
         return Flow.WAITING_ROS
     return Flow.STALLED
 

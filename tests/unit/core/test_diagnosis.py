@@ -287,3 +287,16 @@ def test_similar_topics_are_found_once_while_the_list_stays_the_same(
         (finding,) = findings(listed, HINTS)
         assert "similar topics: /model/robot/odom_x" in finding.text
     assert compared == ["/odom_x"]
+
+
+def test_a_lazy_channel_nobody_reads_waits_for_ros_whatever_it_passed_before() -> None:
+    """The status table showed a lazy channel with its input closed as flowing for the few
+    seconds after its last reader left."""
+    idle = situation(
+        Direction.GZ_TO_ROS,
+        gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Odometry")],
+        since_message=0.5,
+        input_open=False,
+    )
+    assert flow(idle) is Flow.WAITING_ROS
+    assert flow(dataclasses.replace(idle, input_open=True)) is Flow.FLOWING
