@@ -12,6 +12,7 @@ from __future__ import annotations
 import warnings
 from typing import Any
 
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.duration import Duration
 from rclpy.qos import (
     DurabilityPolicy,
@@ -68,6 +69,20 @@ NAMED_PROFILES: dict[str, Any] = {
     "BEST_AVAILABLE": lambda: QoSProfile(**_fields(qos_profile_best_available)),
 }
 
+
+def _depth_checked(qos: QoSProfile) -> SetParametersResult:
+    """rclpy's check of the overridden profile: a negative depth reached the middleware,
+    whose error ("the requested queue size exceeds the DDS type") came with an rcutils
+    'error state is being overwritten' block on stderr."""
+    if qos.depth < 0:
+        reason = (
+            f"depth {qos.depth} is negative; give the depth of history to keep (0: the "
+            "middleware's default)"
+        )
+        return SetParametersResult(successful=False, reason=reason)
+    return SetParametersResult(successful=True)
+
+
 #: Policies users may override per publisher (rclcpp Jazzy set) and per subscription.
 PUBLISHER_OVERRIDES = QoSOverridingOptions(
     policy_kinds=(
@@ -77,9 +92,10 @@ PUBLISHER_OVERRIDES = QoSOverridingOptions(
         QoSPolicyKind.HISTORY,
         QoSPolicyKind.LIVELINESS,
         QoSPolicyKind.RELIABILITY,
-    )
+    ),
+    callback=_depth_checked,
 )
-SUBSCRIPTION_OVERRIDES = QoSOverridingOptions.with_default_policies()
+SUBSCRIPTION_OVERRIDES = QoSOverridingOptions.with_default_policies(callback=_depth_checked)
 
 
 def apply_subscription_overrides(node: Any, topic: str, qos: QoSProfile) -> None:

@@ -31,11 +31,12 @@ from testing.behaviour_harness import (
     relative,
     ros_side,
     start_bridge,
+    started,
     wait_gz_advertised,
 )
-from testing.gzpeer import require_peer, unique_name, wait_until
+from testing.gzpeer import PeerProcess, require_peer, unique_name, wait_for_line, wait_until
 
-__all__ = ["gz_node", "ros_side"]
+__all__ = ["gz_node", "ros_side", "started"]
 
 pytestmark = [pytest.mark.ros, pytest.mark.peer]
 
@@ -193,6 +194,27 @@ def test_a_publisher_depth_deeper_than_the_bridge_queue_still_carries(
     finally:
         ros_side.destroy(subscription)
         publisher.close()
+
+
+@pytest.mark.parametrize(("side", "symbol"), [("publisher", "["), ("subscription", "]")])
+def test_a_negative_override_depth_is_one_error_naming_it(
+    side: str, symbol: str, started: list[PeerProcess]
+) -> None:
+    """It reached the middleware: 'failed to set history depth since the requested queue
+    size exceeds the DDS type', after an rcutils 'error state is being overwritten' block."""
+    topic = unique_name(f"qos_negative_{side}")
+    bridge = start_bridge(
+        f"{topic}@std_msgs/msg/String{symbol}{STRING}",
+        ros_args=["-p", f"qos_overrides.{topic}.{side}.depth:=-3"],
+    )
+    started.append(bridge)
+    error = wait_for_line(bridge, r"\[ERROR\].*Failed to create a bridge", timeout=30).string
+    assert error.endswith(
+        f"Provided QoS overrides for {side} `{topic}` with id `None`, are not valid: depth -3 "
+        "is negative; give the depth of history to keep (0: the middleware's default)"
+    )
+    wait_for_line(bridge, r"No bridges are running", timeout=WAIT)
+    assert "rcutils" not in bridge.output()
 
 
 @pytest.mark.parametrize(("key", "frame"), [("frame", OVERRIDE_FRAME), ("yaml_frame", YAML_FRAME)])
