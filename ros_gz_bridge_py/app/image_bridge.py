@@ -40,7 +40,7 @@ from ros_gz_bridge_py.app.image_bridge_args import (
     with_camera_info,
     with_qos,
 )
-from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem
+from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem, unknown_parameters
 from ros_gz_bridge_py.app.settings import (
     ImageBridgeParameters,
     Switches,
@@ -105,9 +105,14 @@ def bridge_specs(
 
 
 def build_bridge(
-    node: Node, topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal
+    node: Node,
+    topics: Sequence[ImageTopic],
+    switches: Switches,
+    stop: StopSignal,
+    ros_args: Sequence[str],
 ) -> Bridge | None:
-    """The running bridge, or None (logged) when the parameters leave nothing to bridge."""
+    """The running bridge, or None (logged) when the parameters leave nothing to bridge;
+    ``ros_args`` are the ROS arguments, whose parameters no parameter takes are warned of."""
     logger = node.get_logger()
     for warning in switches.warnings:
         logger.warning(warning)
@@ -118,6 +123,8 @@ def build_bridge(
     except ConfigError as err:
         logger.error(str(err))
         return None
+    for warning in unknown_parameters(PROGRAM, ros_args, node):
+        logger.warning(warning)
     specs = bridge_specs(node, topic_specs(topics, gz_type), params)
     if not specs:
         logger.error(
@@ -142,13 +149,15 @@ def build_bridge(
     return bridge
 
 
-def run(topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal) -> int:
+def run(
+    topics: Sequence[ImageTopic], switches: Switches, stop: StopSignal, ros_args: Sequence[str]
+) -> int:
     """Bridge until ``stop`` or rclpy shutdown; the node and bridge are closed on the way out."""
     node = BridgeNode(NODE_NAME)
     bridge: Bridge | None = None
     diagnostics: DiagnosticsPublisher | None = None
     try:
-        bridge = build_bridge(node, topics, switches, stop)
+        bridge = build_bridge(node, topics, switches, stop, ros_args)
         if bridge is None:
             return USAGE_EXIT
         if stop.requested:
@@ -209,9 +218,9 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
     if cleaned:
         rclpy.logging.get_logger(NODE_NAME).info(cleaned)
     if stop is not None:
-        return run(topics, switches, stop)
+        return run(topics, switches, stop, ros_args)
     with StopSignal() as own:
-        return run(topics, switches, own)
+        return run(topics, switches, own, ros_args)
 
 
 if __name__ == "__main__":

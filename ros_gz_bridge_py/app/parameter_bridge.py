@@ -28,7 +28,7 @@ from ros_gz_bridge_py.app import discover
 from ros_gz_bridge_py.app.check import DEFAULT_SECONDS as DEFAULT_CHECK_SECONDS
 from ros_gz_bridge_py.app.check import Sides, run_check
 from ros_gz_bridge_py.app.one_cpu import OneCpu, start_one_cpu
-from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem
+from ros_gz_bridge_py.app.ros_arguments import ros_arguments_problem, unknown_parameters
 from ros_gz_bridge_py.app.settings import (
     ParameterBridgeParameters,
     Switches,
@@ -129,6 +129,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             except ConfigError as err:  # a parameter of the wrong type
                 node.get_logger().error(str(err))
                 return USAGE_EXIT
+            for warning in unknown_parameters(PROGRAM, argv, node):
+                node.get_logger().warning(warning)
             try:
                 values = placeholder_values(params, cli_values)
                 cli = parse_cli_args(positional, values)

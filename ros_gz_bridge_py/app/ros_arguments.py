@@ -5,7 +5,9 @@ traceback; here it is one line naming the argument and how to write it.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Sequence
+from typing import Any
 
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.utilities import remove_ros_args
@@ -50,3 +52,46 @@ def _rcl_reason(message: str) -> str:
     reason = RCL_SOURCE_LOCATION.sub("", message).removeprefix("Failed to parse ROS arguments: ")
     head = reason.partition(". Error: ")[0]
     return (head if " rule: " in head else reason).rstrip(".")
+
+
+def unknown_parameters(program: str, argv: Sequence[str], node: Any) -> list[str]:
+    """A warning for each ``-p NAME:=VALUE`` of ``argv``'s ROS arguments that names no
+    parameter ``node`` has declared, with the closest name it has: rcl keeps such a value
+    without a word, so a misspelt ``lazzy:=true`` left ``lazy`` at its default unnoticed.
+
+    Dotted names (``qos_overrides.*``, ``bridges.*``) are left out: they are declared as the
+    topics and bridges they name are made. So are names for another node (``other:NAME``).
+    """
+    warnings = []
+    for name in _parameter_names(argv, node.get_name()):
+        if "." in name or node.has_parameter(name):
+            continue
+        known = list(node.get_parameters_by_prefix(""))
+        close = difflib.get_close_matches(name, known, n=1)
+        hint = (
+            f"; did you mean {close[0]}"
+            if close
+            else f" (ros2 param list {node.get_fully_qualified_name()} lists them)"
+        )
+        warnings.append(f"parameter {name} is none of {program}'s, so it changes nothing{hint}")
+    return warnings
+
+
+def _parameter_names(argv: Sequence[str], node_name: str) -> list[str]:
+    """The names the ``-p``/``--param`` rules of ``argv``'s ROS arguments set for
+    ``node_name`` (or for every node), in order, once each."""
+    names: list[str] = []
+    in_ros = taking = False
+    for arg in argv:
+        if arg == "--ros-args":
+            in_ros, taking = True, False
+        elif in_ros and arg == "--":
+            in_ros = False
+        elif in_ros and taking:
+            taking = False
+            target, colon, name = arg.partition(":=")[0].rpartition(":")
+            if (not colon or target in (node_name, "*")) and name and name not in names:
+                names.append(name)
+        elif in_ros:
+            taking = arg in ("-p", "--param")
+    return names

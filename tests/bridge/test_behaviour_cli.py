@@ -130,3 +130,22 @@ def test_when_every_entry_fails_the_warning_says_so(started: list[PeerProcess]) 
         "No bridges are running: no entry could be bridged (1 failed; the errors above say "
         "why and what to write)"
     )
+
+
+def test_a_misspelt_parameter_is_named_with_the_one_meant(started: list[PeerProcess]) -> None:
+    """rcl keeps any -p value without a word: 'lazzy:=true' left lazy false unnoticed."""
+    topic = unique_name("cli_misspelt")
+    bridge = start_bridge(
+        f"{topic}@std_msgs/msg/String[{STRING}",
+        ros_args=[
+            "-p", "other_node:lazzy:=true",  # another node's: not ours to judge
+            "-p", f"qos_overrides.{topic}.publisher.depth:=3",  # declared with its topic
+            "-p", "ros_gz_bridge:lazzy:=true",
+        ],
+    )  # fmt: skip
+    started.append(bridge)
+    warning = wait_for_line(bridge, r"\[WARN\].*lazzy", timeout=30).string
+    assert warning.endswith(
+        "parameter lazzy is none of parameter_bridge's, so it changes nothing; did you mean lazy"
+    )
+    assert bridge.output().count("is none of parameter_bridge's") == 1

@@ -118,6 +118,7 @@ def bridge(tmp_path_factory: pytest.TempPathFactory) -> Iterator[SharedBridge]:
             "-p", "qos:=bogus",
             "-p", f"config_file:={config}",
             "-p", "status_period:=0.5",
+            "-p", "camera_infos:=true",
         ],
     )  # fmt: skip
     process = start_process(command)
@@ -283,6 +284,13 @@ def test_status_period_publishes_each_topic_on_diagnostics(
 
 def _skipped_lines(process: PeerProcess) -> str:
     return "\n".join(line for line in process.output().splitlines() if "message skipped" in line)
+
+
+def test_a_misspelt_parameter_is_named_with_the_one_meant(bridge: SharedBridge) -> None:
+    assert (
+        "parameter camera_infos is none of image_bridge's, so it changes nothing; did you "
+        "mean camera_info"
+    ) in bridge.process.output()
 
 
 def test_invalid_qos_is_logged_and_default_used(bridge: SharedBridge) -> None:
