@@ -63,10 +63,13 @@ def unknown_parameters(program: str, argv: Sequence[str], node: Any) -> list[str
     topics and bridges they name are made. So are names for another node (``other:NAME``).
     """
     warnings = []
-    for name in _parameter_names(argv, node.get_name()):
-        if "." in name or node.has_parameter(name):
-            continue
-        known = list(node.get_parameters_by_prefix(""))
+    unknown = [
+        name
+        for name in _parameter_names(argv, node.get_name())
+        if "." not in name and not node.has_parameter(name)
+    ]
+    known = list(node.get_parameters_by_prefix("")) if unknown else []
+    for name in unknown:
         close = difflib.get_close_matches(name, known, n=1)
         hint = (
             f"; did you mean {close[0]}"
