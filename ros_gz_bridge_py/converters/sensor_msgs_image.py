@@ -63,6 +63,9 @@ _FORMAT_NAMES: dict[int, str] = {
     ].enum_type.values_by_number.items()
 }
 
+#: The formats that convert, by name, for the error that refuses another.
+_SUPPORTED_FORMATS = ", ".join(_FORMAT_NAMES.get(fmt, str(fmt)) for fmt in PIXEL_FORMATS)
+
 #: ROS distortion_model <-> gz CameraInfo.Distortion.DistortionModelType value.
 DISTORTION_MODELS: dict[str, int] = {"plumb_bob": 0, "rational_polynomial": 1, "equidistant": 2}
 _DISTORTION_NAMES = {value: name for name, value in DISTORTION_MODELS.items()}
@@ -133,9 +136,9 @@ def image_meta_to_ros(gz: Any, data_size: int) -> tuple[Any, int]:
         value = gz.pixel_format_type
         name = _FORMAT_NAMES.get(value)
         spelled = f"{value} ({name})" if name else str(value)
-        supported = ", ".join(_FORMAT_NAMES.get(fmt, str(fmt)) for fmt in PIXEL_FORMATS)
         msg = (
-            f"gz.msgs.Image pixel_format_type {spelled} has no ROS encoding; supported: {supported}"
+            f"gz.msgs.Image pixel_format_type {spelled} has no ROS encoding; "
+            f"supported: {_SUPPORTED_FORMATS}"
         )
         raise ConversionError(msg)
     encoding, bytes_per_pixel = entry
