@@ -70,6 +70,8 @@ NODE_NAME = "ros_gz_image"
 USAGE_EXIT = 255
 #: Exit status when the Gazebo Transport side cannot be opened, as parameter_bridge's.
 TRANSPORT_EXIT = 1
+#: What sets the QoS of image_bridge's channels, as its explanations name it.
+QOS_SETTING = "image_bridge's qos parameter (default, sensor_data or system_default)"
 
 
 def bridge_specs(
@@ -104,10 +106,21 @@ def bridge_specs(
     return list(with_qos(specs, profile))
 
 
+def declared_parameters(node: Node) -> ImageBridgeParameters | None:
+    """The node's parameters, or None (logged) when one has a value of the wrong type."""
+    try:
+        return declare_image_bridge_parameters(node)
+    except ConfigError as err:
+        node.get_logger().error(str(err))
+        return None
+
+
 def build_bridge(
     node: Node,
+    params: ImageBridgeParameters,
     topics: Sequence[ImageTopic],
     switches: Switches,
+    *,
     stop: StopSignal,
     ros_args: Sequence[str],
 ) -> Bridge | None:
@@ -117,7 +130,6 @@ def build_bridge(
     for warning in switches.warnings:
         logger.warning(warning)
     try:
-        params = declare_image_bridge_parameters(node)
         gz_type = check_gz_type(params.gz_type)
         gz_version = check_gz_version(params.shared.gz_version)
     except ConfigError as err:
@@ -142,7 +154,7 @@ def build_bridge(
     )
     bridge = Bridge(
         node,
-        options=dataclasses.replace(options, types_fixed_by=PROGRAM),
+        options=dataclasses.replace(options, types_fixed_by=PROGRAM, qos_setting=QOS_SETTING),
         gz_options=params.shared.gz_node_options(stop),
     )
     bridge.add_all(specs)
@@ -157,12 +169,15 @@ def run(
     bridge: Bridge | None = None
     diagnostics: DiagnosticsPublisher | None = None
     try:
-        bridge = build_bridge(node, topics, switches, stop, ros_args)
+        params = declared_parameters(node)
+        if params is None:
+            return USAGE_EXIT
+        bridge = build_bridge(node, params, topics, switches, stop=stop, ros_args=ros_args)
         if bridge is None:
             return USAGE_EXIT
         if stop.requested:
             return 0
-        diagnostics = start_diagnostics(node, bridge, node.get_parameter("status_period").value)
+        diagnostics = start_diagnostics(node, bridge, params.shared.status_period)
         finish_start_up(node)
         serve(
             node,

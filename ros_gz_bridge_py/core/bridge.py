@@ -138,6 +138,7 @@ class Bridge:
                 self._ctx.own_nodes,
                 self._logger.warning,
                 types_fixed_by=self.options.types_fixed_by,
+                qos_setting=self.options.qos_setting,
             )
             self._explain_timer = ros_node.create_timer(EXPLAIN_PERIOD, self.explain, clock=steady)
 

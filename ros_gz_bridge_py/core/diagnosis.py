@@ -58,6 +58,10 @@ class RosEndpoint:
     qos: str = ""
 
 
+#: What sets a channel's QoS profile where entries do (not image_bridge's, a parameter).
+ENTRY_QOS_SETTING = "the entry's qos_profile"
+
+
 @dataclass(frozen=True)
 class TypeHints:
     """What the converter registry says about types, for the fixes a finding proposes."""
@@ -69,9 +73,10 @@ class TypeHints:
     #: ROS type -> the Gazebo types it pairs with.
     gz_types_for: Callable[[str], list[str]]
     #: The executable that chose the channels' types, where the user cannot ("image_bridge"):
-    #: a fix that changes them points to parameter_bridge, one of the QoS to its parameter.
-    #: "" when entries name their types.
+    #: a fix that changes them points to parameter_bridge. "" when entries name their types.
     types_fixed_by: str = ""
+    #: What the user changes to set a channel's QoS profile, as a fix names it.
+    qos_setting: str = ENTRY_QOS_SETTING
 
 
 @dataclass(frozen=True)
@@ -235,13 +240,6 @@ def _retyped(hints: TypeHints, fix: str) -> str:
     )
 
 
-def _qos_setting(hints: TypeHints) -> str:
-    """What sets a channel's QoS profile: image_bridge has a parameter, not entries."""
-    if hints.types_fixed_by == "image_bridge":
-        return "image_bridge's qos parameter (default, sensor_data or system_default)"
-    return "the entry's qos_profile"
-
-
 def _chosen(situation: Situation, type_name: str) -> str:
     """How the bridge came to use ``type_name``: its configuration, or a rule of discovery."""
     if situation.discovered_by:
@@ -381,7 +379,7 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
                     f"ros-qos:{endpoint.node}",
                     f"the ROS {role} {endpoint.node} of {situation.ros_topic} cannot match the "
                     f"bridge's QoS: {endpoint.qos_problem}; set "
-                    f"{_qos_setting(hints)} (or qos_overrides.{situation.ros_topic}.*) to what "
+                    f"{hints.qos_setting} (or qos_overrides.{situation.ros_topic}.*) to what "
                     "it uses",
                 )
             )

@@ -22,6 +22,7 @@ from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.converters.registry import Registry
 from ros_gz_bridge_py.core.channel import Channel, ChannelState
 from ros_gz_bridge_py.core.diagnosis import (
+    ENTRY_QOS_SETTING,
     Finding,
     RosEndpoint,
     Situation,
@@ -53,13 +54,16 @@ ROS_ENDPOINTS_REFRESH = 10.0
 BRIDGE_WIDE = frozenset({"no-peer"})
 
 
-def type_hints(registry: Registry, types_fixed_by: str = "") -> TypeHints:
+def type_hints(
+    registry: Registry, types_fixed_by: str = "", qos_setting: str = ENTRY_QOS_SETTING
+) -> TypeHints:
     """The registry's answers about types, as the findings' fixes need them."""
     return TypeHints(
         pairs=lambda ros_type, gz_type: registry.find(ros_type, gz_type) is not None,
         ros_types_for=registry.ros_types_for,
         gz_types_for=registry.gz_types_for,
         types_fixed_by=types_fixed_by,
+        qos_setting=qos_setting,
     )
 
 
@@ -180,9 +184,10 @@ class Explainer:
         now: Callable[[], float] = time.monotonic,
         *,
         types_fixed_by: str = "",
+        qos_setting: str = ENTRY_QOS_SETTING,
     ) -> None:
         self._gz = gz_node
-        self._hints = type_hints(registry, types_fixed_by)
+        self._hints = type_hints(registry, types_fixed_by, qos_setting)
         self._own = frozenset(own_nodes)
         self._log = log
         self._now = now

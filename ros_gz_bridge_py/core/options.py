@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ros_gz_bridge_py.config.gz_version import GARDEN
+from ros_gz_bridge_py.core.diagnosis import ENTRY_QOS_SETTING
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
@@ -55,6 +56,8 @@ class BridgeOptions:
     #: The executable that chose every entry's types ("image_bridge"): explanations then send a
     #: topic of other types to parameter_bridge instead of proposing types it cannot take.
     types_fixed_by: str = ""
+    #: What the user changes to set a channel's QoS profile, as explanations name it.
+    qos_setting: str = ENTRY_QOS_SETTING
 
     @property
     def garden(self) -> bool:

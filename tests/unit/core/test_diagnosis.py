@@ -234,7 +234,8 @@ def test_ros_endpoints_of_another_type_or_qos_are_named_even_while_flowing() -> 
     assert "; set the entry's qos_profile (or qos_overrides./odom.*) to what" in found[1].text
     assert flow(flowing) is Flow.FLOWING
     # image_bridge has no entries: its qos parameter (before, the fix named entries)
-    imaged = findings(flowing, dataclasses.replace(HINTS, types_fixed_by="image_bridge"))
+    qos_setting = "image_bridge's qos parameter (default, sensor_data or system_default)"
+    imaged = findings(flowing, dataclasses.replace(HINTS, qos_setting=qos_setting))
     assert "; set image_bridge's qos parameter (default, sensor_data or system_default) (or " in (
         imaged[1].text
     )
