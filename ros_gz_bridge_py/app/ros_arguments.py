@@ -9,6 +9,7 @@ import difflib
 from collections.abc import Sequence
 from typing import Any
 
+import yaml
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.utilities import remove_ros_args
 
@@ -55,19 +56,18 @@ def _rcl_reason(message: str) -> str:
 
 
 def unknown_parameters(program: str, argv: Sequence[str], node: Any) -> list[str]:
-    """A warning for each ``-p NAME:=VALUE`` of ``argv``'s ROS arguments that names no
-    parameter ``node`` has declared, with the closest name it has: rcl keeps such a value
-    without a word, so a misspelt ``lazzy:=true`` left ``lazy`` at its default unnoticed.
+    """A warning for each ``-p NAME:=VALUE`` of ``argv``'s ROS arguments, and each parameter of
+    a ``--params-file`` section for this node by name, that names no parameter ``node`` has
+    declared, with the closest name it has: rcl keeps such a value without a word, so a
+    misspelt ``lazzy:=true`` left ``lazy`` at its default unnoticed.
 
     Dotted names (``qos_overrides.*``, ``bridges.*``) are left out: they are declared as the
-    topics and bridges they name are made. So are names for another node (``other:NAME``).
+    topics and bridges they name are made. So are names for another node (``other:NAME``) and
+    a parameters file's wildcard sections (``/**``), which launch files share between nodes.
     """
     warnings = []
-    unknown = [
-        name
-        for name in _parameter_names(argv, node.get_name())
-        if "." not in name and not node.has_parameter(name)
-    ]
+    names = _parameter_names(argv, node.get_name(), node.get_fully_qualified_name())
+    unknown = [name for name in names if "." not in name and not node.has_parameter(name)]
     known = list(node.get_parameters_by_prefix("")) if unknown else []
     for name in unknown:
         close = difflib.get_close_matches(name, known, n=1)
@@ -80,21 +80,60 @@ def unknown_parameters(program: str, argv: Sequence[str], node: Any) -> list[str
     return warnings
 
 
-def _parameter_names(argv: Sequence[str], node_name: str) -> list[str]:
+def _parameter_names(argv: Sequence[str], node_name: str, full_name: str = "") -> list[str]:
     """The names the ``-p``/``--param`` rules of ``argv``'s ROS arguments set for
-    ``node_name`` (or for every node), in order, once each."""
+    ``node_name`` (or for every node), and the ``--params-file`` sections for ``full_name``
+    (or ``node_name`` at the root) set, in order, once each."""
     names: list[str] = []
-    in_ros = taking = False
+    in_ros = False
+    option = ""
     for arg in argv:
         if arg == "--ros-args":
-            in_ros, taking = True, False
+            in_ros, option = True, ""
         elif in_ros and arg == "--":
             in_ros = False
-        elif in_ros and taking:
-            taking = False
+        elif in_ros and option == "--params-file":
+            option = ""
+            names += _file_parameter_names(arg, node_name, full_name)
+        elif in_ros and option:
+            option = ""
             target, colon, name = arg.partition(":=")[0].rpartition(":")
-            if (not colon or target in (node_name, "*")) and name and name not in names:
+            if not colon or target in (node_name, "*"):
                 names.append(name)
-        elif in_ros:
-            taking = arg in ("-p", "--param")
-    return names
+        elif in_ros and arg in ("-p", "--param", "--params-file"):
+            option = "--params-file" if arg == "--params-file" else "-p"
+    return [name for index, name in enumerate(names) if name and name not in names[:index]]
+
+
+def _file_parameter_names(path: str, node_name: str, full_name: str) -> list[str]:
+    """The top-level parameter names of the sections of the parameters file ``path`` for the
+    node ``full_name`` (``/ns/name``; a plain ``name`` section is the root namespace's); none
+    when the file cannot be read (rcl has said so already)."""
+    try:
+        with open(path, encoding="utf-8") as stream:
+            document = yaml.safe_load(stream)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return []
+    own = (full_name or node_name).lstrip("/")
+    return [
+        name
+        for section, parameters in _sections(document, "")
+        if section.lstrip("/") == own
+        for name in parameters
+    ]
+
+
+def _sections(document: object, prefix: str) -> list[tuple[str, list[str]]]:
+    """(node path, its ``ros__parameters`` names) for every section of a parameters file, the
+    nested namespace keys joined with '/'; a nested block (``qos_overrides:``) is dotted names,
+    left out as on the command line."""
+    if not isinstance(document, dict):
+        return []
+    found: list[tuple[str, list[str]]] = []
+    for key, value in document.items():
+        if key == "ros__parameters" and isinstance(value, dict):
+            leaves = [str(name) for name, item in value.items() if not isinstance(item, dict)]
+            found.append((prefix, leaves))
+        elif isinstance(value, dict):
+            found += _sections(value, f"{prefix}/{str(key).strip('/')}" if prefix else str(key))
+    return found

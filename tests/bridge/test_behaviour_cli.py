@@ -7,6 +7,7 @@ Usage errors end the process before ROS starts, like the C++ bridge (usage on st
 from __future__ import annotations
 
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -147,5 +148,29 @@ def test_a_misspelt_parameter_is_named_with_the_one_meant(started: list[PeerProc
     warning = wait_for_line(bridge, r"\[WARN\].*lazzy", timeout=30).string
     assert warning.endswith(
         "parameter lazzy is none of parameter_bridge's, so it changes nothing; did you mean lazy"
+    )
+    assert bridge.output().count("is none of parameter_bridge's") == 1
+
+
+def test_a_misspelt_parameter_in_a_params_file_is_named(
+    started: list[PeerProcess], tmp_path: Path
+) -> None:
+    """A --params-file value rcl keeps without a word, as a -p one: the file's section for the
+    bridge by name is looked at; its wildcard section, which launch files share, is not."""
+    topic = unique_name("cli_params_file")
+    params = tmp_path / "bridge.yaml"
+    params.write_text(
+        "/**:\n  ros__parameters:\n    shared_with_others: 1\n"
+        "ros_gz_bridge:\n  ros__parameters:\n    status_priod: 2.0\n"
+        f"    qos_overrides:\n      {topic}:\n        publisher:\n          depth: 3\n"
+    )
+    bridge = start_bridge(
+        f"{topic}@std_msgs/msg/String[{STRING}", ros_args=["--params-file", str(params)]
+    )
+    started.append(bridge)
+    warning = wait_for_line(bridge, r"\[WARN\].*status_priod", timeout=30).string
+    assert warning.endswith(
+        "parameter status_priod is none of parameter_bridge's, so it changes nothing; "
+        "did you mean status_period"
     )
     assert bridge.output().count("is none of parameter_bridge's") == 1

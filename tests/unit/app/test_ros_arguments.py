@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from ros_gz_bridge_py.app.ros_arguments import _parameter_names
 
 
@@ -13,3 +15,26 @@ def test_only_the_parameters_of_ros_arguments_for_this_node_are_taken() -> None:
         "-p", "last:=7",
     ]  # fmt: skip
     assert _parameter_names(argv, "me") == ["lazy", "a.b", "mine", "all", "last"]
+
+
+def test_a_parameters_file_section_for_this_node_is_taken(tmp_path: Path) -> None:
+    """--params-file values were not looked at: a misspelt name in the file went unnoticed."""
+    params = tmp_path / "bridge.yaml"
+    params.write_text(
+        "/**:\n  ros__parameters:\n    use_sim_time: true\n    shared: 1\n"
+        "ros_gz_bridge:\n  ros__parameters:\n    lazzy: true\n"
+        "    qos_overrides:\n      /odom:\n        publisher:\n          depth: 3\n"
+        "/robot1/ros_gz_bridge:\n  ros__parameters:\n    in_ns: 1\n"
+        "/robot2:\n  ros__parameters:\n    not_a_node: 1\n"
+        "  ros_gz_bridge:\n    ros__parameters:\n      nested: 1\n"
+        "other_node:\n  ros__parameters:\n    theirs: 1\n"
+    )
+    argv = ["prog", "--ros-args", "--params-file", str(params), "-p", "lazzy:=false"]
+    assert _parameter_names(argv, "ros_gz_bridge", "/ros_gz_bridge") == ["lazzy"]
+    assert _parameter_names(argv, "ros_gz_bridge", "/robot1/ros_gz_bridge") == ["in_ns", "lazzy"]
+    assert _parameter_names(argv, "ros_gz_bridge", "/robot2/ros_gz_bridge") == [
+        "nested",
+        "lazzy",
+    ]
+    unreadable = ["prog", "--ros-args", "--params-file", str(tmp_path / "none.yaml")]
+    assert _parameter_names(unreadable, "ros_gz_bridge", "/ros_gz_bridge") == []
