@@ -35,7 +35,6 @@ from ros_gz_bridge_py.config import (
     ServiceBridgeSpec,
     TopicBridgeSpec,
 )
-from ros_gz_bridge_py.config.model import DEPRECATED_DIRECTIONS
 from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.core.channel import Channel, ChannelContext
 from ros_gz_bridge_py.core.explain import EXPLAIN_PERIOD, Explainer
@@ -179,20 +178,13 @@ class Bridge:
                 nothing of it is left open.
             BridgeError: the bridge is closed.
         """
-        checked = checked_spec(spec)
+        checked = checked_spec(spec, self._logger.warning)
         with self._lock:
             if self._closed:
                 msg = f"the bridge is closed; {spec!r} was not added"
                 raise BridgeError(msg)
             keys = self._keys(checked)
             refuse_twice(checked, keys, self._claims)
-            if isinstance(spec, TopicBridgeSpec) and isinstance(checked, TopicBridgeSpec):
-                old = spec.direction
-                if isinstance(old, str) and old in DEPRECATED_DIRECTIONS:
-                    self._logger.warning(
-                        f"{checked.source or checked.ros_topic}: direction {old} is "
-                        f"deprecated, use {checked.direction.value}"
-                    )
             handle = (
                 self._add_service(checked)
                 if isinstance(checked, ServiceBridgeSpec)

@@ -40,9 +40,10 @@ _EXAMPLES = {
 }
 
 
-def checked_spec(spec: object) -> BridgeSpec:
+def checked_spec(spec: object, warn: Callable[[str], None]) -> BridgeSpec:
     """``spec`` as the bridge takes it, its values in their types (``"GZ_TO_ROS"`` becomes
-    :class:`Direction`, ``"10"`` a depth of 10).
+    :class:`Direction`, ``"10"`` a depth of 10); a deprecated spelling (``"IGN_TO_ROS"``) is
+    taken and ``warn`` told.
 
     Raises:
         ConfigError: not a spec, or a field the YAML parser would refuse; the message names
@@ -69,7 +70,7 @@ def checked_spec(spec: object) -> BridgeSpec:
         _text(spec, "qos_profile", spec.qos_profile)  # its name is checked with the QoS
     return dataclasses.replace(
         spec,
-        direction=_direction(spec),
+        direction=_direction(spec, warn),
         lazy=_optional(spec, "lazy", as_bool),
         publisher_queue=_optional(spec, "publisher_queue", as_queue),
         subscriber_queue=_optional(spec, "subscriber_queue", as_queue),
@@ -139,12 +140,17 @@ def _text(spec: BridgeSpec, name: str, value: object) -> None:
     raise ConfigError(msg, _where(spec))
 
 
-def _direction(spec: TopicBridgeSpec) -> Direction:
+def _direction(spec: TopicBridgeSpec, warn: Callable[[str], None]) -> Direction:
     value: Any = spec.direction
     if isinstance(value, Direction):
         return value
     if isinstance(value, str) and value in DEPRECATED_DIRECTIONS:
-        return DEPRECATED_DIRECTIONS[value]
+        replacement = DEPRECATED_DIRECTIONS[value]
+        warn(
+            f"{spec.source or spec.ros_topic}: direction {value} is deprecated, "
+            f"use {replacement.value}"
+        )
+        return replacement
     try:
         return Direction(value)
     except ValueError:
