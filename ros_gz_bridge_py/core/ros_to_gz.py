@@ -120,14 +120,16 @@ class RosToGzChannel(Channel):
         callback: Callable[..., None]
         overrides: QoSOverridingOptions | None = SUBSCRIPTION_OVERRIDES
         if self.loop_guard:
-            # The overrides are the bridge node's parameters, not the side node's.
+            # The overrides are the bridge node's parameters, not the side node's; so is the
+            # name: the side node takes the one the bridge node resolved (its remap rules).
             apply_subscription_overrides(self.ctx.ros_node, self.spec.ros_topic, self._qos)
-            node, callback, overrides = self.ctx.side_node(), self._on_ros_message_guarded, None
+            node, name, overrides = self.ctx.side_node(), self.ros_topic, None
+            callback = self._on_ros_message_guarded
         else:
-            node, callback = self.ctx.ros_node, self._on_ros_message
+            node, name, callback = self.ctx.ros_node, self.spec.ros_topic, self._on_ros_message
         self._subscription = node.create_subscription(
             self.pair.ros_class,
-            self.spec.ros_topic,
+            name,
             callback,
             self._qos,
             qos_overriding_options=overrides,
@@ -140,7 +142,7 @@ class RosToGzChannel(Channel):
         apply_subscription_overrides(self.ctx.ros_node, self.spec.ros_topic, self._qos)
         node = self.ctx.native_node()
         self._subscription = node.create_subscription(
-            self.pair.ros_class, self.spec.ros_topic, _taken_natively, self._qos, raw=True
+            self.pair.ros_class, self.ros_topic, _taken_natively, self._qos, raw=True
         )
         self._subscription_node = node
         own = self._own

@@ -157,9 +157,12 @@ class ServiceBridge:
         self.late_answers = 0
         self.unanswered = 0
         self._late_notes = Throttle(DROP_WARN_PERIOD)
+        #: The name the bridge's node resolves ``spec.service`` to (its remap rules, which the
+        #: side node that serves it does not take: ``ros/side_node.py``).
+        self.service_name: str = host.owner.resolve_service_name(spec.service)
         self._service = host.node.create_service(
             pair.ros_class,
-            spec.service,
+            self.service_name,
             self._on_request,
             qos_profile=QoSProfile(
                 depth=REQUEST_DEPTH,
@@ -169,8 +172,6 @@ class ServiceBridge:
             callback_group=host.reentrant,
         )
         host.late_responses.serve(self._service, self)
-        #: The name ROS resolved ``spec.service`` to (rclpy's ``srv_name`` is the given one).
-        self.service_name: str = host.node.resolve_service_name(spec.service)
 
     def describe(self) -> str:
         """``ROS->GZ service [<name> (<ROS type> -> <request>/<reply>)]`` with the resolved

@@ -58,15 +58,16 @@ def _helper_node(name: str, owner: Any) -> RosNode:
     service imports numpy (``ros/bridge_node.py``), which a channel created with this node
     would wait for.
 
-    Its own ``__node`` remapping keeps its name when the user renames the bridge's node with
-    ``--ros-args -r __node:=NAME``, which otherwise renames every node of the process; other
-    remappings apply to it as to the bridge's node.
+    The process's ROS arguments are not its own: ``-r __node:=NAME`` would rename it too, and
+    a remap rule for the bridge's node (``-r ros_gz_bridge:/a:=/b``) would not reach it. Its
+    endpoints take the names the bridge's node resolves (every rule the user wrote for it), in
+    the bridge's namespace.
     """
     return RosNode(
         name,
         namespace=owner.get_namespace(),
         context=owner.context,
-        cli_args=["--ros-args", "-r", f"__node:={name}"],
+        use_global_arguments=False,
         start_parameter_services=False,
         parameter_overrides=[Parameter(START_TYPE_DESCRIPTION_SERVICE_PARAM, value=False)],
     )

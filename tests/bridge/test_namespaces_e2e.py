@@ -74,3 +74,39 @@ def test_a_namespaced_command_line_bridge_and_image_bridge_publish_under_it(
     assert (frame.width, frame.height, frame.header.frame_id) == (2, 2, "cam")
     assert probe.count_publishers(f"/{chatter}") == 0
     assert probe.count_publishers(f"/{camera}/image") == 0
+
+
+def test_a_remap_rule_for_the_bridge_node_reaches_every_endpoint(
+    probe: RosSide, started: list[PeerProcess]
+) -> None:
+    """``-r ros_gz_bridge:/a:=/b`` moved the bridge node's publishers, but the subscriptions
+    and services on its helper nodes stayed on /a while the log said /a resolves to /b."""
+    both, one_way = unique_name("remap_both"), unique_name("remap_one_way")
+    service = unique_name("remap_control")
+    renamed = {name: f"{name}_renamed" for name in (both, one_way, service)}
+    rules = [arg for old, new in renamed.items() for arg in ("-r", f"ros_gz_bridge:{old}:={new}")]
+    bridge = start_process(
+        bridge_command(
+            f"{both}@std_msgs/msg/String@gz.msgs.StringMsg",  # its subscription: the side node
+            f"{one_way}@std_msgs/msg/String]gz.msgs.StringMsg",  # the native loop's node
+            f"{service}@ros_gz_interfaces/srv/ControlWorld",
+            ros_args=[*rules, "-r", "other_node:/x:=/y"],
+        )
+    )
+    started.append(bridge)
+    wait_for_line(bridge, rf"the ROS name {service} resolves to {renamed[service]}", timeout=30)
+    for topic in (both, one_way):
+        new = renamed[topic]
+        wait_until(
+            lambda: probe.count_subscribers(new) == 1,  # noqa: B023 - called in this iteration
+            WAIT,
+            f"the bridge's subscription of {new}",
+        )
+        assert probe.count_subscribers(topic) == 0
+    assert probe.count_publishers(renamed[both]) == 1
+
+    def services() -> set[str]:
+        return {name for name, _ in probe.run(probe.node.get_service_names_and_types)}
+
+    wait_until(lambda: renamed[service] in services(), WAIT, f"the service {renamed[service]}")
+    assert service not in services()
