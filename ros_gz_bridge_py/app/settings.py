@@ -287,6 +287,27 @@ def _declare(
         raise ConfigError(msg) from None
 
 
+def _declare_strings(node: Any, name: str) -> tuple[str, ...]:
+    """A list-of-strings parameter, an empty list unless given. rclpy takes an empty list for a
+    byte array, so it is declared with dynamic typing and checked here: declared with its type
+    alone it had no value, and one parameter without a value empties every answer of the
+    node's get_parameters service (``ros2 param dump`` printed nothing).
+
+    Raises:
+        ConfigError: the value given is not a list of strings.
+    """
+    value = _declare(node, name, [], read_only(dynamic_typing=True))
+    if value is None or (
+        isinstance(value, list | tuple) and all(isinstance(v, str) for v in value)
+    ):
+        return tuple(value or ())
+    given = node.get_parameter(name).type_.name
+    said = f"Trying to set parameter '{name}' to '{value}' of type '{given}', expecting a list"
+    wanted = _WRITTEN_AS[Parameter.Type.STRING_ARRAY]
+    msg = f"parameter {name} has the wrong type ({said}); give it as {wanted}, or leave it out"
+    raise ConfigError(msg)
+
+
 def _declare_fields(node: Any, defaults: _Parameters, skip: Collection[str]) -> _Parameters:
     """Declare a parameter per field of ``defaults`` but those in ``skip``, each defaulting to
     its value (which sets its type); ``defaults`` with the declared values."""
@@ -322,9 +343,7 @@ def declare_parameter_bridge_parameters(
         ParameterBridgeParameters(declare_shared_parameters(node, env)),
         ("shared", "service_timeout", *arrays),
     )
-    lists: dict[str, Any] = {
-        name: tuple(_declare(node, name, Parameter.Type.STRING_ARRAY) or ()) for name in arrays
-    }
+    lists: dict[str, Any] = {name: _declare_strings(node, name) for name in arrays}
     any_type = read_only(dynamic_typing=True)
     timeout = _declare(node, "service_timeout", declared.service_timeout, any_type)
     return dataclasses.replace(declared, service_timeout=checked_service_timeout(timeout), **lists)

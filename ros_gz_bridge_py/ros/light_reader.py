@@ -180,14 +180,17 @@ def _basic_reader(typename: str) -> Reader:
 
 
 def _read_string(buf: bytes, pos: int) -> tuple[str, int]:
+    """A CDR string as rclpy reads it: its bytes up to the first NUL (the one that ends it,
+    or one inside), all of them when the last is not a NUL; a length of 0 is ''."""
     pos += -(pos - BODY) % 4
     (length,) = _U32.unpack_from(buf, pos)
     pos += 4
     end = pos + length
-    if length == 0 or end > len(buf):
+    if end > len(buf):
         msg = f"string of {length} bytes at offset {pos}"
         raise IndexError(msg)
-    return buf[pos : end - 1].decode(), end
+    nul = buf.find(0, pos, end)
+    return buf[pos : end if nul < 0 else nul].decode(), end
 
 
 def _nested_reader(slot: Any) -> Reader:

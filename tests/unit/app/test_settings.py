@@ -240,6 +240,21 @@ def test_parameter_bridge_defaults(ros_context: Context) -> None:
 
 
 @pytest.mark.ros
+def test_every_parameter_has_a_value_so_tools_can_read_them_all(ros_context: Context) -> None:
+    """The list parameters were declared without a value, and one such parameter emptied
+    every answer of the node's get_parameters service: ``ros2 param dump`` printed nothing."""
+    node = make_node(ros_context)
+    try:
+        declare_parameter_bridge_parameters(node, {})
+        names = sorted(node.get_parameters_by_prefix(""))
+        values = {parameter.name: parameter.value for parameter in node.get_parameters(names)}
+    finally:
+        node.destroy_node()
+    assert {"bridge_names", "auto_bridge_allow", "auto_bridge_deny", "placeholders"} <= set(values)
+    assert values["bridge_names"] == []
+
+
+@pytest.mark.ros
 def test_parameter_bridge_values(ros_context: Context) -> None:
     node = make_node(
         ros_context,
@@ -400,6 +415,7 @@ def test_every_message_path_switch_is_a_bridge_option() -> None:
         ("subscription_heartbeat", "often", "an integer"),
         ("config_file", 5, "a string"),
         ("bridge_names", "robot", "a list of strings, such as ['a', 'b']"),
+        ("placeholders", [1, 2], "a list of strings, such as ['a', 'b']"),
     ],
 )
 def test_a_parameter_of_the_wrong_type_is_named_with_the_fix(

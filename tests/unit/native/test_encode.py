@@ -322,8 +322,8 @@ def test_string_lengths_that_miss_the_nul_agree(encoding: Encoding) -> None:
 
 
 def test_strings_without_their_nul_or_with_one_inside_agree(encoding: Encoding) -> None:
-    """Python takes a string's bytes but the last one, whatever they are (a NUL among them,
-    the last one not a NUL): the encoder leaves such strings to it."""
+    """Python takes a string's bytes up to its first NUL, all of them without one, as rclpy
+    does: the encoder leaves such strings to it."""
     data = _distinctive(encoding.pair)
     for at, nul in _texts(data):
         start = at + 4

@@ -9,10 +9,11 @@ conversion errors) must be equal.
 
 from __future__ import annotations
 
+import struct
 from typing import Any
 
 import pytest
-from rclpy.serialization import serialize_message
+from rclpy.serialization import deserialize_message, serialize_message
 
 from ros_gz_bridge_py.converters.registry import Pair, default_registry
 from ros_gz_bridge_py.errors import ConversionError
@@ -51,6 +52,23 @@ def test_other_encapsulations_are_left_to_rclpy() -> None:
     cdr = bytearray(serialize_message(filled(Twist)))
     cdr[1] = 0x00  # big endian
     assert light_reader.read(bytes(cdr), Twist) is None
+
+
+@pytest.mark.parametrize(
+    "text",
+    [b"hello\x00", b"hello", b"ab\x00cd\x00", b"", b"\x00", b"caf\xc3\xa9"],
+    ids=["nul-ended", "no-nul", "nul-inside", "empty", "only-nul", "utf8"],
+)
+def test_a_string_reads_as_rclpy_reads_it(text: bytes) -> None:
+    """A String without its closing NUL lost its last letter ('hello' became 'hell') and one
+    of length 0 was refused: rclpy keeps every byte up to the first NUL."""
+    from std_msgs.msg import String  # noqa: PLC0415
+
+    cdr = b"\x00\x01\x00\x00" + struct.pack("<I", len(text)) + text
+    cdr += b"\x00" * (-len(cdr) % 4)
+    tree = light_reader.read(cdr, String)
+    assert tree is not None
+    assert tree.data == deserialize_message(cdr, String).data
 
 
 def test_truncated_message_is_a_conversion_error() -> None:
