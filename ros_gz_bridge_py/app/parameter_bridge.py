@@ -65,6 +65,7 @@ from ros_gz_bridge_py.core.explain import gazebo_name
 from ros_gz_bridge_py.core.status import DiagnosticsPublisher, serve, start_diagnostics
 from ros_gz_bridge_py.errors import ConfigError, TransportError
 from ros_gz_bridge_py.ros.bridge_node import BridgeNode
+from ros_gz_bridge_py.ros.python_logging import python_logging_to
 from ros_gz_bridge_py.ros.runtime import apply_speed_settings, make_executor
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, create_gz_node
@@ -119,6 +120,7 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
         if stop is None:
             stop = scope.enter_context(StopSignal())
         node = BridgeNode(NODE_NAME)
+        scope.enter_context(python_logging_to(node.get_logger()))
         bridge: Bridge | None = None
         diagnostics: DiagnosticsPublisher | None = None
         discovered: DiscoveredBridges | None = None

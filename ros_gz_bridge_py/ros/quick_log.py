@@ -20,7 +20,8 @@ from typing import Any
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.logging import LoggingSeverity
 
-_WRITE = getattr(_rclpy, "rclpy_logging_rcutils_log", None)
+#: rclpy's binding that writes one record through rcutils (None where a build lacks it).
+RCUTILS_WRITE = getattr(_rclpy, "rclpy_logging_rcutils_log", None)
 
 
 class QuickLogger:
@@ -50,13 +51,13 @@ class QuickLogger:
         return bool(self._logger.is_enabled_for(severity))
 
     def _log(self, severity: LoggingSeverity, message: str, filters: dict[str, Any]) -> None:
-        if filters or _WRITE is None:
+        if filters or RCUTILS_WRITE is None:
             self._logger.log(message, severity, **filters)
         elif self._logger.is_enabled_for(severity):
             caller = sys._getframe(2)  # _log <- info/warning/... <- the caller
             code = caller.f_code
             path = os.path.abspath(code.co_filename)  # as rclpy names it
-            _WRITE(severity, self._name, message, code.co_name, path, caller.f_lineno)
+            RCUTILS_WRITE(severity, self._name, message, code.co_name, path, caller.f_lineno)
 
 
 def quick_logger(logger: Any) -> QuickLogger:

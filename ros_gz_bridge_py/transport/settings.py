@@ -79,15 +79,22 @@ def planned_rcvhwm(subscriptions: int) -> int:
     return min(DEFAULT_HWM, max(PLANNED_MIN_HWM, fits))
 
 
-def _positive(env: Mapping[str, str], name: str, default: int) -> int:
-    return _integer(env, name, default, None, "a non-negative integer")
+def _positive(env: Mapping[str, str], name: str, default: int, said: str = "") -> int:
+    return _integer(env, name, default, None, "a non-negative integer", said=said)
 
 
 def _integer(
-    env: Mapping[str, str], name: str, default: int, highest: int | None, what: str
+    env: Mapping[str, str],
+    name: str,
+    default: int,
+    highest: int | None,
+    what: str,
+    *,
+    said: str = "",
 ) -> int:
     """The integer from 0 to ``highest`` in ``name``; ``default`` when unset, and with a
-    warning naming the value when it is not ``what``."""
+    warning naming the variable and its value when it is not ``what`` (``said`` is what the
+    warning calls the default, when not its number)."""
     raw = lookup(env, name)
     if raw is None:
         return default
@@ -96,7 +103,8 @@ def _integer(
     except ValueError:
         value = -1
     if value < 0 or (highest is not None and value > highest):
-        _LOG.warning("ignoring %s=%r: not %s; using %d", name, raw, what, default)
+        variable = next(prefix + name for prefix in ("GZ_", "IGN_") if prefix + name in env)
+        _LOG.warning("ignoring %s=%r: not %s; using %s", variable, raw, what, said or default)
         return default
     return value
 
@@ -164,7 +172,7 @@ class TransportSettings:
         if srv_port == msg_port:
             srv_port = msg_port - 1 if msg_port == MAX_PORT else msg_port + 1
         relays = tuple(ip for ip in (lookup(env, "RELAY") or "").split(":") if ip)
-        rcvhwm = _positive(env, "TRANSPORT_RCVHWM", -1)  # -1: not set
+        rcvhwm = _positive(env, "TRANSPORT_RCVHWM", -1, "the default")  # -1: not set
         return cls(
             partition=default_partition(env) if partition is None else partition,
             ip=lookup(env, "IP") or None,

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import logging
 import socket
+
+import pytest
 
 from ros_gz_bridge_py.transport.settings import (
     DEFAULT_MAX_MESSAGE_SIZE,
@@ -104,3 +107,19 @@ def test_a_receive_hwm_the_user_sets_wins_over_the_planned_one() -> None:
     for name in ("GZ_TRANSPORT_RCVHWM", "IGN_TRANSPORT_RCVHWM"):
         settings = TransportSettings.from_env({name: "300"}, planned_subscriptions=201)
         assert settings.rcvhwm == 300
+
+
+def test_a_bad_value_is_named_by_the_variable_set_and_the_default_in_words(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """The warning said 'TRANSPORT_RCVHWM' (no such variable) and 'using -1' (a marker)."""
+    with caplog.at_level(logging.WARNING):
+        settings = TransportSettings.from_env(
+            {"GZ_TRANSPORT_RCVHWM": "abc", "IGN_DISCOVERY_MSG_PORT": "70000"},
+            planned_subscriptions=1,
+        )
+    assert settings.rcvhwm == planned_rcvhwm(1)
+    assert [record.getMessage() for record in caplog.records] == [
+        "ignoring IGN_DISCOVERY_MSG_PORT='70000': not a port number; using 10317",
+        "ignoring GZ_TRANSPORT_RCVHWM='abc': not a non-negative integer; using the default",
+    ]
