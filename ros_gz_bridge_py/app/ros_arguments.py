@@ -6,6 +6,7 @@ traceback; here it is one line naming the argument and how to write it.
 from __future__ import annotations
 
 import difflib
+import re
 from collections.abc import Sequence
 from typing import Any
 
@@ -19,7 +20,11 @@ from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION
 _ROS_ARGUMENT_FIXES = (
     ("parameter override", "write -p NAME:=VALUE with a value, e.g. -p config_file:=bridge.yaml"),
     ("params", "give --params-file the path of a readable parameters YAML file"),
-    ("remap", "write -r FROM:=TO, e.g. -r __ns:=/robot1"),
+    (
+        "remap",
+        "write -r FROM:=TO, e.g. -r __ns:=/robot1; a ROS name is letters, digits and "
+        "underscores between its '/' (no '-' or '.'), and a node name starts with a letter",
+    ),
     ("log level", "write --log-level LEVEL: debug, info, warn, error or fatal"),
 )
 _ROS_ARGUMENTS_GUIDE = "see 'Passing ROS arguments to nodes' in the ROS 2 documentation"
@@ -42,9 +47,30 @@ def ros_arguments_problem(program: str, argv: Sequence[str]) -> str:
         )
     except _rclpy.RCLInvalidROSArgsError as err:
         reason = _rcl_reason(str(err))
-        fix = next((fix for words, fix in _ROS_ARGUMENT_FIXES if words in reason), None)
+        fix = _bridge_list_fix(reason) or next(
+            (fix for words, fix in _ROS_ARGUMENT_FIXES if words in reason), None
+        )
         return f"{program}: bad ROS argument: {reason}; {fix or _ROS_ARGUMENTS_GUIDE}"
     return ""
+
+
+def _bridge_list_fix(reason: str) -> str:
+    """The fix when rcl could not read a ``--params-file`` that is a list of bridges (the
+    bridge's own YAML, which ``config_file`` takes); '' otherwise."""
+    found = re.search(r"--params-file (.+?)'", reason)
+    if found is None:
+        return ""
+    try:
+        with open(found.group(1), encoding="utf-8") as stream:
+            document = yaml.safe_load(stream)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return ""
+    if not isinstance(document, list):
+        return ""
+    return (
+        "that file is a list of bridges, not a parameters file: give it as "
+        f"-p config_file:={found.group(1)}"
+    )
 
 
 def _rcl_reason(message: str) -> str:

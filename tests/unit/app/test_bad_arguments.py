@@ -46,6 +46,24 @@ def run(program: str, *args: str, env: dict[str, str] | None = None) -> tuple[in
     return done.returncode, lines
 
 
+def test_a_bridge_list_given_as_a_parameters_file_is_sent_to_config_file(
+    tmp_path: Path,
+) -> None:
+    """rcl said 'Sequences cannot be key' and the fix asked for a readable file."""
+    bridges = tmp_path / "bridge.yaml"
+    bridges.write_text(
+        "- ros_topic_name: chatter\n  gz_topic_name: chatter\n"
+        "  ros_type_name: std_msgs/msg/String\n  gz_type_name: gz.msgs.StringMsg\n"
+    )
+    problem = ros_arguments_problem(
+        "parameter_bridge", ["pb", "--ros-args", "--params-file", str(bridges)]
+    )
+    assert problem.endswith(
+        "; that file is a list of bridges, not a parameters file: give it as "
+        f"-p config_file:={bridges}"
+    )
+
+
 @pytest.mark.parametrize(
     ("ros_args", "named", "fix"),
     [
@@ -58,6 +76,12 @@ def run(program: str, *args: str, env: dict[str, str] | None = None) -> tuple[in
             "give --params-file the path of a readable parameters YAML file",
         ),
         (["-r", "foo"], "'-r foo'", "write -r FROM:=TO"),
+        (
+            ["-r", "__node:=my-bridge"],
+            "'-r __node:=my-bridge'",
+            "write -r FROM:=TO, e.g. -r __ns:=/robot1; a ROS name is letters, digits and "
+            "underscores between its '/' (no '-' or '.'), and a node name starts with a letter",
+        ),
         (
             ["--log-level", "loud"],
             "'--log-level loud'. Error: Argument does not use a valid severity level",
