@@ -81,6 +81,8 @@ DISCOVER_OPTION = "--discover"
 USAGE_EXIT = 255
 #: Exit status when the Gazebo Transport side cannot be opened (a Zenoh router not there).
 TRANSPORT_EXIT = 1
+#: How many YAML entries completed by discovery the start-up line names.
+SHOWN_ENTRIES = 3
 
 
 def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> int:
@@ -254,6 +256,11 @@ def check(
                 print(f"Discovered {topic}: not bridged: {why}")
             return list(wanted.specs.values())
 
+        for pattern in patterns:
+            print(
+                f"{pattern.source}: completed by Gazebo discovery (a type left out, or a "
+                "wildcard): checked as the topics it takes"
+            )
         sides = Sides(node, gz_node, default_registry())
         status = run_check(
             sides, specs, seconds, out=sys.stdout, spin_once=executor.spin_once,
@@ -375,7 +382,7 @@ def build_bridge(
     if patterns or rules.enabled:
         discovered = DiscoveredBridges(bridge, patterns=patterns, rules=rules)
         what = ["auto_bridge"] if rules.enabled else []
-        what += [f"{len(patterns)} YAML entries completed by discovery"] if patterns else []
+        what += [_completed_entries(patterns)] if patterns else []
         logger.info(f"Following Gazebo discovery: {' and '.join(what)}")
     elif not bridge.handles and failures:
         logger.warning(
@@ -389,6 +396,14 @@ def build_bridge(
             "(parameter_bridge -h shows the syntax)"
         )
     return bridge, discovered
+
+
+def _completed_entries(patterns: Sequence[TopicPattern]) -> str:
+    """The YAML entries discovery completes, named (the first few)."""
+    named = ", ".join(pattern.source for pattern in patterns[:SHOWN_ENTRIES])
+    more = f" and {len(patterns) - SHOWN_ENTRIES} more" if len(patterns) > SHOWN_ENTRIES else ""
+    count = "1 YAML entry" if len(patterns) == 1 else f"{len(patterns)} YAML entries"
+    return f"{count} completed by discovery ({named}{more})"
 
 
 if __name__ == "__main__":

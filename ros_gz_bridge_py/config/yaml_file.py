@@ -288,6 +288,17 @@ def _parse_topic(entry: _Entry) -> TopicBridgeSpec | TopicPattern:
     return TopicPattern.from_spec(spec, direction) if completed_by_discovery else spec
 
 
+def _left_out_type(entry: _Entry, close: list[str]) -> str:
+    """What ignoring a misspelt type key does to a topic entry: without that type, the entry
+    is one that Gazebo discovery completes (no error, as the C++ bridge gave)."""
+    meant = close[0] if close else ""
+    if meant not in ("ros_type_name", "gz_type_name") or entry.has(meant):
+        return ""
+    if entry.text("service_name"):
+        return ""
+    return f"; without {meant} the entry waits for Gazebo discovery to give its types"
+
+
 def _parse_entry(
     node: yaml.Node,
     source_name: str,
@@ -304,7 +315,7 @@ def _parse_entry(
     for key in entry.unknown_keys():
         close = difflib.get_close_matches(key, _KNOWN_KEYS, n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
-        entry.warn(f"unknown key '{key}'{hint} is ignored")
+        entry.warn(f"unknown key '{key}'{hint} is ignored{_left_out_type(entry, close)}")
     parsed: list[Parsed] = []
     for chosen in templates.combinations(entry.placeholder_names(), placeholders, entry.location):
         entry.chosen = chosen

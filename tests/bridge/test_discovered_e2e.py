@@ -372,3 +372,38 @@ def test_check_with_auto_bridge_checks_the_inferred_entry_and_names_its_rule(
     report = output.split(title, 1)[1]
     assert "Gazebo: subscriber (ignition.msgs.Twist, takes ours)" in report
     assert "ok: messages can flow" in report
+
+
+def test_entries_discovery_completes_are_named_at_start_and_by_check(
+    started: list[PeerProcess], tmp_path: Path
+) -> None:
+    """The start-up line said '1 YAML entries completed by discovery', naming none, and
+    --check left such an entry out of its report without a word."""
+    topic = unique_name("left_out_type")
+    config = tmp_path / "bridge.yaml"
+    config.write_text(
+        f"- topic_name: {topic}\n  ros_type_name: std_msgs/msg/String\n"
+        "  gz_typename: gz.msgs.StringMsg\n"
+    )
+    where = f"{config} entry 1 (line 1)"
+    bridge = start_process(bridge_command(ros_args=["-p", f"config_file:={config}"]))
+    started.append(bridge)
+    wait_for_line(
+        bridge,
+        "without gz_type_name the entry waits for Gazebo discovery to give its types",
+        timeout=30,
+    )
+    wait_for_line(
+        bridge,
+        re.escape(f"Following Gazebo discovery: 1 YAML entry completed by discovery ({where})"),
+        timeout=30,
+    )
+    check = start_process(
+        [str(PARAMETER_BRIDGE), "--check", "1", "--ros-args", "-p", f"config_file:={config}"]
+    )
+    started.append(check)
+    check.wait(30)
+    assert (
+        f"{where}: completed by Gazebo discovery (a type left out, or a wildcard): checked as "
+        "the topics it takes"
+    ) in check.output()

@@ -305,6 +305,30 @@ def test_unknown_keys_warn_with_a_hint() -> None:
     )
 
 
+def test_a_misspelt_type_key_says_the_entry_waits_for_discovery() -> None:
+    """The entry became one that discovery completes, and the warning said only 'ignored'."""
+    text = """\
+- topic_name: t
+  ros_type_name: std_msgs/msg/String
+  gz_typename: gz.msgs.StringMsg
+- topic_name: u
+  ros_type_name: std_msgs/msg/String
+  gz_type_name: gz.msgs.StringMsg
+  gz_typename: gz.msgs.StringMsg
+"""
+    result = parse_yaml(text, "b.yaml")
+    assert [type(item).__name__ for item in result.specs + result.patterns] == [
+        "TopicBridgeSpec",
+        "TopicPattern",
+    ]
+    assert result.warnings == (
+        "b.yaml entry 1 (line 1): unknown key 'gz_typename' (did you mean 'gz_type_name'?) is "
+        "ignored; without gz_type_name the entry waits for Gazebo discovery to give its types",
+        "b.yaml entry 2 (line 4): unknown key 'gz_typename' (did you mean 'gz_type_name'?) is "
+        "ignored",
+    )
+
+
 def test_humble_keys_and_directions_are_deprecated_but_accepted() -> None:
     text = """\
 - ros_topic_name: chatter
