@@ -24,6 +24,11 @@ FLOWING_WINDOW = 5.0
 #: How many similar Gazebo topic names a finding suggests.
 SUGGESTIONS = 3
 
+#: How alike two topics' last names must be (difflib's ratio) for one to be proposed for the
+#: other: names in one namespace share their prefix, which alone made /robot1/clock "close"
+#: to /robot1/odom.
+CLOSE_NAME = 0.6
+
 
 class Flow(enum.Enum):
     """What a channel is doing, as users see it."""
@@ -333,12 +338,20 @@ class _SimilarTopics:
             self._topics, self._found = listed, {}
         found = self._found.get(topic)
         if found is None:
-            tail = "/" + topic.strip("/").rsplit("/", 1)[-1]
+            name = _last_name(topic)
             others = [t for t in listed if t != topic]
-            ending = [t for t in others if t.endswith(tail)]
-            close = difflib.get_close_matches(topic, others, SUGGESTIONS)
+            ending = [t for t in others if t.endswith("/" + name)]
+            close = [
+                t
+                for t in difflib.get_close_matches(topic, others, SUGGESTIONS)
+                if difflib.SequenceMatcher(None, name, _last_name(t)).ratio() >= CLOSE_NAME
+            ]
             found = self._found[topic] = list(dict.fromkeys(ending + close))[:SUGGESTIONS]
         return list(found)
+
+
+def _last_name(topic: str) -> str:
+    return topic.strip("/").rsplit("/", 1)[-1]
 
 
 _similar_topics = _SimilarTopics()

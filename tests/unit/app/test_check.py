@@ -83,7 +83,9 @@ def test_entries_with_refused_names_get_a_problem_and_the_others_their_report(
 def test_similar_topics_are_other_processes_never_the_checks_own(
     sides: Sides, network: MemoryNetwork
 ) -> None:
-    MemoryGzNode(network=network).advertise("/model/r2/odometry", STRING)
+    other = MemoryGzNode(network=network)
+    for name in ("/model/r2/odometry", "/model/r2/cmd_vel"):
+        other.advertise(name, STRING)
     _, out = check(
         sides,
         [
@@ -93,7 +95,8 @@ def test_similar_topics_are_other_processes_never_the_checks_own(
     )
     hints = [line for line in out.splitlines() if "similar topics" in line]
     assert len(hints) == 2, out
-    assert all(line.endswith("similar topics: /model/r2/odometry") for line in hints), out
+    assert hints[0].endswith("similar topics: /model/r2/odometry"), out
+    assert hints[1].endswith("similar topics: /model/r2/cmd_vel"), out
 
 
 def test_sigint_ends_the_check_at_once_without_a_report(sides: Sides) -> None:

@@ -120,6 +120,13 @@ def test_other_partition_no_peer_and_absent_are_told_apart() -> None:
     (finding,) = findings(absent, HINTS)
     assert finding.key == "gz-absent:publisher"
     assert "similar topics: /model/robot/odom, /odometry" in finding.text
+    # a namespace shared, the last names unlike (found by a new user: /robot1/clock was told
+    # of /robot1/odom)
+    namespaced = situation(
+        Direction.GZ_TO_ROS, gz_topic="/robot1/clock", gz_topics=["/robot1/odom", "/robot1/clocks"]
+    )
+    (finding,) = findings(namespaced, HINTS)
+    assert finding.text.endswith("similar topics: /robot1/clocks")
 
 
 def test_the_partition_of_the_endpoints_a_channel_needs_is_proposed_first() -> None:
