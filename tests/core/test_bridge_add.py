@@ -154,3 +154,36 @@ def test_a_service_bridged_already_is_refused_a_second_time(rig: Rig) -> None:
         "a second bridge would pass every call twice."
     )
     assert rig.bridge.handles == [first]
+
+
+@pytest.mark.parametrize(
+    ("ros_topic", "gz_topic", "fix"),
+    [
+        (
+            "/robot-1/odom", "/robot-1/odom",
+            "; [/robot-1/odom] is no valid ROS name: letters, digits and underscores between its "
+            "'/' (no '-', '.' or spaces), though Gazebo takes it: set ros_topic_name to a ROS "
+            "name and gz_topic_name to this one",
+        ),
+        (
+            "bad name", "/fine",
+            "; [bad name] is no valid ROS name: letters, digits and underscores between its '/' "
+            "(no '-', '.' or spaces)",
+        ),
+        (
+            "/fine", "~/private",
+            "; a Gazebo name starting with '~' is the bridge node's namespace only with "
+            "-p expand_gz_topic_names:=true",
+        ),
+    ],
+)  # fmt: skip
+def test_a_name_one_side_refuses_is_told_what_to_write(
+    rig: Rig, ros_topic: str, gz_topic: str, fix: str
+) -> None:
+    """Found by a new user: rcl's 'failed to resolve name' did not say that the ROS name was
+    the one refused (Gazebo takes '-'), nor '~' in a Gazebo name how to get the namespace."""
+    spec = TopicBridgeSpec(ros_topic, gz_topic, "std_msgs/msg/String", "gz.msgs.StringMsg")
+    with pytest.raises(ConfigError) as raised:
+        rig.add(spec)
+    assert str(raised.value).endswith(fix)
+    assert rig.bridge.handles == []
