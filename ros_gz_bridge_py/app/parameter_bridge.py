@@ -16,6 +16,7 @@ parameter), YAML entries that discovery completes and ``auto_bridge`` (both foll
 from __future__ import annotations
 
 import contextlib
+import functools
 import sys
 from collections.abc import Sequence
 
@@ -38,6 +39,7 @@ from ros_gz_bridge_py.app.settings import (
     read_switches,
 )
 from ros_gz_bridge_py.app.sources import (
+    bridge_parameter_problem,
     collect_sources,
     discovery_rules,
     gz_subscriptions,
@@ -133,7 +135,8 @@ def main(argv: Sequence[str] | None = None, stop: StopSignal | None = None) -> i
             except ConfigError as err:  # a parameter of the wrong type
                 node.get_logger().error(str(err))
                 return USAGE_EXIT
-            for warning in unknown_parameters(PROGRAM, argv, node):
+            bridges = functools.partial(bridge_parameter_problem, bridge_names=params.bridge_names)
+            for warning in unknown_parameters(PROGRAM, argv, node, bridges):
                 node.get_logger().warning(warning)
             try:
                 values = placeholder_values(params, cli_values)
@@ -376,6 +379,7 @@ def build_bridge(
             'publisher (GZ_TRANSPORT_RCVHWM sets both; docs/many-topics.md, "A fleet\'s memory")'
         )
     failures = bridge.add_all(spec for source in sources for spec in source.specs)
+    unread = sum(len(source.errors) for source in sources)  # a file not read, an entry refused
     patterns: list[TopicPattern] = [p for source in sources for p in source.patterns]
     rules = discovery_rules(node, params, enabled=params.auto_bridge)
     discovered = None
@@ -384,10 +388,10 @@ def build_bridge(
         what = ["auto_bridge"] if rules.enabled else []
         what += [_completed_entries(patterns)] if patterns else []
         logger.info(f"Following Gazebo discovery: {' and '.join(what)}")
-    elif not bridge.handles and failures:
+    elif not bridge.handles and (failures or unread):
         logger.warning(
-            f"No bridges are running: no entry could be bridged ({len(failures)} failed; the "
-            "errors above say why and what to write)"
+            f"No bridges are running: no entry could be bridged ({len(failures) + unread} "
+            "failed; the errors above say why and what to write)"
         )
     elif not bridge.handles:
         logger.warning(

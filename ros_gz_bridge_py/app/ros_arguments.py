@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import difflib
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import yaml
@@ -81,18 +81,26 @@ def _rcl_reason(message: str) -> str:
     return (head if " rule: " in head else reason).rstrip(".")
 
 
-def unknown_parameters(program: str, argv: Sequence[str], node: Any) -> list[str]:
+def unknown_parameters(
+    program: str,
+    argv: Sequence[str],
+    node: Any,
+    dotted_problem: Callable[[str], str] | None = None,
+) -> list[str]:
     """A warning for each ``-p NAME:=VALUE`` of ``argv``'s ROS arguments, and each parameter of
     a ``--params-file`` section for this node by name, that names no parameter ``node`` has
     declared, with the closest name it has: rcl keeps such a value without a word, so a
     misspelt ``lazzy:=true`` left ``lazy`` at its default unnoticed.
 
-    Dotted names (``qos_overrides.*``, ``bridges.*``) are left out: they are declared as the
-    topics and bridges they name are made. So are names for another node (``other:NAME``) and
-    a parameters file's wildcard sections (``/**``), which launch files share between nodes.
+    Dotted names (``qos_overrides.*``, ``bridges.*``) are declared as the topics and bridges
+    they name are made: ``dotted_problem`` judges them (a warning, or ''), else they are left
+    out. So are names for another node (``other:NAME``) and a parameters file's wildcard
+    sections (``/**``), which launch files share between nodes.
     """
-    warnings = []
     names = _parameter_names(argv, node.get_name(), node.get_fully_qualified_name())
+    dotted = [name for name in names if "." in name]
+    warnings = [dotted_problem(name) for name in dotted] if dotted_problem else []
+    warnings = [warning for warning in warnings if warning]
     unknown = [name for name in names if "." not in name and not node.has_parameter(name)]
     known = list(node.get_parameters_by_prefix("")) if unknown else []
     for name in unknown:
@@ -151,15 +159,25 @@ def _file_parameter_names(path: str, node_name: str, full_name: str) -> list[str
 
 def _sections(document: object, prefix: str) -> list[tuple[str, list[str]]]:
     """(node path, its ``ros__parameters`` names) for every section of a parameters file, the
-    nested namespace keys joined with '/'; a nested block (``qos_overrides:``) is dotted names,
-    left out as on the command line."""
+    nested namespace keys joined with '/'."""
     if not isinstance(document, dict):
         return []
     found: list[tuple[str, list[str]]] = []
     for key, value in document.items():
         if key == "ros__parameters" and isinstance(value, dict):
-            leaves = [str(name) for name, item in value.items() if not isinstance(item, dict)]
-            found.append((prefix, leaves))
+            found.append((prefix, _dotted_names(value)))
         elif isinstance(value, dict):
             found += _sections(value, f"{prefix}/{str(key).strip('/')}" if prefix else str(key))
     return found
+
+
+def _dotted_names(parameters: dict[Any, Any]) -> list[str]:
+    """The names rcl gives the values of a ``ros__parameters`` block: a nested block's
+    (``qos_overrides:``) joined with '.'."""
+    names: list[str] = []
+    for key, value in parameters.items():
+        if isinstance(value, dict):
+            names += [f"{key}.{name}" for name in _dotted_names(value)]
+        else:
+            names.append(str(key))
+    return names

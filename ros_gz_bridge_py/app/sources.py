@@ -7,6 +7,7 @@ their problems are logged as they are read.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 from collections.abc import Sequence
 
 from rclpy.node import Node
@@ -41,6 +42,32 @@ BRIDGE_PARAMETER_KEYS = (
     "gz_req_type_name",
     "gz_rep_type_name",
 )
+
+
+def bridge_parameter_problem(name: str, bridge_names: Sequence[str]) -> str:
+    """What is wrong with the parameter ``name`` given on the command line or in a parameters
+    file, if it is a ``bridges.*`` one no bridge takes (rcl keeps it without a word): a bridge
+    not in ``bridge_names``, or a key no bridge has. '' for any other name."""
+    if not name.startswith("bridges."):
+        return ""
+    rest = name.removeprefix("bridges.")
+    bridge = next((b for b in bridge_names if rest.startswith(f"{b}.")), None)
+    if bridge is None:
+        listed = ", ".join(bridge_names) or "empty"
+        return (
+            f"parameter {name} changes nothing: no bridge of bridge_names ({listed}) has it; "
+            "add the bridge's name to bridge_names"
+        )
+    key = rest.removeprefix(f"{bridge}.")
+    if key in BRIDGE_PARAMETER_KEYS:
+        return ""
+    close = difflib.get_close_matches(key, BRIDGE_PARAMETER_KEYS, n=1)
+    hint = (
+        f"; did you mean bridges.{bridge}.{close[0]}"
+        if close
+        else f" (a bridge's keys: {', '.join(BRIDGE_PARAMETER_KEYS)})"
+    )
+    return f"parameter {name} is no key of a bridge, so it changes nothing{hint}"
 
 
 def parameter_bridge_specs(node: Node, names: Sequence[str]) -> ParseResult:

@@ -131,6 +131,13 @@ def test_when_every_entry_fails_the_warning_says_so(started: list[PeerProcess]) 
         "No bridges are running: no entry could be bridged (1 failed; the errors above say "
         "why and what to write)"
     )
+    # a config file that cannot be read is a failure too, not a file never given
+    unread = start_bridge(ros_args=["-p", f"config_file:=/{unique_name('absent')}.yaml"])
+    started.append(unread)
+    warning = wait_for_line(unread, r"\[WARN\].*No bridges are running", timeout=WAIT).string
+    assert warning.endswith(
+        "no entry could be bridged (1 failed; the errors above say why and what to write)"
+    )
 
 
 def test_a_misspelt_parameter_is_named_with_the_one_meant(started: list[PeerProcess]) -> None:
@@ -174,3 +181,24 @@ def test_a_misspelt_parameter_in_a_params_file_is_named(
         "did you mean status_period"
     )
     assert bridge.output().count("is none of parameter_bridge's") == 1
+
+
+def test_a_bridges_parameter_no_bridge_takes_is_named(
+    started: list[PeerProcess], tmp_path: Path
+) -> None:
+    """A misspelt key of a bridges.<name> block in a parameters file changed nothing, unsaid."""
+    topic = unique_name("cli_bridges_key")
+    params = tmp_path / "bridges.yaml"
+    params.write_text(
+        "ros_gz_bridge:\n  ros__parameters:\n    bridge_names: [b3]\n    bridges:\n"
+        f"      b3:\n        ros_topic_name: {topic}\n        gz_topic_name: {topic}\n"
+        f"        ros_type_name: std_msgs/msg/String\n        gz_type_name: {STRING}\n"
+        "        directon: GZ_TO_ROS\n"
+    )
+    bridge = start_bridge(ros_args=["--params-file", str(params)])
+    started.append(bridge)
+    warning = wait_for_line(bridge, r"\[WARN\].*bridges\.b3\.directon", timeout=30).string
+    assert warning.endswith(
+        "parameter bridges.b3.directon is no key of a bridge, so it changes nothing; did you "
+        "mean bridges.b3.direction"
+    )
