@@ -140,9 +140,9 @@ def _parameter_names(argv: Sequence[str], node_name: str, full_name: str = "") -
 
 
 def _file_parameter_names(path: str, node_name: str, full_name: str) -> list[str]:
-    """The top-level parameter names of the sections of the parameters file ``path`` for the
-    node ``full_name`` (``/ns/name``; a plain ``name`` section is the root namespace's); none
-    when the file cannot be read (rcl has said so already)."""
+    """The parameter names (a nested block's joined with '.') of the sections of the
+    parameters file ``path`` for the node ``full_name`` (``/ns/name``; a plain ``name``
+    section is the root namespace's); none when the file cannot be read (rcl has said so)."""
     try:
         with open(path, encoding="utf-8") as stream:
             document = yaml.safe_load(stream)
