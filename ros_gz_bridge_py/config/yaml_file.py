@@ -236,6 +236,14 @@ def _parse_service(entry: _Entry) -> ServiceBridgeSpec:
     )
 
 
+#: The queue key a one-way topic bridge does not read, and the one it does: a ROS -> Gazebo
+#: bridge's ROS side is a subscription, a Gazebo -> ROS bridge's a publisher.
+_ONE_WAY_QUEUES = {
+    Direction.ROS_TO_GZ: ("publisher_queue", "subscriber_queue"),
+    Direction.GZ_TO_ROS: ("subscriber_queue", "publisher_queue"),
+}
+
+
 def _parse_topic(entry: _Entry) -> TopicBridgeSpec | TopicPattern:
     topic_name = entry.text("topic_name")
     ros_topic = entry.text("ros_topic_name")
@@ -268,6 +276,13 @@ def _parse_topic(entry: _Entry) -> TopicBridgeSpec | TopicPattern:
     lazy = entry.flag("lazy")
     publisher_queue = entry.queue("publisher_queue")
     subscriber_queue = entry.queue("subscriber_queue")
+    if direction is not None and direction in _ONE_WAY_QUEUES:
+        unused, used = _ONE_WAY_QUEUES[direction]
+        if entry.has(unused):
+            entry.warn(
+                f"{unused} does not apply to a {direction.value} bridge (its ROS side takes "
+                f"{used}); it is ignored"
+            )
     max_rate = entry.rate("max_rate")
     if ros_type and (hint := ros_type_hint(ros_type)):
         entry.warn(hint)

@@ -494,3 +494,33 @@ def test_zero_queue_is_kept_with_a_located_warning() -> None:
         "b.yaml entry 1 (line 1): subscriber_queue 0 means the middleware's default history depth"
     )
     assert "set subscriber_queue to the depth you want" in warning
+
+
+def test_the_queue_a_one_way_bridge_does_not_read_is_said_to_be_ignored() -> None:
+    """publisher_queue on a ROS_TO_GZ entry was ignored without a word (as the C++ bridge)."""
+    text = """\
+- topic_name: a
+  ros_type_name: std_msgs/msg/String
+  gz_type_name: gz.msgs.StringMsg
+  direction: ROS_TO_GZ
+  publisher_queue: 5
+  subscriber_queue: 7
+- topic_name: b
+  ros_type_name: std_msgs/msg/String
+  gz_type_name: gz.msgs.StringMsg
+  direction: GZ_TO_ROS
+  subscriber_queue: 5
+- topic_name: c
+  ros_type_name: std_msgs/msg/String
+  gz_type_name: gz.msgs.StringMsg
+  publisher_queue: 5
+  subscriber_queue: 5
+"""
+    result = parse_yaml(text, "q.yaml")
+    assert [spec.subscriber_queue for spec in _topics(result)] == [7, 5, 5]
+    assert result.warnings == (
+        "q.yaml entry 1 (line 1): publisher_queue does not apply to a ROS_TO_GZ bridge (its "
+        "ROS side takes subscriber_queue); it is ignored",
+        "q.yaml entry 2 (line 7): subscriber_queue does not apply to a GZ_TO_ROS bridge (its "
+        "ROS side takes publisher_queue); it is ignored",
+    )
