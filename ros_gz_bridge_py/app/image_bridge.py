@@ -168,38 +168,48 @@ def run(
     """Bridge until ``stop`` or rclpy shutdown; the node and bridge are closed on the way out."""
     node = BridgeNode(NODE_NAME)
     with python_logging_to(node.get_logger()):
-        bridge: Bridge | None = None
-        diagnostics: DiagnosticsPublisher | None = None
-        try:
-            params = declared_parameters(node)
-            if params is None:
-                return USAGE_EXIT
-            bridge = build_bridge(node, params, topics, switches, stop=stop, ros_args=ros_args)
-            if bridge is None:
-                return USAGE_EXIT
-            if stop.requested:
-                return 0
-            diagnostics = start_diagnostics(node, bridge, params.shared.status_period)
-            finish_start_up(node)
-            serve(
-                node,
-                bridge,
-                stop,
-                events_executor=switches.events_executor,
-                dds_event_batch=switches.dds_event_batch,
-            )
-        except TransportError as err:
-            if stop.requested:  # Ctrl-C while the node started (a Zenoh client's wait)
-                return 0
-            node.get_logger().error(str(err))
-            return TRANSPORT_EXIT
-        finally:
-            if diagnostics is not None:
-                diagnostics.close()
-            if bridge is not None:
-                bridge.close()
-            node.destroy_node()
-            rclpy.try_shutdown()
+        return _run(node, topics, switches, stop, ros_args)
+
+
+def _run(
+    node: BridgeNode,
+    topics: Sequence[ImageTopic],
+    switches: Switches,
+    stop: StopSignal,
+    ros_args: Sequence[str],
+) -> int:
+    bridge: Bridge | None = None
+    diagnostics: DiagnosticsPublisher | None = None
+    try:
+        params = declared_parameters(node)
+        if params is None:
+            return USAGE_EXIT
+        bridge = build_bridge(node, params, topics, switches, stop=stop, ros_args=ros_args)
+        if bridge is None:
+            return USAGE_EXIT
+        if stop.requested:
+            return 0
+        diagnostics = start_diagnostics(node, bridge, params.shared.status_period)
+        finish_start_up(node)
+        serve(
+            node,
+            bridge,
+            stop,
+            events_executor=switches.events_executor,
+            dds_event_batch=switches.dds_event_batch,
+        )
+    except TransportError as err:
+        if stop.requested:  # Ctrl-C while the node started (a Zenoh client's wait)
+            return 0
+        node.get_logger().error(str(err))
+        return TRANSPORT_EXIT
+    finally:
+        if diagnostics is not None:
+            diagnostics.close()
+        if bridge is not None:
+            bridge.close()
+        node.destroy_node()
+        rclpy.try_shutdown()
     return 0
 
 

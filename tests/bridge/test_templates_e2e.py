@@ -67,7 +67,9 @@ def test_one_templated_entry_bridges_two_robots_and_a_wildcard_takes_a_late_topi
         )
     )
     started.append(bridge)
-    wait_for_line(bridge, r"Following Gazebo discovery: 1 YAML entries", timeout=30)
+    wait_for_line(
+        bridge, r"Following Gazebo discovery: 1 YAML entry completed by discovery", timeout=30
+    )
     for robot, x in (("r1", 1.0), ("r2", 2.0)):
         inbox, _ = probe.subscribe(Odometry, f"{stem}/{robot}/odom")
         odometry = inbox.wait_for_count(1, WAIT)[0][0]
