@@ -55,6 +55,9 @@ def checked_spec(spec: object, warn: Callable[[str], None]) -> BridgeSpec:
         for name in ("gz_req_type", "gz_rep_type"):
             if getattr(spec, name) is not None:
                 _text(spec, name, getattr(spec, name))
+        if (spec.gz_req_type is None) != (spec.gz_rep_type is None):
+            msg = "set both gz_req_type and gz_rep_type, or neither"
+            raise ConfigError(msg, _where(spec))
         return spec
     if not isinstance(spec, TopicBridgeSpec):
         msg = (

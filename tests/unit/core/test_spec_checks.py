@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from ros_gz_bridge_py.config import Direction, TopicBridgeSpec
+from ros_gz_bridge_py.config import Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.core.spec_checks import checked_spec
 from ros_gz_bridge_py.errors import ConfigError
 
@@ -37,3 +37,20 @@ def test_the_current_spellings_say_nothing_and_an_unknown_one_is_refused() -> No
     assert warned == []
     with pytest.raises(ConfigError, match="direction 'SIDEWAYS' is none of"):
         checked_spec(spec("SIDEWAYS"), warned.append)
+
+
+def test_a_service_with_one_gazebo_type_of_two_is_refused_as_in_yaml() -> None:
+    """Bridge.add took it and logged '-> gz.msgs.WorldControl/)'; YAML and the CLI refuse it."""
+    warned: list[str] = []
+    half = ServiceBridgeSpec(
+        "/world/control", "ros_gz_interfaces/srv/ControlWorld", gz_req_type="gz.msgs.WorldControl"
+    )
+    with pytest.raises(ConfigError, match=r"set both gz_req_type and gz_rep_type, or neither"):
+        checked_spec(half, warned.append)
+    both = ServiceBridgeSpec(
+        "/world/control", "ros_gz_interfaces/srv/ControlWorld", "gz.msgs.WorldControl",
+        "gz.msgs.Boolean",
+    )  # fmt: skip
+    assert checked_spec(both, warned.append) == both
+    neither = ServiceBridgeSpec("/world/control", "ros_gz_interfaces/srv/ControlWorld")
+    assert checked_spec(neither, warned.append) == neither
