@@ -15,12 +15,13 @@ hosts:
 
 from __future__ import annotations
 
-import contextlib
 import threading
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node as RosNode
 from rclpy.parameter import Parameter
 from rclpy.task import Future
@@ -33,6 +34,8 @@ from ros_gz_bridge_py.ros.late_responses import LateResponses
 #: tools leave out (``ros2 node list`` without ``--all``): users see the one node they started,
 #: as with the C++ bridge.
 HIDDEN = "_"
+#: Longest time one spin step of the side node waits: how long closing waits for its thread.
+SPIN_STEP = 0.2
 SUFFIX = "_side"
 NATIVE_SUFFIX = "_native"
 
@@ -86,6 +89,7 @@ class SideNode:
         self.late_responses = LateResponses(self.node)
         self._executor = MultiThreadedExecutor(num_threads=self.THREADS, context=owner.context)
         self._executor.add_node(self.node)
+        self._closing = False
         self._thread = threading.Thread(target=self._spin, name="ros-gz-side", daemon=True)
         self._thread.start()
 
@@ -101,12 +105,28 @@ class SideNode:
         return future
 
     def _spin(self) -> None:
-        with contextlib.suppress(ExternalShutdownException):
-            self._executor.spin()
+        """Spin until closed. rclpy raises InvalidHandle into the spinning thread when an
+        entity it waits on is destroyed from another thread (a bridge removed while messages
+        flow): that ended this thread, and every later service and loop-guarded channel
+        carried nothing without a word; the entity is gone, so spinning goes on."""
+        context = self.owner.context
+        while not self._closing and context.ok():
+            try:
+                self._executor.spin_once(timeout_sec=SPIN_STEP)
+            except ExternalShutdownException:
+                return
+            except _rclpy.InvalidHandle:
+                continue
 
     def close(self) -> None:
+        self._closing = True
         self._executor.shutdown(timeout_sec=1.0)
         self._thread.join(timeout=2.0)
+        # rclpy's MultiThreadedExecutor leaves its worker pool running after shutdown():
+        # without this, each closed bridge left its idle worker threads behind.
+        pool = getattr(self._executor, "_executor", None)
+        if isinstance(pool, ThreadPoolExecutor):
+            pool.shutdown(wait=True)
         self.node.destroy_node()
 
 
