@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any, TextIO
 
 from rclpy.qos import QoSProfile
+from rclpy.qos_overriding_options import InvalidQosOverridesError
 
 from ros_gz_bridge_py.app.discover import listen
 from ros_gz_bridge_py.config import BridgeSpec, Direction, ServiceBridgeSpec, TopicBridgeSpec
@@ -37,7 +38,12 @@ from ros_gz_bridge_py.core.explain import (
 )
 from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION, ConfigError, TransportError
 from ros_gz_bridge_py.msgs.names import same_message
-from ros_gz_bridge_py.ros.qos import endpoint_qos, gz_to_ros_publisher_qos
+from ros_gz_bridge_py.ros.qos import (
+    apply_publisher_overrides,
+    apply_subscription_overrides,
+    endpoint_qos,
+    gz_to_ros_publisher_qos,
+)
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, Publisher
 from ros_gz_bridge_py.transport.api import GraphEndpoint
@@ -208,7 +214,13 @@ def _topic_reports(
     gz_endpoints = gz_node.observe(spec.gz_topic)
     reports = []
     for direction in directions:
-        qos = _entry_qos(spec, direction, ros_topic)
+        try:
+            qos = _entry_qos(ros_node, spec, direction, ros_topic)
+        except InvalidQosOverridesError as err:
+            reports.append(
+                EntryReport(f"{spec.ros_topic} <-> {spec.gz_topic}{where}", (), (str(err),))
+            )
+            continue
         ros_side = ros_endpoints(ros_node, direction, ros_topic, as_the_graph_shows(qos), own)
         situation = Situation(
             direction=direction,
@@ -239,10 +251,22 @@ def _topic_reports(
     return reports
 
 
-def _entry_qos(spec: TopicBridgeSpec, direction: Direction, ros_topic: str) -> QoSProfile:
+def _entry_qos(
+    ros_node: Any, spec: TopicBridgeSpec, direction: Direction, ros_topic: str
+) -> QoSProfile:
+    """The QoS the bridge's ROS endpoint of ``spec`` would have, its ``qos_overrides`` applied
+    (without them a subscriber matching the overridden profile was reported as a PROBLEM).
+
+    Raises:
+        InvalidQosOverridesError: the overrides given are refused, as the bridge refuses them.
+    """
     if direction is Direction.GZ_TO_ROS:
-        return gz_to_ros_publisher_qos(ros_topic, spec.qos_profile, spec.publisher_queue)
-    return endpoint_qos(spec.qos_profile, spec.subscriber_queue)
+        qos = gz_to_ros_publisher_qos(ros_topic, spec.qos_profile, spec.publisher_queue)
+        apply_publisher_overrides(ros_node, ros_topic, qos)
+    else:
+        qos = endpoint_qos(spec.qos_profile, spec.subscriber_queue)
+        apply_subscription_overrides(ros_node, ros_topic, qos)
+    return qos
 
 
 def _gazebo_lines(situation: Situation, direction: Direction) -> list[str]:

@@ -14,6 +14,7 @@ from typing import Any
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.duration import Duration
+from rclpy.publisher import Publisher
 from rclpy.qos import (
     DurabilityPolicy,
     HistoryPolicy,
@@ -109,6 +110,15 @@ def apply_subscription_overrides(node: Any, topic: str, qos: QoSProfile) -> None
     """
     _declare_qos_parameters(
         Subscription, node, node.resolve_topic_name(topic), qos, SUBSCRIPTION_OVERRIDES
+    )
+
+
+def apply_publisher_overrides(node: Any, topic: str, qos: QoSProfile) -> None:
+    """Apply to ``qos`` (in place) the ``qos_overrides`` of a publisher of ``topic`` on
+    ``node``, as ``create_publisher`` with :data:`PUBLISHER_OVERRIDES` does: for what
+    ``--check`` compares with the ROS endpoints it sees."""
+    _declare_qos_parameters(
+        Publisher, node, node.resolve_topic_name(topic), qos, PUBLISHER_OVERRIDES
     )
 
 

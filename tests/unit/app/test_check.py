@@ -111,3 +111,37 @@ def test_sigint_ends_the_check_at_once_without_a_report(sides: Sides) -> None:
     assert (status, out.splitlines()[-1]) == (0, STOPPED)
     assert took < 15.0  # not the 30 s asked for
     assert "checked can carry messages" not in out
+
+
+@pytest.mark.parametrize("overridden", [False, True])
+def test_the_qos_overrides_given_are_those_the_check_compares(
+    ros_context: Any, network: MemoryNetwork, overridden: bool
+) -> None:
+    """--check compared the profile without the overrides: a transient-local subscriber the
+    override serves was a PROBLEM, and the check failed, while the bridge carried it."""
+    import rclpy  # noqa: PLC0415
+    from rclpy.parameter import Parameter  # noqa: PLC0415
+    from rclpy.qos import DurabilityPolicy, QoSProfile  # noqa: PLC0415
+    from std_msgs.msg import String  # noqa: PLC0415
+
+    name = f"/latched_{os.getpid()}_{int(overridden)}"
+    override = Parameter(f"qos_overrides.{name}.publisher.durability", value="transient_local")
+    node = rclpy.create_node(
+        "check_qos", context=ros_context, parameter_overrides=[override] if overridden else []
+    )
+    listener = rclpy.create_node("check_qos_listener", context=ros_context)
+    try:
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        listener.create_subscription(String, name, lambda _m: None, latched)
+        deadline = time.monotonic() + 10
+        while not node.get_subscriptions_info_by_topic(name) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        MemoryGzNode(network=network).advertise(name, STRING)
+        sides = Sides(node, MemoryGzNode(network=network), default_registry())
+        status, out = check(sides, [topic(name, name, Direction.GZ_TO_ROS)])
+    finally:
+        listener.destroy_node()
+        node.destroy_node()
+    problem = "Volatile publisher and transient local subscription"
+    assert (problem in out) is not overridden, out
+    assert status == (0 if overridden else 1), out
