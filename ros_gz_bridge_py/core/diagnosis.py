@@ -378,6 +378,9 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
                 )
             else:
                 fix = f"no converter takes {endpoint.msg_type}"
+            if not situation.discovered_by:  # the other way round: the ROS node changes
+                verb = "subscribe to" if role == "subscriber" else "publish"
+                fix += f"; or have {endpoint.node} {verb} {situation.ros_type}"
             found.append(
                 Finding(
                     f"ros-type:{endpoint.node}:{endpoint.msg_type}",

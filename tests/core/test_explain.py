@@ -290,7 +290,8 @@ def test_a_ros_reader_of_another_type_is_explained(
     assert texts(channel) == [
         f"the ROS subscriber /{other_process.get_name()} of {topic} uses std_msgs/msg/Int32, "
         "but the bridge is configured with std_msgs/msg/String; std_msgs/msg/Int32 pairs with "
-        "gz.msgs.Int32: set the ROS and Gazebo types to such a pair"
+        "gz.msgs.Int32: set the ROS and Gazebo types to such a pair; or have "
+        f"/{other_process.get_name()} subscribe to std_msgs/msg/String"
     ]
 
 

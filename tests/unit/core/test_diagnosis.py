@@ -91,7 +91,7 @@ def test_image_bridge_sends_a_topic_of_other_types_to_parameter_bridge() -> None
     assert ros_side.text.endswith(
         "; image_bridge cannot take other types: bridge the topic with parameter_bridge "
         "(std_msgs/msg/String pairs with gz.msgs.StringMsg: set the ROS and Gazebo types to "
-        "such a pair)"
+        "such a pair); or have /viewer subscribe to sensor_msgs/msg/Image"
     )
     (unpaired,) = findings(
         dataclasses.replace(
@@ -308,3 +308,21 @@ def test_a_lazy_channel_nobody_reads_waits_for_ros_whatever_it_passed_before() -
     )
     assert flow(idle) is Flow.WAITING_ROS
     assert flow(dataclasses.replace(idle, input_open=True)) is Flow.FLOWING
+
+
+def test_a_ros_publisher_of_another_type_is_also_told_to_publish_the_configured_one() -> None:
+    """The fix only proposed retyping the entry, which breaks a Gazebo side that takes the
+    configured type (found by a new user)."""
+    teleop = situation(
+        Direction.ROS_TO_GZ,
+        ros_topic="/cmd",
+        ros_type="geometry_msgs/msg/Twist",
+        gz_type="gz.msgs.Twist",
+        gz_endpoints=[endpoint(SUBSCRIBER, "ignition.msgs.Twist")],
+        ros_endpoints=[RosEndpoint("/teleop", "std_msgs/msg/String")],
+    )
+    (finding,) = findings(teleop, HINTS)
+    assert finding.text.endswith(
+        "std_msgs/msg/String pairs with gz.msgs.StringMsg: set the ROS and Gazebo types to such "
+        "a pair; or have /teleop publish geometry_msgs/msg/Twist"
+    )
