@@ -236,6 +236,7 @@ def _topic_reports(
             gz_subscriber_registered=probe is not None and bool(probe.wire_types()),
             gz_topics=gz_topics,
             discovered_by=spec.discovered_by,
+            bidirectional=spec.direction is Direction.BIDIRECTIONAL,
         )
         arrow = (
             f"Gazebo {name} ({spec.gz_type}) -> ROS {ros_topic} ({spec.ros_type})"

@@ -120,6 +120,8 @@ class Situation:
     #: hearing none is no fault yet: the channel waits (a Gazebo endpoint absent), it is not
     #: told that no Gazebo process exists.
     peers_settled: bool = True
+    #: The channel is one half of a bidirectional entry (the other half has its own).
+    bidirectional: bool = False
 
 
 def flow(situation: Situation) -> Flow:
@@ -312,6 +314,15 @@ def _heard(processes: int) -> str:
 def _absent_finding(situation: Situation, role: str) -> Finding:
     similar = _similar_topics(situation.gz_topic, situation.gz_topics)
     hint = f"; similar topics: {', '.join(similar)}" if similar else ""
+    other = PUBLISHER if role == SUBSCRIBER else SUBSCRIBER
+    if not situation.bidirectional and any(
+        e.role == other and e.partition == situation.partition for e in situation.gz_endpoints
+    ):
+        turned = "ROS_TO_GZ (']'" if role == PUBLISHER else "GZ_TO_ROS ('['"
+        hint += (
+            f"; a Gazebo {other} of {situation.gz_topic} is there: to carry messages the other "
+            f"way, bridge it {turned} on the command line)"
+        )
     return Finding(
         f"gz-absent:{role}",
         f"no Gazebo {role} of {situation.gz_topic} in partition '{situation.partition}' "

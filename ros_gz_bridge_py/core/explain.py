@@ -309,6 +309,7 @@ class Explainer:
             interval=seen.interval,
             discovered_by=spec.discovered_by,
             peers_settled=now - self._started >= WARM_UP,
+            bidirectional=spec.direction is Direction.BIDIRECTIONAL,
         )
 
     def _ask_subscribers(self, now: float) -> None:

@@ -326,3 +326,27 @@ def test_a_ros_publisher_of_another_type_is_also_told_to_publish_the_configured_
         "std_msgs/msg/String pairs with gz.msgs.StringMsg: set the ROS and Gazebo types to such "
         "a pair; or have /teleop publish geometry_msgs/msg/Twist"
     )
+
+
+def test_a_one_way_channel_facing_the_other_role_is_told_to_turn() -> None:
+    """'[' written for ']' said only 'no Gazebo publisher', while a Gazebo subscriber was
+    there (found by a new user); half of a bidirectional entry is not told so."""
+    wrong_way = situation(
+        Direction.GZ_TO_ROS, gz_endpoints=[endpoint(SUBSCRIBER, "gz.msgs.Odometry")]
+    )
+    (finding,) = findings(wrong_way, HINTS)
+    assert finding.key == "gz-absent:publisher"
+    assert finding.text.endswith(
+        "; a Gazebo subscriber of /odom is there: to carry messages the other way, bridge it "
+        "ROS_TO_GZ (']' on the command line)"
+    )
+    half = dataclasses.replace(wrong_way, bidirectional=True)
+    (finding,) = findings(half, HINTS)
+    assert "the other way" not in finding.text
+    backwards = situation(
+        Direction.ROS_TO_GZ,
+        gz_endpoints=[endpoint(PUBLISHER, "gz.msgs.Odometry")],
+        ros_endpoints=[RosEndpoint("/nav", "nav_msgs/msg/Odometry")],
+    )
+    (finding,) = findings(backwards, HINTS)
+    assert finding.text.endswith("bridge it GZ_TO_ROS ('[' on the command line)")
