@@ -212,7 +212,8 @@ def _topic_reports(
         if spec.direction in (d, Direction.BIDIRECTIONAL)
     ]
     gz_endpoints = gz_node.observe(spec.gz_topic)
-    reports = []
+    reports: list[EntryReport] = []
+    waits: list[bool] = []
     for direction in directions:
         try:
             qos = _entry_qos(ros_node, spec, direction, ros_topic)
@@ -220,6 +221,7 @@ def _topic_reports(
             reports.append(
                 EntryReport(f"{spec.ros_topic} <-> {spec.gz_topic}{where}", (), (str(err),))
             )
+            waits.append(False)
             continue
         ros_side = ros_endpoints(ros_node, direction, ros_topic, as_the_graph_shows(qos), own)
         situation = Situation(
@@ -249,7 +251,17 @@ def _topic_reports(
             *_ros_lines(ros_side, direction),
         )
         reports.append(EntryReport(f"{arrow}{where}", seen, tuple(f.text for f in found)))
+        waits.append(bool(found) and not any(f.fault for f in found))
+    if len(reports) == 2 and any(not report.problems for report in reports):
+        return [_waiting(r) if wait else r for r, wait in zip(reports, waits, strict=True)]
     return reports
+
+
+def _waiting(report: EntryReport) -> EntryReport:
+    """The half of a bidirectional entry that waits for a side not there (no fault) while
+    the other half carries: a note, not a problem (a working '@' entry failed the check)."""
+    notes = tuple(f"waiting, while the other direction carries: {p}" for p in report.problems)
+    return EntryReport(report.title, report.seen + notes, ())
 
 
 def _entry_qos(

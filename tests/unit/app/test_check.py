@@ -145,3 +145,20 @@ def test_the_qos_overrides_given_are_those_the_check_compares(
     problem = "Volatile publisher and transient local subscription"
     assert (problem in out) is not overridden, out
     assert status == (0 if overridden else 1), out
+
+
+def test_a_bidirectional_entry_carrying_one_way_passes(
+    sides: Sides, network: MemoryNetwork
+) -> None:
+    """A working '@' entry (Gazebo publishes, nothing in Gazebo subscribes) failed the check:
+    its ROS -> Gazebo half's 'no Gazebo subscriber' was a PROBLEM (found by a new user)."""
+    name = f"/both_{os.getpid()}"
+    MemoryGzNode(network=network).advertise(name, STRING)
+    status, out = check(sides, [topic(name, name, Direction.BIDIRECTIONAL)])
+    assert status == 0, out
+    assert "PROBLEM" not in out
+    assert f"waiting, while the other direction carries: no Gazebo subscriber of {name}" in out
+    assert out.endswith("2 of 2 checked can carry messages\n")
+    # a one-way entry with nothing on its Gazebo side is still a problem
+    status, out = check(sides, [topic(f"{name}_in", f"{name}_in", Direction.ROS_TO_GZ)])
+    assert status == 1, out
