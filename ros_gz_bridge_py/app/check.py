@@ -36,6 +36,7 @@ from ros_gz_bridge_py.core.explain import (
     ros_endpoints,
     type_hints,
 )
+from ros_gz_bridge_py.core.spec_checks import refused_name_fix
 from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION, ConfigError, TransportError
 from ros_gz_bridge_py.msgs.names import same_message
 from ros_gz_bridge_py.ros.qos import (
@@ -54,7 +55,6 @@ DEFAULT_SECONDS = 5.0
 #: What a check stopped by SIGINT or SIGTERM prints instead of its report: the report of a
 #: shorter listen would show as missing what it had no time to hear.
 STOPPED = "Stopped (SIGINT or SIGTERM) before the end of listening: nothing checked"
-_TILDE_HINT = "; -p expand_gz_topic_names:=true expands '~' in YAML entries as in ROS names"
 
 
 @dataclass(frozen=True)
@@ -181,13 +181,12 @@ def _resolved_names(sides: Sides, spec: TopicBridgeSpec) -> tuple[str, str, str]
         ros_topic = str(sides.ros_node.resolve_topic_name(spec.ros_topic))
     except RuntimeError as err:  # rclpy's RCLError
         reason = RCL_SOURCE_LOCATION.sub("", str(err))
-        msg = f"invalid ROS topic name {spec.ros_topic!r}: {reason}"
+        msg = f"invalid ROS topic name {spec.ros_topic!r}: {reason}{refused_name_fix(spec, reason)}"
         raise ConfigError(msg) from None
     try:
         partition, name = gazebo_name(sides.gz_node, spec.gz_topic)
     except TransportError as err:
-        hint = _TILDE_HINT if spec.gz_topic.startswith("~") else ""
-        msg = f"{err}{hint}"
+        msg = f"{err}{refused_name_fix(spec, str(err))}"
         raise ConfigError(msg) from None
     return ros_topic, partition, name
 

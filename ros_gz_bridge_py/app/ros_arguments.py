@@ -14,6 +14,7 @@ import yaml
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.utilities import remove_ros_args
 
+from ros_gz_bridge_py.config.names import ROS_NAME_RULE
 from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION
 
 #: rcl's words for a kind of ROS argument, and how to write one.
@@ -22,8 +23,8 @@ _ROS_ARGUMENT_FIXES = (
     ("params", "give --params-file the path of a readable parameters YAML file"),
     (
         "remap",
-        "write -r FROM:=TO, e.g. -r __ns:=/robot1; a ROS name is letters, digits and "
-        "underscores between its '/' (no '-' or '.'), and a node name starts with a letter",
+        f"write -r FROM:=TO, e.g. -r __ns:=/robot1; {ROS_NAME_RULE}, and a node name starts "
+        "with a letter",
     ),
     ("log level", "write --log-level LEVEL: debug, info, warn, error or fatal"),
 )
@@ -98,9 +99,8 @@ def unknown_parameters(
     sections (``/**``), which launch files share between nodes.
     """
     names = _parameter_names(argv, node.get_name(), node.get_fully_qualified_name())
-    dotted = [name for name in names if "." in name]
-    warnings = [dotted_problem(name) for name in dotted] if dotted_problem else []
-    warnings = [warning for warning in warnings if warning]
+    judged = [dotted_problem(name) for name in names if "." in name] if dotted_problem else []
+    warnings = [warning for warning in judged if warning]
     unknown = [name for name in names if "." not in name and not node.has_parameter(name)]
     known = list(node.get_parameters_by_prefix("")) if unknown else []
     for name in unknown:
@@ -136,7 +136,7 @@ def _parameter_names(argv: Sequence[str], node_name: str, full_name: str = "") -
                 names.append(name)
         elif in_ros and arg in ("-p", "--param", "--params-file"):
             option = "--params-file" if arg == "--params-file" else "-p"
-    return [name for index, name in enumerate(names) if name and name not in names[:index]]
+    return [name for name in dict.fromkeys(names) if name]
 
 
 def _file_parameter_names(path: str, node_name: str, full_name: str) -> list[str]:

@@ -12,6 +12,11 @@ import re
 
 from ros_gz_bridge_py.errors import ConfigError
 
+#: What a ROS name may hold, as fixes say it (rcl's own errors name only the rule broken).
+ROS_NAME_RULE = (
+    "a ROS name is letters, digits and underscores between its '/' (no '-', '.' or spaces)"
+)
+
 
 def _normalise_namespace(namespace: str) -> str:
     stripped = namespace.strip("/")

@@ -46,6 +46,7 @@ from ros_gz_bridge_py.core.spec_checks import (
     Key,
     checked_spec,
     refuse_twice,
+    refused_name_fix,
     service_key,
     topic_keys,
 )
@@ -65,7 +66,6 @@ from ros_gz_bridge_py.ros.side_node import (
     unspun_node,
 )
 from ros_gz_bridge_py.transport import GzNode, NodeOptions, create_gz_node
-from ros_gz_bridge_py.transport.names import is_valid_topic
 
 __all__ = ["Bridge", "BridgeHandle", "BridgeOptions"]
 
@@ -349,32 +349,12 @@ class Bridge:
 
 
 def _failed_text(spec: TopicBridgeSpec, why: str) -> str:
+    reason = RCL_SOURCE_LOCATION.sub("", why)
     return (
         f"Failed to create a bridge for topic [{spec.ros_topic}] with ROS2 type [{spec.ros_type}] "
         f"to topic [{spec.gz_topic}] with Gazebo Transport type [{spec.gz_type}]: "
-        f"{RCL_SOURCE_LOCATION.sub('', why)}{_name_fix(spec, why)}"
+        f"{reason}{refused_name_fix(spec, reason)}"
     )
-
-
-def _name_fix(spec: TopicBridgeSpec, why: str) -> str:
-    """What to write when a name is one that ROS or Gazebo refuses; '' for other failures."""
-    if why.startswith("failed to resolve name"):  # rcl's words for a ROS name it refuses
-        fix = (
-            f"; [{spec.ros_topic}] is no valid ROS name: letters, digits and underscores "
-            "between its '/' (no '-', '.' or spaces)"
-        )
-        if spec.ros_topic == spec.gz_topic and is_valid_topic(spec.gz_topic):
-            fix += (
-                ", though Gazebo takes it: set ros_topic_name to a ROS name and gz_topic_name "
-                "to this one"
-            )
-        return fix
-    if why.startswith("invalid Gazebo Transport topic") and spec.gz_topic.startswith("~"):
-        return (
-            "; a Gazebo name starting with '~' is the bridge node's namespace only with "
-            "-p expand_gz_topic_names:=true"
-        )
-    return ""
 
 
 def _close_handle(handle: BridgeHandle) -> None:

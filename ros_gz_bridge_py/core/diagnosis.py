@@ -318,10 +318,10 @@ def _absent_finding(situation: Situation, role: str) -> Finding:
     if not situation.bidirectional and any(
         e.role == other and e.partition == situation.partition for e in situation.gz_endpoints
     ):
-        turned = "ROS_TO_GZ (']'" if role == PUBLISHER else "GZ_TO_ROS ('['"
+        turned, symbol = ("ROS_TO_GZ", "]") if role == PUBLISHER else ("GZ_TO_ROS", "[")
         hint += (
             f"; a Gazebo {other} of {situation.gz_topic} is there: to carry messages the other "
-            f"way, bridge it {turned} on the command line)"
+            f"way, bridge it {turned} ('{symbol}' on the command line)"
         )
     return Finding(
         f"gz-absent:{role}",

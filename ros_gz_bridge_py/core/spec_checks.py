@@ -19,8 +19,10 @@ from ros_gz_bridge_py.config import (
     TopicBridgeSpec,
 )
 from ros_gz_bridge_py.config.model import DEPRECATED_DIRECTIONS, as_bool, as_queue, as_rate
+from ros_gz_bridge_py.config.names import ROS_NAME_RULE
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.msgs.names import canonical_type
+from ros_gz_bridge_py.transport.names import is_valid_topic
 
 #: What one bridge carries: a direction (or "service") and the names and types it joins.
 Key = tuple[str, ...]
@@ -170,3 +172,19 @@ def _optional(spec: TopicBridgeSpec, name: str, convert: Callable[[str, object],
         return convert(name, value)
     except ConfigError as err:
         raise ConfigError(err.message, _where(spec)) from None
+
+
+def refused_name_fix(spec: TopicBridgeSpec, why: str) -> str:
+    """What to write when ``why`` says a side refuses a name of ``spec`` (rcl's words for a
+    ROS name, the transport's for a Gazebo one); '' for other failures."""
+    if why.startswith("failed to resolve name"):
+        fix = f"; [{spec.ros_topic}] is no valid ROS name: {ROS_NAME_RULE}"
+        if spec.ros_topic == spec.gz_topic and is_valid_topic(spec.gz_topic):
+            fix += (
+                ", though Gazebo takes it: set ros_topic_name to a ROS name and gz_topic_name "
+                "to this one"
+            )
+        return fix
+    if why.startswith("invalid Gazebo Transport topic") and spec.gz_topic.startswith("~"):
+        return "; -p expand_gz_topic_names:=true expands '~' in YAML entries as in ROS names"
+    return ""

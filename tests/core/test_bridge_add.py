@@ -161,19 +161,18 @@ def test_a_service_bridged_already_is_refused_a_second_time(rig: Rig) -> None:
     [
         (
             "/robot-1/odom", "/robot-1/odom",
-            "; [/robot-1/odom] is no valid ROS name: letters, digits and underscores between its "
-            "'/' (no '-', '.' or spaces), though Gazebo takes it: set ros_topic_name to a ROS "
-            "name and gz_topic_name to this one",
+            "; [/robot-1/odom] is no valid ROS name: a ROS name is letters, digits and "
+            "underscores between its '/' (no '-', '.' or spaces), though Gazebo takes it: set "
+            "ros_topic_name to a ROS name and gz_topic_name to this one",
         ),
         (
             "bad name", "/fine",
-            "; [bad name] is no valid ROS name: letters, digits and underscores between its '/' "
-            "(no '-', '.' or spaces)",
+            "; [bad name] is no valid ROS name: a ROS name is letters, digits and underscores "
+            "between its '/' (no '-', '.' or spaces)",
         ),
         (
             "/fine", "~/private",
-            "; a Gazebo name starting with '~' is the bridge node's namespace only with "
-            "-p expand_gz_topic_names:=true",
+            "; -p expand_gz_topic_names:=true expands '~' in YAML entries as in ROS names",
         ),
     ],
 )  # fmt: skip

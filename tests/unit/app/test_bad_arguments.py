@@ -80,7 +80,8 @@ def test_a_bridge_list_given_as_a_parameters_file_is_sent_to_config_file(
             ["-r", "__node:=my-bridge"],
             "'-r __node:=my-bridge'",
             "write -r FROM:=TO, e.g. -r __ns:=/robot1; a ROS name is letters, digits and "
-            "underscores between its '/' (no '-' or '.'), and a node name starts with a letter",
+            "underscores between its '/' (no '-', '.' or spaces), and a node name starts with a "
+            "letter",
         ),
         (
             ["--log-level", "loud"],

@@ -71,7 +71,8 @@ def test_entries_with_refused_names_get_a_problem_and_the_others_their_report(
     assert status == 1, out
     assert (
         "/a//b <-> /a/b\n  PROBLEM: invalid ROS topic name '/a//b': failed to resolve name: "
-        "topic name must not contain repeated '/'\n"
+        "topic name must not contain repeated '/'; [/a//b] is no valid ROS name: a ROS name is "
+        "letters, digits and underscores between its '/' (no '-', '.' or spaces)\n"
     ) in out
     assert "priv <-> ~/priv\n  PROBLEM: invalid Gazebo Transport topic '~/priv'" in out
     assert "-p expand_gz_topic_names:=true expands '~'" in out
