@@ -61,6 +61,9 @@ class RosEndpoint:
     qos_problem: str = ""
     #: Its QoS in a few words ("reliable, volatile, depth 10").
     qos: str = ""
+    #: The ``qos_overrides`` of the bridge's endpoint that match it, as ``-p`` takes them
+    #: after the topic's name (``publisher.durability:=transient_local``).
+    qos_fixes: tuple[str, ...] = ()
 
 
 #: What sets a channel's QoS profile where entries do (not image_bridge's, a parameter).
@@ -405,12 +408,25 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
                 Finding(
                     f"ros-qos:{endpoint.node}",
                     f"the ROS {role} {endpoint.node} of {situation.ros_topic} cannot match the "
-                    f"bridge's QoS: {endpoint.qos_problem}; set "
-                    f"{hints.qos_setting} (or qos_overrides.{situation.ros_topic}.*) to what "
-                    "it uses",
+                    f"bridge's QoS: {endpoint.qos_problem}; {_qos_fix(situation, endpoint, hints)}",
                 )
             )
     return found
+
+
+def _qos_fix(situation: Situation, endpoint: RosEndpoint, hints: TypeHints) -> str:
+    """The parameters that give the bridge's endpoint the other end's QoS, as a command line
+    takes them (a params file or a launch file's parameters take the same names)."""
+    if not endpoint.qos_fixes:
+        uses = f" ({endpoint.qos})" if endpoint.qos else ""
+        return (
+            f"set {hints.qos_setting} (or qos_overrides.{situation.ros_topic}.*) to what it "
+            f"uses{uses}"
+        )
+    overrides = " ".join(
+        f"-p qos_overrides.{situation.ros_topic}.{fix}" for fix in endpoint.qos_fixes
+    )
+    return f"run the bridge with --ros-args {overrides} (or set {hints.qos_setting} to match)"
 
 
 def _discovered_fix(situation: Situation, ros_type: str, hints: TypeHints) -> str:

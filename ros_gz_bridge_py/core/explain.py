@@ -3,7 +3,9 @@ channel's flow state and causes (``diagnosis.py``), and logs each cause once.
 
 A cause is logged once it has lasted two evaluations (discovery needs a moment to see
 everything), at most once a minute while it comes and goes, and again only after it went
-away. "No Gazebo peer at all" concerns every channel, so it is said once for the bridge.
+away. "No Gazebo peer at all" concerns every channel, so it is said once for the bridge. The
+half of a bidirectional entry that waits for a side not there while the other half has
+carried is not warned about: an '@' entry's Gazebo topic often has no subscriber at all.
 """
 
 from __future__ import annotations
@@ -16,7 +18,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rclpy.duration import Infinite
-from rclpy.qos import LivelinessPolicy, QoSCompatibility, QoSProfile, qos_check_compatible
+from rclpy.qos import (
+    DurabilityPolicy,
+    LivelinessPolicy,
+    QoSCompatibility,
+    QoSProfile,
+    ReliabilityPolicy,
+    qos_check_compatible,
+)
 
 from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.converters.registry import Registry
@@ -94,8 +103,14 @@ def ros_endpoints(
             (our_qos, info.qos_profile) if to_ros else (info.qos_profile, our_qos)
         )
         compatibility, reason = qos_check_compatible(publisher, subscription)
-        problem = qos_errors(reason) if compatibility == QoSCompatibility.ERROR else ""
-        found.append(RosEndpoint(node, info.topic_type, problem, describe_qos(info.qos_profile)))
+        problem = ""
+        fixes: tuple[str, ...] = ()
+        if compatibility == QoSCompatibility.ERROR:
+            problem = qos_errors(reason)
+            fixes = qos_fixes(to_ros, publisher, subscription)
+        found.append(
+            RosEndpoint(node, info.topic_type, problem, describe_qos(info.qos_profile), fixes)
+        )
     return found
 
 
@@ -117,6 +132,27 @@ def qos_errors(reason: str) -> str:
     without rcl's markup, for a sentence of ours."""
     errors = [part.strip() for part in reason.split(";") if part.strip().startswith("ERROR:")]
     return ", ".join(error.removeprefix("ERROR:").strip() for error in errors) or reason.strip()
+
+
+def qos_fixes(we_publish: bool, publisher: QoSProfile, subscription: QoSProfile) -> tuple[str, ...]:
+    """The ``qos_overrides`` of the bridge's endpoint (``publisher.durability:=transient_local``)
+    that match the other end's reliability and durability, the incompatibilities users meet
+    (a transient-local /map reader; a best-effort sensor publisher). Empty when those match:
+    then another policy (deadline, liveliness) is at fault, which the entry's profile sets."""
+    ours, theirs = (publisher, subscription) if we_publish else (subscription, publisher)
+    side = "publisher" if we_publish else "subscription"
+    fixes = []
+    if (publisher.reliability, subscription.reliability) == (
+        ReliabilityPolicy.BEST_EFFORT,
+        ReliabilityPolicy.RELIABLE,
+    ):
+        fixes.append(f"{side}.reliability:={theirs.reliability.name.lower()}")
+    if we_publish and (ours.durability, theirs.durability) == (
+        DurabilityPolicy.VOLATILE,
+        DurabilityPolicy.TRANSIENT_LOCAL,
+    ):  # a subscription's durability has no override (rclpy's default policies)
+        fixes.append("publisher.durability:=transient_local")
+    return tuple(fixes)
 
 
 def as_the_graph_shows(profile: QoSProfile) -> QoSProfile:
@@ -194,6 +230,7 @@ class Explainer:
         self._started = now()
         self._seen: dict[int, _Seen] = {}
         self._bridge_announced: set[str] = set()
+        self._bridge_logged: dict[str, float] = {}
         self._asked = float("-inf")
 
     def evaluate(self, channels: Sequence[Channel]) -> None:
@@ -215,6 +252,7 @@ class Explainer:
         for endpoint in self._gz.graph():
             graph.setdefault(endpoint.topic, []).append(endpoint)
         nodes = self._ros_others(channels[0].ctx.ros_node)
+        judged: list[tuple[Channel, _Seen, list[Finding]]] = []
         for channel in channels:
             seen = self._seen.get(id(channel)) or self._remember(channel, now)
             self._count(seen, channel, now)
@@ -233,8 +271,19 @@ class Explainer:
                 found = findings(situation, self._hints)
             channel.flow = flow(situation)
             channel.findings = found
+            judged.append((channel, seen, found))
+        carried: dict[int, list[Channel]] = {}  # spec -> its channels that passed a message
+        for channel in channels:
+            if channel.stats.received:
+                carried.setdefault(id(channel.spec), []).append(channel)
+        for channel, seen, found in judged:
             if now - seen.started >= WARM_UP:
-                self._report(channel, seen, found, now)
+                said = found
+                if any(other is not channel for other in carried.get(id(channel.spec), ())):
+                    # A '@' entry's half that waits while the other one has carried: a side
+                    # not there (a Gazebo topic nobody subscribes to) is the usual case then.
+                    said = [finding for finding in found if finding.fault]
+                self._report(channel, seen, said, now)
 
     def _ros_others(self, ros_node: Any) -> frozenset[tuple[str, str]] | None:
         """The ROS graph's nodes, or None when it shows none that is not the bridge's: then no
@@ -326,10 +375,13 @@ class Explainer:
             if key in seen.announced or now - seen.present[key] < CONFIRM_AFTER:
                 continue
             if key in BRIDGE_WIDE:
-                seen.announced.add(key)
                 if key not in self._bridge_announced:
+                    if now - self._bridge_logged.get(key, float("-inf")) < RELOG_AFTER:
+                        continue  # it came and went lately (a `gz topic -l` heard): said already
+                    self._bridge_logged[key] = now
                     self._bridge_announced.add(key)
                     self._log(f"Nothing can flow: {finding.text}")
+                seen.announced.add(key)
                 continue
             if now - seen.logged.get(key, float("-inf")) < RELOG_AFTER:
                 continue  # it came and went lately: said already

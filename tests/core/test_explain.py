@@ -10,13 +10,14 @@ side is the graph of this process's contexts.
 from __future__ import annotations
 
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
 import rclpy
 from rclpy.context import Context
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.utilities import try_shutdown
 from std_msgs.msg import Int32, String
 
@@ -26,10 +27,12 @@ from ros_gz_bridge_py.core.diagnosis import Flow
 from ros_gz_bridge_py.core.explain import (
     CONFIRM_AFTER,
     EXPLAIN_PERIOD,
+    RELOG_AFTER,
     ROS_ENDPOINTS_REFRESH,
     WARM_UP,
     Explainer,
     qos_errors,
+    qos_fixes,
 )
 from ros_gz_bridge_py.core.status import OK, WARN, StatusTracker
 from ros_gz_bridge_py.msgs import message_class
@@ -212,6 +215,17 @@ def test_no_gazebo_at_all_is_said_once_for_the_bridge(rig: Rig) -> None:
         "Nothing can flow: no Gazebo Transport process is heard at all; the bridge listens "
         f"with the in-memory network {rig.network.name}, partition '{rig.gz.partition}'."
     )
+    # A process heard for a moment (a `gz topic -l` of another partition) is not a reason
+    # to say it again: at most once a minute while it comes and goes.
+    passing = rig.gazebo(partition="elsewhere")
+    judge.evaluate(EXPLAIN_PERIOD)
+    assert [f.key for f in first.findings] == ["gz-absent:publisher"]
+    passing.close()
+    judge.evaluate(EXPLAIN_PERIOD)
+    judge.evaluate(EXPLAIN_PERIOD)
+    assert judge.logged == [line]
+    judge.evaluate(RELOG_AFTER)
+    assert judge.logged == [line, line]
 
 
 def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> None:
@@ -227,6 +241,29 @@ def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> N
     # A side that is not there yet is explained, not warned about.
     status = StatusTracker(rig.bridge).snapshot()[0]
     assert (status.level, status.message()) == (OK, f"waiting for Gazebo: {texts(channel)[0]}")
+
+
+def test_the_waiting_half_of_a_bidirectional_entry_that_carries_is_no_warning(
+    rig: Rig, world: RosWorld
+) -> None:
+    """An '@' entry's Gazebo topic often has no Gazebo subscriber at all: once the entry's
+    Gazebo->ROS half carried, its ROS->Gazebo half waiting for one is shown, not logged."""
+    topic = unique("both_ways")
+    handle = rig.add(string_spec(topic, Direction.BIDIRECTIONAL))
+    carrying, waiting = gz_to_ros(handle), ros_to_gz(handle)
+    publisher = rig.gazebo().advertise(topic, STRING)
+    inbox, _ = world.subscribe(String, topic)
+    sent = publish_until(
+        lambda i: publisher.publish(GzString(data=str(i))),
+        lambda: bool(inbox.messages()),
+        "a message in ROS",
+    )
+    settled(carrying, sent)
+    judge = Judge(rig)
+    judge.until_confirmed()
+    assert flow_of(waiting) is Flow.WAITING_GAZEBO
+    assert [f.key for f in waiting.findings] == ["gz-absent:subscriber"]
+    assert judge.logged == []
 
 
 def test_ros_to_gazebo_waits_for_gazebo_then_ros_then_flows(rig: Rig, world: RosWorld) -> None:
@@ -295,18 +332,43 @@ def test_a_ros_reader_of_another_type_is_explained(
     ]
 
 
-def test_a_ros_reader_with_incompatible_qos_is_explained(rig: Rig, world: RosWorld) -> None:
+@pytest.mark.parametrize(
+    ("profile", "reader", "told"),
+    [("CLOCK", QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE),
+      ("Best effort publisher and reliable subscription", "publisher.reliability:=reliable")),
+     (None, QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL),
+      ("Volatile publisher and transient local subscription",
+       "publisher.durability:=transient_local"))],
+)  # fmt: skip
+def test_a_ros_reader_with_incompatible_qos_is_told_the_parameter_that_matches_it(
+    world: RosWorld,
+    make_rig: Callable[..., Rig],
+    profile: str | None,
+    reader: QoSProfile,
+    told: tuple[str, str],
+) -> None:
+    """``told``: rcl's reason, and the override the fix names."""
+    reason, fix = told
     topic = unique("ros_qos")
-    channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS, qos_profile="CLOCK")))
-    rig.gazebo().advertise(topic, STRING)
-    world.subscribe(String, topic, QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
-    wait_until(lambda: len(world.subscribers(topic)) == 1, "the reliable reader in the graph")
-    Judge(rig).evaluate()
-    assert texts(channel) == [
+    world.subscribe(String, topic, reader)
+    wait_until(lambda: len(world.subscribers(topic)) == 1, "the reader in the graph")
+
+    def texts_of(node_options: dict[str, Any] | None) -> list[str]:
+        rig = make_rig(node_options=node_options)
+        channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS, qos_profile=profile)))
+        rig.gazebo().advertise(topic, STRING)
+        Judge(rig).evaluate()
+        return texts(channel)
+
+    assert texts_of(None) == [
         f"the ROS subscriber /{world.node.get_name()} of {topic} cannot match the bridge's "
-        "QoS: Best effort publisher and reliable subscription; set the entry's qos_profile (or "
-        f"qos_overrides.{topic}.*) to what it uses"
+        f"QoS: {reason}; run the bridge with --ros-args -p qos_overrides.{topic}.{fix} (or set "
+        "the entry's qos_profile to match)"
     ]
+    # The parameter named is the fix: given to the bridge node, the reader matches.
+    name, value = fix.split(":=")
+    given = {"parameter_overrides": [Parameter(f"qos_overrides.{topic}.{name}", value=value)]}
+    assert texts_of(given) == []
 
 
 def test_rcl_qos_reasons_become_a_clause_of_the_explanation() -> None:
@@ -320,6 +382,21 @@ def test_rcl_qos_reasons_become_a_clause_of_the_explanation() -> None:
         "Best effort publisher and reliable subscription, "
         "Volatile publisher and transient local subscription"
     )
+
+
+def test_qos_fixes_name_the_overrides_of_the_bridges_own_endpoint() -> None:
+    best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
+    reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    # ROS->Gazebo: a best-effort sensor publisher, the bridge's reliable subscription.
+    assert qos_fixes(False, best_effort, reliable) == ("subscription.reliability:=best_effort",)
+    # Gazebo->ROS: the bridge publishes best effort and volatile to a reliable latched reader.
+    assert qos_fixes(True, best_effort, latched) == (
+        "publisher.reliability:=reliable",
+        "publisher.durability:=transient_local",
+    )
+    # A subscription's durability has no override: nothing to propose there.
+    assert qos_fixes(False, reliable, latched) == ()
 
 
 def _read_by_another_type(
