@@ -148,14 +148,15 @@ def parse_bridge_params(text: str) -> dict[str, Scalar]:
         LaunchArgumentError: a pair without a colon or without a name.
     """
     params: dict[str, Scalar] = {}
-    for pair in text.translate(_DROPPED_FROM_BRIDGE_PARAMS).split(","):
+    for written in text.split(","):  # the dropped characters hold no comma
+        pair = written.translate(_DROPPED_FROM_BRIDGE_PARAMS)
         if not pair:
             continue
         name, colon, value = pair.partition(":")
         if not colon or not name:
             msg = (
-                f"bridge_params: {pair!r} is not NAME: VALUE; write the parameters as "
-                "\"'name1': 'value1', 'name2': 'value2'\""
+                f"bridge_params: {written.strip()!r} is not NAME: VALUE; write the parameters "
+                "as \"'name1': 'value1', 'name2': 'value2'\""
             )
             raise LaunchArgumentError(msg)
         params[name] = _scalar(value)

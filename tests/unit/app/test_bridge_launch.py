@@ -117,10 +117,19 @@ def test_bridge_params_keep_a_value_with_a_colon_and_skip_an_empty_pair() -> Non
     assert parse_bridge_params("'override_frame_id': 'a:b',") == {"override_frame_id": "a:b"}
 
 
-@pytest.mark.parametrize("text", ["lazy", "'lazy' 'true'", ": true"])
-def test_a_bridge_params_pair_without_name_and_colon_is_named_with_the_fix(text: str) -> None:
-    with pytest.raises(LaunchArgumentError, match=r"bridge_params: .* is not NAME: VALUE"):
+@pytest.mark.parametrize(
+    ("text", "named"),
+    [("lazy", "'lazy'"), ("'lazy' 'true'", "\"'lazy' 'true'\""), ("a: 1, : true", "': true'"),
+     ("lazy true", "'lazy true'")],
+)  # fmt: skip
+def test_a_bridge_params_pair_without_name_and_colon_is_named_with_the_fix(
+    text: str, named: str
+) -> None:
+    """The pair is quoted as written (with its spaces and quotes, which the parse drops:
+    'lazy true' was told as 'lazytrue')."""
+    with pytest.raises(LaunchArgumentError) as raised:
         parse_bridge_params(text)
+    assert str(raised.value).startswith(f"bridge_params: {named} is not NAME: VALUE; write ")
 
 
 def test_the_default_arguments_start_bridge_node_as_ros_gz_starts_its_own() -> None:
