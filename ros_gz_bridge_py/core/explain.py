@@ -311,7 +311,9 @@ class Explainer:
         """A channel's first evaluation; what does not change is worked out once (at rest, a
         fleet's 201 channels every 2 s made this a third of the bridge's CPU)."""
         name = gazebo_name(self._gz, channel.spec.gz_topic)
-        seen = _Seen(now, name, as_the_graph_shows(channel.qos), channel.stats.received)
+        # Counted from 0: a channel that passed messages before its first evaluation (2 s
+        # after the bridge started) is flowing at once, not "stalled" in its first status.
+        seen = _Seen(now, name, as_the_graph_shows(channel.qos))
         self._seen[id(channel)] = seen
         return seen
 

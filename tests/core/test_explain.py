@@ -260,7 +260,11 @@ def test_the_waiting_half_of_a_bidirectional_entry_that_carries_is_no_warning(
     )
     settled(carrying, sent)
     judge = Judge(rig)
-    judge.until_confirmed()
+    judge.evaluate()
+    # Messages passed before the first look: flowing at once, not "stalled" in a first status.
+    assert flow_of(carrying) is Flow.FLOWING
+    judge.evaluate(WARM_UP)
+    judge.evaluate(CONFIRM_AFTER)
     assert flow_of(waiting) is Flow.WAITING_GAZEBO
     assert [f.key for f in waiting.findings] == ["gz-absent:subscriber"]
     assert judge.logged == []
