@@ -238,6 +238,7 @@ def _topic_reports(
             gz_topics=gz_topics,
             discovered_by=spec.discovered_by,
             bidirectional=spec.direction is Direction.BIDIRECTIONAL,
+            ros_namespace=ros_node.get_namespace(),
         )
         arrow = (
             f"Gazebo {name} ({spec.gz_type}) -> ROS {ros_topic} ({spec.ros_type})"

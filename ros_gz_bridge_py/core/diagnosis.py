@@ -125,6 +125,9 @@ class Situation:
     peers_settled: bool = True
     #: The channel is one half of a bidirectional entry (the other half has its own).
     bidirectional: bool = False
+    #: The bridge node's namespace ("/" or "" at the root): a Gazebo name outside it, when
+    #: the simulator has the topic inside, is told how to put it there.
+    ros_namespace: str = ""
 
 
 def flow(situation: Situation) -> Flow:
@@ -317,6 +320,14 @@ def _heard(processes: int) -> str:
 def _absent_finding(situation: Situation, role: str) -> Finding:
     similar = _similar_topics(situation.gz_topic, situation.gz_topics)
     hint = f"; similar topics: {', '.join(similar)}" if similar else ""
+    namespace = situation.ros_namespace.rstrip("/")
+    inside = f"{namespace}/{situation.gz_topic.lstrip('/')}"
+    if namespace and inside in similar:
+        hint += (
+            f"; Gazebo names do not take the bridge's namespace {namespace} unless "
+            "expand_gz_topic_names is true (-p expand_gz_topic_names:=true, with the entry's "
+            f"Gazebo name relative), or write {inside}"
+        )
     other = PUBLISHER if role == SUBSCRIBER else SUBSCRIBER
     if not situation.bidirectional and any(
         e.role == other and e.partition == situation.partition for e in situation.gz_endpoints

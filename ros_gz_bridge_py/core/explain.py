@@ -361,6 +361,7 @@ class Explainer:
             discovered_by=spec.discovered_by,
             peers_settled=now - self._started >= WARM_UP,
             bidirectional=spec.direction is Direction.BIDIRECTIONAL,
+            ros_namespace=channel.ctx.ros_node.get_namespace(),
         )
 
     def _ask_subscribers(self, now: float) -> None:

@@ -350,3 +350,23 @@ def test_a_one_way_channel_facing_the_other_role_is_told_to_turn() -> None:
     )
     (finding,) = findings(backwards, HINTS)
     assert finding.text.endswith("bridge it GZ_TO_ROS ('[' on the command line)")
+
+
+def test_a_name_outside_the_bridges_namespace_is_told_how_to_put_it_inside() -> None:
+    """A robot's bridge under -r __ns:=/robot1 with 'odom': Gazebo names are not expanded
+    by default, and the simulator has /robot1/odom."""
+    waiting = situation(
+        Direction.GZ_TO_ROS,
+        gz_topics=["/robot1/odom", "/robot2/odom"],
+        ros_namespace="/robot1",
+    )
+    (found,) = findings(waiting, HINTS)
+    assert found.text.endswith(
+        "similar topics: /robot1/odom, /robot2/odom; Gazebo names do not take the bridge's "
+        "namespace /robot1 unless expand_gz_topic_names is true (-p "
+        "expand_gz_topic_names:=true, with the entry's Gazebo name relative), or write "
+        "/robot1/odom"
+    )
+    for elsewhere in ("/", "/robot3"):  # no such topic inside the namespace: no such hint
+        other = dataclasses.replace(waiting, ros_namespace=elsewhere)
+        assert "namespace" not in findings(other, HINTS)[0].text
