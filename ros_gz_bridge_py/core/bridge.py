@@ -137,6 +137,7 @@ class Bridge:
                 self.registry,
                 self._ctx.own_nodes,
                 self._logger.warning,
+                note=self._logger.info,
                 types_fixed_by=self.options.types_fixed_by,
                 qos_setting=self.options.qos_setting,
             )

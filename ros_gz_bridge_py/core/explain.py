@@ -209,7 +209,11 @@ class _Seen:
 
 
 class Explainer:
-    """Evaluates channels and logs their causes; one per bridge."""
+    """Evaluates channels and logs their causes; one per bridge.
+
+    ``log`` takes the misconfigurations (a WARN); ``note`` the sides that are not there yet,
+    which are no fault (an INFO: a simulator that starts after the bridge is the usual case),
+    and defaults to ``log``."""
 
     def __init__(
         self,
@@ -219,6 +223,7 @@ class Explainer:
         log: Callable[[str], None],
         now: Callable[[], float] = time.monotonic,
         *,
+        note: Callable[[str], None] | None = None,
         types_fixed_by: str = "",
         qos_setting: str = ENTRY_QOS_SETTING,
     ) -> None:
@@ -226,6 +231,7 @@ class Explainer:
         self._hints = type_hints(registry, types_fixed_by, qos_setting)
         self._own = frozenset(own_nodes)
         self._log = log
+        self._note = note or log
         self._now = now
         self._started = now()
         self._seen: dict[int, _Seen] = {}
@@ -391,4 +397,5 @@ class Explainer:
             seen.logged[key] = now
             seen.announced.add(key)
             state = channel.flow.value if channel.flow is not None else "starting"
-            self._log(f"{channel.describe()}: {state}: {finding.text}")
+            say = self._log if finding.fault else self._note
+            say(f"{channel.describe()}: {state}: {finding.text}")

@@ -62,14 +62,20 @@ class Judge:
     def __init__(self, rig: Rig) -> None:
         self.rig = rig
         self.now = 500.0
-        self.logged: list[str] = []
+        self.logged: list[str] = []  # warnings
+        self.noted: list[str] = []  # sides not there yet
         node = rig.node
         own = {
             (node.get_name(), node.get_namespace()),
             (side_node_name(node), node.get_namespace()),
         }
         self.explainer = Explainer(
-            rig.gz, rig.bridge.registry, own, self.logged.append, now=lambda: self.now
+            rig.gz,
+            rig.bridge.registry,
+            own,
+            self.logged.append,
+            now=lambda: self.now,
+            note=self.noted.append,
         )
 
     def evaluate(self, after: float = 0.0) -> None:
@@ -233,12 +239,16 @@ def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> N
     channel = gz_to_ros(rig.add(string_spec(f"/{stem}", Direction.GZ_TO_ROS)))
     rig.add(string_spec(f"/{stem}_cmd", Direction.ROS_TO_GZ))  # the bridge's own: not suggested
     rig.gazebo().advertise(f"/robot/{stem}", STRING)
-    Judge(rig).evaluate()
+    judge = Judge(rig)
+    judge.until_confirmed()
     assert texts(channel) == [
         f"no Gazebo publisher of /{stem} in partition '{rig.gz.partition}' "
         f"(1 Gazebo process heard in any partition); similar topics: /robot/{stem}"
     ]
-    # A side that is not there yet is explained, not warned about.
+    # A side that is not there yet is explained, not warned about: an INFO line (a simulator
+    # that starts after the bridge is the usual case) and an OK status.
+    assert judge.logged == []
+    assert f"{channel.describe()}: waiting for Gazebo: {texts(channel)[0]}" in judge.noted
     status = StatusTracker(rig.bridge).snapshot()[0]
     assert (status.level, status.message()) == (OK, f"waiting for Gazebo: {texts(channel)[0]}")
 
@@ -267,7 +277,7 @@ def test_the_waiting_half_of_a_bidirectional_entry_that_carries_is_no_warning(
     judge.evaluate(CONFIRM_AFTER)
     assert flow_of(waiting) is Flow.WAITING_GAZEBO
     assert [f.key for f in waiting.findings] == ["gz-absent:subscriber"]
-    assert judge.logged == []
+    assert judge.logged == judge.noted == []
 
 
 def test_ros_to_gazebo_waits_for_gazebo_then_ros_then_flows(rig: Rig, world: RosWorld) -> None:
