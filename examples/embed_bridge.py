@@ -15,7 +15,9 @@ Run it next to Gazebo publishers of both topics that keep publishing, for exampl
     python examples/embed_bridge.py --first /first --second /second
 
 It prints one line per step (``RECEIVED <topic> <data>``, ``REMOVED <topic>``, ``DONE``) and
-exits with status 1 if a message does not arrive within ``--timeout`` seconds.
+exits with status 1 if a message does not arrive within ``--timeout`` seconds. Ctrl-C closes the
+bridge, then shuts rclpy down (rclpy's own signal handler would shut it down first), prints
+``INTERRUPTED`` and exits with status 130.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from typing import Any
 
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import String
 
 from ros_gz_bridge_py import Bridge, BridgeOptions
@@ -69,7 +72,8 @@ def main() -> int:
     parser.add_argument("--timeout", type=float, default=20.0, help="seconds per message")
     args = parser.parse_args()
 
-    rclpy.init()
+    # Ctrl-C is ours to handle: the bridge closes before rclpy shuts down.
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("embed_bridge_example")
     executor = SingleThreadedExecutor()
     executor.add_node(node)
@@ -91,6 +95,9 @@ def main() -> int:
             if step == 0:
                 bridge.remove(handle)  # the other bridges (none here) keep running
                 print(f"REMOVED {topic}", flush=True)
+    except KeyboardInterrupt:
+        print("INTERRUPTED", flush=True)
+        status = 130
     finally:
         bridge.close()
         executor.shutdown(timeout_sec=1.0)

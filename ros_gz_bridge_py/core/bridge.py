@@ -39,13 +39,13 @@ from ros_gz_bridge_py.converters.registry import Registry, default_registry
 from ros_gz_bridge_py.core.channel import Channel, ChannelContext
 from ros_gz_bridge_py.core.explain import EXPLAIN_PERIOD, Explainer
 from ros_gz_bridge_py.core.gz_to_ros import GzToRosChannel
+from ros_gz_bridge_py.core.node_share import share_of
 from ros_gz_bridge_py.core.options import BridgeOptions
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.services import ServiceBridge
 from ros_gz_bridge_py.core.spec_checks import (
     Key,
     checked_spec,
-    refuse_twice,
     refused_name_fix,
     service_key,
     topic_keys,
@@ -85,9 +85,9 @@ class Bridge:
     def __init__(
         self,
         ros_node: Any,
+        *,
         gz_node: GzNode | None = None,
         options: BridgeOptions | None = None,
-        *,
         registry: Registry | None = None,
         gz_options: NodeOptions | None = None,
     ) -> None:
@@ -104,7 +104,23 @@ class Bridge:
             gz_options = dataclasses.replace(
                 gz_options or NodeOptions(), legacy_spelling=Spelling.GZ
             )
-        self.gz_node = gz_node if gz_node is not None else create_gz_node(gz_options)
+        self._share = share_of(ros_node)
+        self._number = self._share.number()
+        try:
+            self.gz_node = gz_node if gz_node is not None else create_gz_node(gz_options)
+        except BaseException:
+            self._share.give_back(self._number)
+            raise
+        try:
+            self._start(ros_node)
+        except BaseException:  # a failed construction leaves nothing running
+            self._share.give_back(self._number)
+            if self._owns_gz_node:
+                self.gz_node.close()
+            raise
+
+    def _start(self, ros_node: Any) -> None:
+        """What :meth:`__init__` makes once the Gazebo node exists."""
         self._side: SideNode | None = None
         self._native: Any = None
         self._ctx = ChannelContext(
@@ -115,8 +131,8 @@ class Bridge:
             own_nodes=frozenset(
                 {
                     (ros_node.get_name(), ros_node.get_namespace()),
-                    (side_node_name(ros_node), ros_node.get_namespace()),
-                    (native_node_name(ros_node), ros_node.get_namespace()),
+                    (side_node_name(ros_node, self._number), ros_node.get_namespace()),
+                    (native_node_name(ros_node, self._number), ros_node.get_namespace()),
                 }
             ),
             options=self.options,
@@ -124,8 +140,6 @@ class Bridge:
         self._logger = quick_logger(ros_node.get_logger())
         self._lock = threading.RLock()
         self._handles: list[BridgeHandle] = []
-        #: What each open handle bridges (``spec_checks.py``), to refuse a second bridge of it.
-        self._claims: dict[Key, BridgeSpec] = {}
         self._closed = False
         steady = steady_clock()
         self._timer = ros_node.create_timer(self.options.heartbeat, self.heartbeat, clock=steady)
@@ -186,14 +200,17 @@ class Bridge:
                 msg = f"the bridge is closed; {spec!r} was not added"
                 raise BridgeError(msg)
             keys = self._keys(checked)
-            refuse_twice(checked, keys, self._claims)
-            handle = (
-                self._add_service(checked)
-                if isinstance(checked, ServiceBridgeSpec)
-                else self._add_topic(checked)
-            )
+            self._share.claim(checked, keys)  # this bridge's, and every other's on the node
+            try:
+                handle = (
+                    self._add_service(checked)
+                    if isinstance(checked, ServiceBridgeSpec)
+                    else self._add_topic(checked)
+                )
+            except BaseException:
+                self._share.release(checked)
+                raise
             self._handles.append(handle)
-            self._claims.update(dict.fromkeys(keys, handle.spec))
             return handle
 
     def add_all(self, specs: Iterable[BridgeSpec]) -> list[ConfigError]:
@@ -213,9 +230,7 @@ class Bridge:
             if handle not in self._handles:
                 return
             self._handles.remove(handle)
-            for key in self._keys(handle.spec):
-                if self._claims.get(key) is handle.spec:
-                    del self._claims[key]
+            self._share.release(handle.spec)
         _close_handle(handle)
 
     def heartbeat(self) -> None:
@@ -243,7 +258,9 @@ class Bridge:
                 return
             self._closed = True
             handles, self._handles = self._handles, []
-            self._claims.clear()
+            for handle in handles:
+                self._share.release(handle.spec)
+            self._share.give_back(self._number)
         self.ros_node.destroy_timer(self._timer)
         if self._explain_timer is not None:
             self.ros_node.destroy_timer(self._explain_timer)
@@ -281,14 +298,15 @@ class Bridge:
         try:
             for kind in kinds:
                 channel = kind(self._ctx, spec, layouts, lazy)
-                for line in channel.creation_lines():
-                    self._logger.info(line)
                 handle.channels.append(channel)
                 self._guard_loops(channel, handle.channels)
                 channel.start()
         except Exception as err:
             _close_handle(handle)
             raise ConfigError(_failed_text(spec, str(err)), spec.source or None) from err
+        for channel in handle.channels:  # once they exist: a refused entry is not "Creating"
+            for line in channel.creation_lines():
+                self._logger.info(line)
         return handle
 
     def _keys(self, spec: BridgeSpec) -> list[Key]:
@@ -304,13 +322,13 @@ class Bridge:
     def _native_node(self) -> Any:
         with self._lock:
             if self._native is None:
-                self._native = unspun_node(self.ros_node)
+                self._native = unspun_node(self.ros_node, self._number)
             return self._native
 
     def _side_node(self) -> SideNode:
         with self._lock:
             if self._side is None:
-                self._side = SideNode(self.ros_node)
+                self._side = SideNode(self.ros_node, self._number)
             return self._side
 
     def _guard_loops(self, new: Channel, siblings: list[Channel]) -> None:

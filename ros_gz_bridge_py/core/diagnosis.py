@@ -428,15 +428,10 @@ def _ros_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
 def _qos_fix(situation: Situation, endpoint: RosEndpoint, hints: TypeHints) -> str:
     """The parameters that give the bridge's endpoint the other end's QoS, as a command line
     takes them (a params file or a launch file's parameters take the same names)."""
+    topic, uses = situation.ros_topic, f" ({endpoint.qos})" if endpoint.qos else ""
     if not endpoint.qos_fixes:
-        uses = f" ({endpoint.qos})" if endpoint.qos else ""
-        return (
-            f"set {hints.qos_setting} (or qos_overrides.{situation.ros_topic}.*) to what it "
-            f"uses{uses}"
-        )
-    overrides = " ".join(
-        f"-p qos_overrides.{situation.ros_topic}.{fix}" for fix in endpoint.qos_fixes
-    )
+        return f"set {hints.qos_setting} (or qos_overrides.{topic}.*) to what it uses{uses}"
+    overrides = " ".join(f"-p qos_overrides.{topic}.{fix}" for fix in endpoint.qos_fixes)
     return f"run the bridge with --ros-args {overrides} (or set {hints.qos_setting} to match)"
 
 

@@ -8,11 +8,13 @@ bridge passes its own.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ros_gz_bridge_py.config.gz_version import GARDEN
 from ros_gz_bridge_py.core.diagnosis import ENTRY_QOS_SETTING
 from ros_gz_bridge_py.core.services import DEFAULT_TIMEOUT
+from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.transport.delivery import MAX_QUEUED_BYTES
 
 #: How much lower the CPU priority (nice) of bulk-path delivery threads is, by default.
@@ -58,6 +60,25 @@ class BridgeOptions:
     types_fixed_by: str = ""
     #: What the user changes to set a channel's QoS profile, as explanations name it.
     qos_setting: str = ENTRY_QOS_SETTING
+
+    def __post_init__(self) -> None:
+        """Refuse numbers the bridge cannot run with, before anything is opened (a heartbeat
+        of 0 was a timer spinning a core; a negative one rcl's raw error).
+
+        Raises:
+            ConfigError: the first such field, named with what it takes.
+        """
+        checks = (
+            ("heartbeat", self.heartbeat > 0, "seconds between lazy re-checks, > 0 (1.0)"),
+            ("service_timeout", self.service_timeout > 0, "seconds, > 0"),
+            ("max_rate", self.max_rate >= 0, "messages per second, 0 for no limit"),
+            ("max_queued_bytes", self.max_queued_bytes >= 1, "bytes, at least 1"),
+        )
+        for name, fine, takes in checks:
+            value = getattr(self, name)
+            if not fine or not math.isfinite(value):
+                msg = f"BridgeOptions({name}={value!r}): give {takes}"
+                raise ConfigError(msg)
 
     @property
     def garden(self) -> bool:

@@ -40,19 +40,24 @@ SUFFIX = "_side"
 NATIVE_SUFFIX = "_native"
 
 
-def side_node_name(owner: Any) -> str:
-    return f"{HIDDEN}{owner.get_name()}{SUFFIX}"
+def side_node_name(owner: Any, number: int = 1) -> str:
+    """``number``: the bridge's on ``owner`` (``core/node_share.py``); the first has none."""
+    return f"{HIDDEN}{owner.get_name()}{SUFFIX}{_numbered(number)}"
 
 
-def native_node_name(owner: Any) -> str:
-    return f"{HIDDEN}{owner.get_name()}{NATIVE_SUFFIX}"
+def native_node_name(owner: Any, number: int = 1) -> str:
+    return f"{HIDDEN}{owner.get_name()}{NATIVE_SUFFIX}{_numbered(number)}"
 
 
-def unspun_node(owner: Any) -> Any:
+def _numbered(number: int) -> str:
+    return "" if number == 1 else f"_{number}"
+
+
+def unspun_node(owner: Any, number: int = 1) -> Any:
     """A node beside ``owner`` (same context and namespace) that no executor spins: the
     subscriptions of native ROS -> Gazebo loops live there, so that only those loops take
     their messages (docs/native.md §7)."""
-    return _helper_node(native_node_name(owner), owner)
+    return _helper_node(native_node_name(owner, number), owner)
 
 
 def _helper_node(name: str, owner: Any) -> RosNode:
@@ -81,10 +86,11 @@ class SideNode:
 
     THREADS = 4
 
-    def __init__(self, owner: Any) -> None:
+    def __init__(self, owner: Any, number: int = 1) -> None:
+        """``number``: the bridge's on ``owner`` (:func:`side_node_name`)."""
         #: The bridge's node, whose name the bridge's log lines carry.
         self.owner = owner
-        self.node = _helper_node(side_node_name(owner), owner)
+        self.node = _helper_node(side_node_name(owner, number), owner)
         self.reentrant = ReentrantCallbackGroup()
         self.late_responses = LateResponses(self.node)
         self._executor = MultiThreadedExecutor(num_threads=self.THREADS, context=owner.context)

@@ -9,6 +9,7 @@ ROS->Gazebo bridge no ROS subscription and no Gazebo advertisement.
 
 from __future__ import annotations
 
+import signal
 import sys
 import uuid
 from collections.abc import Iterator
@@ -68,6 +69,21 @@ def test_example_bridges_removes_and_bridges_again(started: list[PeerProcess]) -
     wait_for_line(example, rf"^RECEIVED {second} from gazebo two$", timeout=WAIT + 5)
     wait_for_line(example, r"^DONE$")
     assert example.wait(WAIT) == 0, example.output()
+    assert "Traceback" not in example.output()
+
+
+def test_example_stops_on_ctrl_c_without_a_traceback(started: list[PeerProcess]) -> None:
+    """Ctrl-C while it waited printed two tracebacks (rclpy's shutdown in the spin thread,
+    then the KeyboardInterrupt) and no DONE."""
+    example = start_process(
+        [sys.executable, str(EXAMPLE), "--first", unique_name("embed_nothing"), "--timeout", "60"]
+    )
+    started.append(example)
+    wait_for_line(example, r"^ADDED ", timeout=30)
+    example.send_signal(signal.SIGINT)
+    assert example.wait(WAIT) == 130, example.output()
+    wait_for_line(example, r"^INTERRUPTED$")
+    wait_for_line(example, r"^DONE$")
     assert "Traceback" not in example.output()
 
 

@@ -8,14 +8,18 @@ node of this process.
 from __future__ import annotations
 
 import dataclasses
+import os
+import threading
 from typing import Any
 
 import pytest
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from std_msgs.msg import String
 
 from ros_gz_bridge_py.config import Direction, ServiceBridgeSpec, TopicBridgeSpec
+from ros_gz_bridge_py.core.bridge import Bridge
 from ros_gz_bridge_py.errors import BridgeError, ConfigError
-from tests.core.harness import Rig, gz_to_ros, unique
+from tests.core.harness import TEST_OPTIONS, Rig, RosWorld, gz_to_ros, unique
 
 pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
 
@@ -186,3 +190,43 @@ def test_a_name_one_side_refuses_is_told_what_to_write(
         rig.add(spec)
     assert str(raised.value).endswith(fix)
     assert rig.bridge.handles == []
+
+
+def test_two_bridges_on_one_node_bridge_a_topic_once_and_name_their_helpers_apart(
+    rig: Rig,
+) -> None:
+    """Two Bridge objects on one node bridged one topic twice (every message arrived twice)
+    and made two helper nodes of one name."""
+    topic, other = unique("twice"), unique("once")
+    rig.add(string_spec(topic, Direction.BIDIRECTIONAL))  # its loop guard needs the side node
+    second = rig.world.run(lambda: Bridge(rig.node, gz_node=rig.gz, options=TEST_OPTIONS))
+    try:
+        with pytest.raises(ConfigError, match=r"bridged already by an earlier Bridge\.add"):
+            rig.world.run(lambda: second.add(string_spec(topic, Direction.GZ_TO_ROS)))
+        rig.world.run(lambda: second.add(string_spec(other, Direction.BIDIRECTIONAL)))
+        name = rig.node.get_name()
+        helpers = {n for n in rig.node.get_node_names() if n.startswith(f"_{name}_side")}
+        assert helpers == {f"_{name}_side", f"_{name}_side_2"}
+    finally:
+        rig.world.run(second.close)
+    # Closed, it holds nothing: the topic it took may be bridged again.
+    rig.add(string_spec(other, Direction.GZ_TO_ROS))
+
+
+def test_options_are_given_by_keyword() -> None:
+    """``Bridge(node, BridgeOptions(...))`` took the options as the Gazebo node and failed
+    at the first add with "'BridgeOptions' object has no attribute ..."."""
+    untyped: Any = Bridge  # as an untyped program calls it
+    with pytest.raises(TypeError, match="positional argument"):
+        untyped(object(), TEST_OPTIONS)
+
+
+def test_a_bridge_that_cannot_start_leaves_nothing_open(world: RosWorld) -> None:
+    """Each failed construction left its own Gazebo node running (a thread and 19 fds)."""
+    node = world.create_node(unique("destroyed").strip("/"))
+    node.destroy_node()
+    before = threading.active_count(), len(os.listdir("/proc/self/fd"))
+    for _ in range(3):
+        with pytest.raises(_rclpy.InvalidHandle):  # the node is destroyed
+            Bridge(node, options=TEST_OPTIONS)
+    assert (threading.active_count(), len(os.listdir("/proc/self/fd"))) == before

@@ -45,7 +45,9 @@ class Setup:
         settings = dataclasses.replace(TransportSettings.from_env(), max_message_size=LIMIT)
         self.gz_bridge_node = MemoryGzNode(settings=settings, network=network)
         self.gazebo = MemoryGzNode(network=network)
-        self.bridge = Bridge(self.ros_node, self.gz_bridge_node, BridgeOptions(explain=False))
+        self.bridge = Bridge(
+            self.ros_node, gz_node=self.gz_bridge_node, options=BridgeOptions(explain=False)
+        )
         self.warnings: list[str] = []
 
     def channel(self, topic: str, ros_type: str, gz_type: str) -> Channel:

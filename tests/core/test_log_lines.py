@@ -15,6 +15,7 @@ import pytest
 
 from ros_gz_bridge_py.config import Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.core.bridge import BridgeHandle
+from ros_gz_bridge_py.errors import ConfigError
 from tests.core.harness import Rig, gz_to_ros, options, ros_to_gz, unique
 
 pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
@@ -138,3 +139,14 @@ def test_a_service_without_gazebo_types_logs_them_empty_then_ours(
         f"{described}: the ROS name {service} resolves to {NAMESPACE}/{service}; "
         "the Gazebo types left out are the service type's",
     ]
+
+
+def test_an_entry_a_side_refuses_is_not_logged_as_created(
+    rig: Rig, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """The bridge made its channels' creation lines before it started them: a Gazebo name the
+    transport refuses was logged as "Creating ..." and then refused."""
+    logged(rig, capfd)
+    with pytest.raises(ConfigError, match="invalid Gazebo Transport topic"):
+        rig.add(TopicBridgeSpec(unique("ros_ok"), "/my topic", STRING, "gz.msgs.StringMsg"))
+    assert logged(rig, capfd) == []
