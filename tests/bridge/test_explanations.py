@@ -223,6 +223,36 @@ def test_a_subscriber_of_our_type_that_left_is_not_one_of_another_type(
     assert "did not take" not in bridge.output()
 
 
+def test_a_killed_subscriber_is_no_subscriber_any_more(started: list[PeerProcess]) -> None:
+    """A Fortress subscriber killed (no END_CONNECTION, no BYE) was kept as registered for
+    good: the channel showed "flowing" or "waiting for ROS" to nobody (found by a new user
+    restarting a simulator)."""
+    require_peer()
+    topic = unique_name("xp_killed")
+    bridge = start_process(bridge_command(f"{topic}@geometry_msgs/msg/Twist]gz.msgs.Twist"))
+    started.append(bridge)
+    wait_for_line(bridge, r"Creating ROS->GZ", timeout=30)
+    echo = start_peer("echo", topic, "ignition.msgs.Twist", "120")
+    started.append(echo)
+
+    def row_shows(flow: str) -> bool:
+        """Whether the status table printed now shows ``flow`` for the channel."""
+        left = len(bridge.output())
+        bridge.send_signal(signal.SIGUSR1)
+        time.sleep(0.3)
+        row = re.compile(rf"^\S+\s+ROS->GZ\s+{re.escape(topic)}\s.*{flow}", re.MULTILINE)
+        return bool(row.search(bridge.output()[left:]))
+
+    deadline = time.monotonic() + EXPLAIN_WITHIN + WAIT
+    while not row_shows("waiting for ROS"):  # registered: it waits for a ROS publisher
+        assert time.monotonic() < deadline, bridge.output()
+    echo.kill()
+    echo.wait(WAIT)
+    deadline = time.monotonic() + EXPLAIN_WITHIN
+    while not row_shows("waiting for Gazebo"):
+        assert time.monotonic() < deadline, bridge.output()
+
+
 def test_check_without_problems_exits_0(started: list[PeerProcess]) -> None:
     require_peer()
     topic = unique_name("xp_fine")

@@ -28,6 +28,7 @@ from ros_gz_bridge_py.transport.zmq.discovery_events import (
     SubscriberRemoved,
 )
 from ros_gz_bridge_py.transport.zmq.discovery_memo import DatagramMemo
+from ros_gz_bridge_py.transport.zmq.discovery_tables import drop_process
 from ros_gz_bridge_py.transport.zmq.wire import (
     WIRE_VERSION,
     DiscoveryMessage,
@@ -399,19 +400,17 @@ class DiscoveryEngine:
         self.spellings.forget(process)
         for topic in list(self._subscribe_seen):
             self._forget_sighting(topic, process)
-        for topic in list(self._listed):
-            by_node = self._listed[topic]
-            for key in [key for key in by_node if key[0] == process]:
-                del by_node[key]
-            if not by_node:
-                del self._listed[topic]
+        drop_process(self._listed, process)
         events: list[Event] = []
         for topic in list(self._remote):
             records = self._remote[topic].pop(process, [])
             events += [PublisherRemoved(r) for r in records]
             if not self._remote[topic]:
                 del self._remote[topic]
-        return events
+        # Its subscriptions to our topics go with it, as gz-transport drops a gone process's
+        # remote subscribers (one killed, without END_CONNECTION, was kept for good).
+        gone = drop_process(self._subscribers, process)
+        return events + [SubscriberRemoved(topic, *key) for topic, key in gone]
 
     def _on_new_connection(self, record: PublisherRecord) -> list[Event]:
         if record.msg is None:

@@ -221,6 +221,26 @@ def test_remote_subscribers_from_new_and_end_connection() -> None:
     assert engine.remote_subscribers(TOPIC) == ()
 
 
+@pytest.mark.parametrize("goes", ["silent", "bye"])
+def test_a_gone_process_is_no_remote_subscriber_any_more(goes: str) -> None:
+    """A subscriber killed without END_CONNECTION (SIGKILL, a crash) was kept for good: the
+    bridge's ROS->Gazebo channel showed "flowing" to nobody and a lazy one stayed open (found
+    by a new user restarting a simulator)."""
+    engine = DiscoveryEngine(ME, 0.0)
+    engine.advertise(record(ME))
+    theirs = PublisherRecord(
+        TOPIC, "a", PEER, PEER_NODE, Scope.ALL, MessagePublisher("gz.msgs.StringMsg", ctrl=ME)
+    )
+    engine.datagram_received(datagram(DiscoveryType.NEW_CONNECTION, pub=theirs), "127.0.0.1", 0.0)
+    assert engine.registered_topics() == [TOPIC]
+    if goes == "bye":
+        events = engine.datagram_received(datagram(DiscoveryType.BYE), "127.0.0.1", 0.5)[1]
+    else:
+        events = engine.tick(SILENCE_INTERVAL + 0.2)[1]
+    assert events == [SubscriberRemoved(TOPIC, PEER, PEER_NODE)]
+    assert (engine.remote_subscribers(TOPIC), engine.registered_topics()) == ((), [])
+
+
 def test_a_subscriber_that_unsubscribes_leaves_no_sighting_behind() -> None:
     """A typed subscriber that took our type and went (END_CONNECTION) is not one that
     SUBSCRIBEd and never took it: the explanations called it "did not take ... it expects
