@@ -32,10 +32,10 @@ from ros_gz_bridge_py.core.diagnosis import (
 from ros_gz_bridge_py.core.explain import (
     as_the_graph_shows,
     gazebo_name,
-    published_by_others,
     ros_endpoints,
     type_hints,
 )
+from ros_gz_bridge_py.core.similar_topics import Offered, offered_by_others
 from ros_gz_bridge_py.core.spec_checks import refused_name_fix
 from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION, ConfigError, TransportError
 from ros_gz_bridge_py.msgs.names import same_message
@@ -47,7 +47,7 @@ from ros_gz_bridge_py.ros.qos import (
 )
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, Publisher
-from ros_gz_bridge_py.transport.api import GraphEndpoint
+from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER, GraphEndpoint
 
 #: Seconds ``--check`` listens by default: discovery re-announces every second, the ROS graph
 #: settles within about two.
@@ -138,7 +138,7 @@ def _announce(
 def _reports(
     sides: Sides, specs: Sequence[BridgeSpec], probes: dict[int, Publisher | None]
 ) -> list[EntryReport]:
-    gz_topics = published_by_others(sides.gz_node)
+    gz_topics = offered_by_others(sides.gz_node.graph(), getattr(sides.gz_node, "partition", ""))
     reports: list[EntryReport] = []
     for index, spec in enumerate(specs):
         if isinstance(spec, ServiceBridgeSpec):
@@ -192,7 +192,7 @@ def _resolved_names(sides: Sides, spec: TopicBridgeSpec) -> tuple[str, str, str]
 
 
 def _topic_reports(
-    sides: Sides, spec: TopicBridgeSpec, probe: Publisher | None, gz_topics: Sequence[str]
+    sides: Sides, spec: TopicBridgeSpec, probe: Publisher | None, gz_topics: Offered
 ) -> list[EntryReport]:
     ros_node, gz_node, registry = sides.ros_node, sides.gz_node, sides.registry
     own = {(ros_node.get_name(), ros_node.get_namespace())}
@@ -223,6 +223,7 @@ def _topic_reports(
             waits.append(False)
             continue
         ros_side = ros_endpoints(ros_node, direction, ros_topic, as_the_graph_shows(qos), own)
+        role = PUBLISHER if direction is Direction.GZ_TO_ROS else SUBSCRIBER
         situation = Situation(
             direction=direction,
             ros_topic=ros_topic,
@@ -235,7 +236,8 @@ def _topic_reports(
             gz_peers=gz_node.peer_processes(),
             listening=gz_node.listening(),
             gz_subscriber_registered=probe is not None and bool(probe.wire_types()),
-            gz_topics=gz_topics,
+            gz_topics=gz_topics.topics(role),
+            gz_typed=gz_topics.of_type(role, spec.gz_type),
             discovered_by=spec.discovered_by,
             bidirectional=spec.direction is Direction.BIDIRECTIONAL,
             ros_namespace=ros_node.get_namespace(),

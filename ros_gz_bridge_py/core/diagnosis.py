@@ -10,24 +10,17 @@ functions: the bridge gathers the facts (``explain.py``) and decides what to log
 
 from __future__ import annotations
 
-import difflib
 import enum
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from ros_gz_bridge_py.config import Direction
+from ros_gz_bridge_py.core.similar_topics import SUGGESTIONS, SimilarTopics
 from ros_gz_bridge_py.msgs.names import GENERIC_TYPE, Spelling, respell, same_message, spelling_of
 from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER, GraphEndpoint
 
 #: A channel that passed a message this recently is flowing (at least; see :func:`flow`).
 FLOWING_WINDOW = 5.0
-#: How many similar Gazebo topic names a finding suggests.
-SUGGESTIONS = 3
-
-#: How alike two topics' last names must be (difflib's ratio) for one to be proposed for the
-#: other: names in one namespace share their prefix, which alone made /robot1/clock "close"
-#: to /robot1/odom.
-CLOSE_NAME = 0.6
 
 
 class Flow(enum.Enum):
@@ -109,8 +102,17 @@ class Situation:
     listening: str
     #: A Gazebo subscriber takes our messages (ROS->Gazebo; from NEW_CONNECTION or tokens).
     gz_subscriber_registered: bool = False
-    #: Topic names with publishers in our partition, for "did you mean".
+    #: Topics of other processes in our partition with endpoints of the role the channel
+    #: needs (publishers to read, subscribers to write to), for "did you mean".
     gz_topics: Sequence[str] = ()
+    #: Those of them whose endpoints of that role take the channel's Gazebo type.
+    gz_typed: Sequence[str] = ()
+    #: The Gazebo side had long enough to be there (the bridge listened a while, and the
+    #: partition's other topics have been up a while): a side still absent is a fault then,
+    #: not a simulator that starts after the bridge.
+    overdue: bool = False
+    #: No Gazebo process is heard now, but some were (for a while) since the bridge started.
+    peers_lost: bool = False
     #: The channel's input side is open (a lazy channel without readers closes it).
     input_open: bool = True
     #: Seconds since the channel last passed a message; None if it never did.
@@ -160,7 +162,7 @@ def findings(situation: Situation, hints: TypeHints) -> list[Finding]:
 # --- the Gazebo side -------------------------------------------------------------------------
 
 
-def _wanted_role(situation: Situation) -> str:
+def wanted_role(situation: Situation) -> str:
     """The Gazebo endpoints a channel needs: publishers to read, or subscribers to write to."""
     return PUBLISHER if situation.direction is Direction.GZ_TO_ROS else SUBSCRIBER
 
@@ -196,7 +198,7 @@ def _where(endpoint: GraphEndpoint) -> str:
 
 
 def _gazebo_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
-    role = _wanted_role(situation)
+    role = wanted_role(situation)
     mine = [
         e for e in situation.gz_endpoints if e.role == role and e.partition == situation.partition
     ]
@@ -304,10 +306,18 @@ def _no_peer_finding(situation: Situation) -> Finding:
         else "the same GZ_PARTITION (IGN_PARTITION on Fortress), GZ_IP/IGN_IP on a network both "
         "reach, and the same GZ_TRANSPORT_IMPLEMENTATION (zeromq or zenoh)"
     )
+    still = "still " if situation.overdue else ""
+    heard = (
+        "the Gazebo Transport processes heard before are gone (a simulator that stopped, or a "
+        "network that went away)"
+        if situation.peers_lost
+        else f"no Gazebo Transport process is {still}heard at all"
+    )
     return Finding(
-        "no-peer",
-        f"no Gazebo Transport process is heard at all; the bridge listens with "
-        f"{situation.listening}. Compare with the simulator's environment: {compare}",
+        "no-peer" + (":overdue" if situation.overdue else ""),
+        f"{heard}; the bridge listens with {situation.listening}. Compare with the "
+        f"simulator's environment: {compare}",
+        fault=situation.overdue,
     )
 
 
@@ -319,7 +329,16 @@ def _heard(processes: int) -> str:
 
 def _absent_finding(situation: Situation, role: str) -> Finding:
     similar = _similar_topics(situation.gz_topic, situation.gz_topics)
-    hint = f"; similar topics: {', '.join(similar)}" if similar else ""
+    typed = [t for t in situation.gz_typed if t != situation.gz_topic]
+    shown = ([t for t in similar if t in typed] + [t for t in typed if t not in similar])[
+        :SUGGESTIONS
+    ]
+    hint = ""
+    if shown:
+        more = f" and {len(typed) - len(shown)} more" if len(typed) > len(shown) else ""
+        hint = f"; Gazebo {role}s of {situation.gz_type} there: {', '.join(shown)}{more}"
+    similar = [t for t in similar if t not in shown]
+    hint += f"; similar topics: {', '.join(similar)}" if similar else ""
     namespace = situation.ros_namespace.rstrip("/")
     inside = f"{namespace}/{situation.gz_topic.lstrip('/')}"
     if namespace and inside in similar:
@@ -337,49 +356,21 @@ def _absent_finding(situation: Situation, role: str) -> Finding:
             f"; a Gazebo {other} of {situation.gz_topic} is there: to carry messages the other "
             f"way, bridge it {turned} ('{symbol}' on the command line)"
         )
+    overdue = (
+        ", though the partition's other topics have been there a while: the simulator has "
+        "none of this name"
+        if situation.overdue
+        else ""
+    )
     return Finding(
-        f"gz-absent:{role}",
+        f"gz-absent:{role}" + (":overdue" if situation.overdue else ""),
         f"no Gazebo {role} of {situation.gz_topic} in partition '{situation.partition}' "
-        f"({_heard(situation.gz_peers)}){hint}",
-        fault=False,
+        f"({_heard(situation.gz_peers)}){overdue}{hint}",
+        fault=situation.overdue,
     )
 
 
-class _SimilarTopics:
-    """Topics ending like a topic (a relative name in the wrong place), then close spellings;
-    found once per topic while the list of topics stays the same: the explainer asks again
-    every few seconds for every channel waiting for Gazebo, and difflib compares the name with
-    every topic (101 waiting channels took 5-10% of a core at rest)."""
-
-    def __init__(self) -> None:
-        self._topics: tuple[str, ...] = ()
-        self._found: dict[str, list[str]] = {}
-
-    def __call__(self, topic: str, topics: Sequence[str]) -> list[str]:
-        if not topics:  # the explainer's first look, before it fetches the list: keep the cache
-            return []
-        listed = tuple(topics)
-        if listed != self._topics:
-            self._topics, self._found = listed, {}
-        found = self._found.get(topic)
-        if found is None:
-            name = _last_name(topic)
-            others = [t for t in listed if t != topic]
-            ending = [t for t in others if t.endswith("/" + name)]
-            close = [
-                t
-                for t in difflib.get_close_matches(topic, others, SUGGESTIONS)
-                if difflib.SequenceMatcher(None, name, _last_name(t)).ratio() >= CLOSE_NAME
-            ]
-            found = self._found[topic] = list(dict.fromkeys(ending + close))[:SUGGESTIONS]
-        return list(found)
-
-
-def _last_name(topic: str) -> str:
-    return topic.strip("/").rsplit("/", 1)[-1]
-
-
-_similar_topics = _SimilarTopics()
+_similar_topics = SimilarTopics()
 
 
 # --- the ROS side ----------------------------------------------------------------------------

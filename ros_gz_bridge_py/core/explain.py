@@ -33,15 +33,18 @@ from ros_gz_bridge_py.core.channel import Channel, ChannelState
 from ros_gz_bridge_py.core.diagnosis import (
     ENTRY_QOS_SETTING,
     Finding,
+    Flow,
     RosEndpoint,
     Situation,
     TypeHints,
     findings,
     flow,
+    wanted_role,
 )
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
+from ros_gz_bridge_py.core.similar_topics import Offered, offered_by_others
 from ros_gz_bridge_py.transport import GzNode
-from ros_gz_bridge_py.transport.api import PUBLISHER, GraphEndpoint
+from ros_gz_bridge_py.transport.api import GraphEndpoint
 from ros_gz_bridge_py.transport.names import decompose, fully_qualified_name
 
 #: Seconds between two evaluations of every channel.
@@ -60,7 +63,11 @@ ASK_SUBSCRIBERS_EVERY = 10.0
 #: channel's every 2 s was 8 ms a pass for a fleet of 25 robots, most of the bridge's Python.
 ROS_ENDPOINTS_REFRESH = 10.0
 #: Causes that concern the whole bridge rather than one channel (logged once).
-BRIDGE_WIDE = frozenset({"no-peer"})
+BRIDGE_WIDE = frozenset({"no-peer", "no-peer:overdue"})
+#: Seconds after which a Gazebo side still absent is a fault (WARN), no longer a simulator
+#: that starts after the bridge: the bridge listened this long without hearing any Gazebo
+#: process, or the partition's other topics have been there this long (and the channel too).
+PATIENCE = 30.0
 
 
 def type_hints(
@@ -112,19 +119,6 @@ def ros_endpoints(
             RosEndpoint(node, info.topic_type, problem, describe_qos(info.qos_profile), fixes)
         )
     return found
-
-
-def published_by_others(gz_node: GzNode) -> list[str]:
-    """The topics other processes publish in the node's partition: those a "similar topics"
-    hint may name (``topic_list`` has the bridge's own too)."""
-    partition = gz_node.partition.strip("/")
-    return sorted(
-        {
-            endpoint.topic
-            for endpoint in gz_node.graph()
-            if endpoint.role == PUBLISHER and endpoint.partition.strip("/") == partition
-        }
-    )
 
 
 def qos_errors(reason: str) -> str:
@@ -206,6 +200,8 @@ class _Seen:
     endpoints: list[RosEndpoint] = field(default_factory=list)
     endpoints_key: tuple[frozenset[tuple[str, str]], int] | None = None
     endpoints_at: float = 0.0
+    #: A cause of its own was logged since it last flowed.
+    waited: bool = False
 
 
 class Explainer:
@@ -237,6 +233,14 @@ class Explainer:
         self._seen: dict[int, _Seen] = {}
         self._bridge_announced: set[str] = set()
         self._bridge_logged: dict[str, float] = {}
+        self._partition = getattr(gz_node, "partition", "").strip("/")
+        #: Since when other processes have endpoints in the bridge's partition (None: not now).
+        self._alive_since: float | None = None
+        #: Since when Gazebo processes are heard (None: none now), and whether they were
+        #: heard in two looks at least once (a passing `gz topic -l` is not).
+        self._peers_since: float | None = None
+        self._peers_heard = False
+        self._no_peer_said = False
         self._asked = float("-inf")
 
     def evaluate(self, channels: Sequence[Channel]) -> None:
@@ -251,20 +255,33 @@ class Explainer:
         }
         peers = self._gz.peer_processes()
         listening = self._gz.listening()
-        topics: list[str] | None = None
+        offered: Offered | None = None
         # One snapshot of the Gazebo graph for every channel (observe per channel would scan
         # it once per channel: with 1,000 discovered topics, most of a core).
+        everything = self._gz.graph()
         graph: dict[str, list[GraphEndpoint]] = {}
-        for endpoint in self._gz.graph():
+        for endpoint in everything:
             graph.setdefault(endpoint.topic, []).append(endpoint)
+        self._follow_peers(everything, peers, now)
         nodes = self._ros_others(channels[0].ctx.ros_node)
-        judged: list[tuple[Channel, _Seen, list[Finding]]] = []
+        carried: dict[int, list[Channel]] = {}  # spec -> its channels that passed a message
+        for channel in channels:
+            if channel.stats.received:
+                carried.setdefault(id(channel.spec), []).append(channel)
+        judged: list[tuple[Channel, _Seen, list[Finding], bool]] = []
         for channel in channels:
             seen = self._seen.get(id(channel)) or self._remember(channel, now)
             self._count(seen, channel, now)
+            # A '@' entry's half that waits while the other one has carried: a side not
+            # there (a Gazebo topic nobody subscribes to) is the usual case, never a fault.
+            quiet = any(other is not channel for other in carried.get(id(channel.spec), ()))
             situation = self._situation(
                 channel, seen, now, (peers, listening), graph, ros_nodes=nodes
             )
+            if not quiet and self._overdue(seen, peers, now):
+                situation = dataclasses.replace(situation, overdue=True)
+            if not peers and self._peers_heard:
+                situation = dataclasses.replace(situation, peers_lost=True)
             if (
                 situation.direction is Direction.ROS_TO_GZ
                 and not situation.gz_subscriber_registered
@@ -272,24 +289,49 @@ class Explainer:
                 self._ask_subscribers(now)
             found = findings(situation, self._hints)
             if any(f.key.startswith("gz-absent") for f in found):
-                topics = published_by_others(self._gz) if topics is None else topics
-                situation = dataclasses.replace(situation, gz_topics=topics)
+                offered = offered or offered_by_others(everything, self._partition)
+                role = wanted_role(situation)
+                situation = dataclasses.replace(
+                    situation,
+                    gz_topics=offered.topics(role),
+                    gz_typed=offered.of_type(role, situation.gz_type),
+                )
                 found = findings(situation, self._hints)
             channel.flow = flow(situation)
             channel.findings = found
-            judged.append((channel, seen, found))
-        carried: dict[int, list[Channel]] = {}  # spec -> its channels that passed a message
-        for channel in channels:
-            if channel.stats.received:
-                carried.setdefault(id(channel.spec), []).append(channel)
-        for channel, seen, found in judged:
+            judged.append((channel, seen, found, quiet))
+        for channel, seen, found, quiet in judged:
             if now - seen.started >= WARM_UP:
-                said = found
-                if any(other is not channel for other in carried.get(id(channel.spec), ())):
-                    # A '@' entry's half that waits while the other one has carried: a side
-                    # not there (a Gazebo topic nobody subscribes to) is the usual case then.
-                    said = [finding for finding in found if finding.fault]
+                said = [finding for finding in found if finding.fault] if quiet else found
                 self._report(channel, seen, said, now)
+
+    def _follow_peers(self, graph: Sequence[GraphEndpoint], peers: int, now: float) -> None:
+        """Note since when the bridge's partition has other processes' endpoints, and say
+        once that Gazebo is heard after "nothing can flow" was said."""
+        if any(endpoint.partition.strip("/") == self._partition for endpoint in graph):
+            self._alive_since = now if self._alive_since is None else self._alive_since
+        else:
+            self._alive_since = None
+        if not peers:
+            self._peers_since = None
+            return
+        self._peers_since = now if self._peers_since is None else self._peers_since
+        if now - self._peers_since < CONFIRM_AFTER:
+            return
+        self._peers_heard = True
+        if self._no_peer_said:
+            self._no_peer_said = False
+            self._bridge_logged.clear()  # losing them again is said at once
+            heard = "1 process" if peers == 1 else f"{peers} processes"
+            self._note(f"Gazebo Transport heard now ({heard} in any partition)")
+
+    def _overdue(self, seen: _Seen, peers: int, now: float) -> bool:
+        """Whether the channel's Gazebo side had :data:`PATIENCE` to be there."""
+        if now - seen.started < PATIENCE:
+            return False
+        if not peers:
+            return now - self._started >= PATIENCE
+        return self._alive_since is not None and now - self._alive_since >= PATIENCE
 
     def _ros_others(self, ros_node: Any) -> frozenset[tuple[str, str]] | None:
         """The ROS graph's nodes, or None when it shows none that is not the bridge's: then no
@@ -377,6 +419,9 @@ class Explainer:
 
     def _report(self, channel: Channel, seen: _Seen, found: list[Finding], now: float) -> None:
         keys = {finding.key for finding in found}
+        if seen.waited and not keys and channel.flow is Flow.FLOWING:
+            seen.waited = False  # what was said of it no longer holds: say so
+            self._note(f"{channel.describe()}: flowing")
         seen.present = {key: seen.present.get(key, now) for key in keys}
         seen.announced &= keys
         for finding in found:
@@ -389,13 +434,16 @@ class Explainer:
                         continue  # it came and went lately (a `gz topic -l` heard): said already
                     self._bridge_logged[key] = now
                     self._bridge_announced.add(key)
-                    self._log(f"Nothing can flow: {finding.text}")
+                    self._no_peer_said = True
+                    say = self._log if finding.fault else self._note
+                    say(f"Nothing can flow: {finding.text}")
                 seen.announced.add(key)
                 continue
             if now - seen.logged.get(key, float("-inf")) < RELOG_AFTER:
                 continue  # it came and went lately: said already
             seen.logged[key] = now
             seen.announced.add(key)
+            seen.waited = True
             state = channel.flow.value if channel.flow is not None else "starting"
             say = self._log if finding.fault else self._note
             say(f"{channel.describe()}: {state}: {finding.text}")

@@ -85,8 +85,8 @@ def test_similar_topics_are_other_processes_never_the_checks_own(
     sides: Sides, network: MemoryNetwork
 ) -> None:
     other = MemoryGzNode(network=network)
-    for name in ("/model/r2/odometry", "/model/r2/cmd_vel"):
-        other.advertise(name, STRING)
+    other.advertise("/model/r2/odometry", STRING)
+    other.subscribe("/model/r2/cmd_vel", lambda *_: None, STRING)
     _, out = check(
         sides,
         [
@@ -94,10 +94,12 @@ def test_similar_topics_are_other_processes_never_the_checks_own(
             topic("/model/r1/cmd_vel", "/model/r1/cmd_vel", Direction.ROS_TO_GZ),
         ],
     )
-    hints = [line for line in out.splitlines() if "similar topics" in line]
+    hints = [line for line in out.splitlines() if " there: " in line]
     assert len(hints) == 2, out
-    assert hints[0].endswith("similar topics: /model/r2/odometry"), out
-    assert hints[1].endswith("similar topics: /model/r2/cmd_vel"), out
+    # A Gazebo->ROS entry is shown publishers, a ROS->Gazebo one subscribers (it was shown
+    # publishers, which a ROS->Gazebo entry cannot use), of its type first.
+    assert hints[0].endswith("Gazebo publishers of gz.msgs.StringMsg there: /model/r2/odometry")
+    assert hints[1].endswith("Gazebo subscribers of gz.msgs.StringMsg there: /model/r2/cmd_vel")
 
 
 def test_sigint_ends_the_check_at_once_without_a_report(sides: Sides) -> None:

@@ -177,7 +177,10 @@ def test_no_peer_is_no_fault_before_discovery_listened_long_enough() -> None:
     assert "(0 Gazebo processes heard in any partition)" in finding.text
     assert flow(early) is Flow.WAITING_GAZEBO
     (settled,) = findings(dataclasses.replace(early, peers_settled=True), HINTS)
-    assert (settled.key, settled.fault) == ("no-peer", True)
+    assert (settled.key, settled.fault) == ("no-peer", False)  # a simulator not up yet
+    (overdue,) = findings(dataclasses.replace(early, peers_settled=True, overdue=True), HINTS)
+    assert (overdue.key, overdue.fault) == ("no-peer:overdue", True)
+    assert overdue.text.startswith("no Gazebo Transport process is still heard at all; ")
 
 
 def test_ros_to_gazebo_waits_for_a_registered_subscriber() -> None:
@@ -370,3 +373,44 @@ def test_a_name_outside_the_bridges_namespace_is_told_how_to_put_it_inside() -> 
     for elsewhere in ("/", "/robot3"):  # no such topic inside the namespace: no such hint
         other = dataclasses.replace(waiting, ros_namespace=elsewhere)
         assert "namespace" not in findings(other, HINTS)[0].text
+
+
+def test_an_absent_topic_is_shown_the_topics_of_its_type_and_long_names_alike() -> None:
+    """A simulator's own names (found by a new user: /model/turtlebot3_waffle/odometry for
+    /odom, .../joint_state for /joint_states) were not proposed: compared whole, long names
+    never looked close, and the type was not looked at."""
+    odom = situation(
+        Direction.GZ_TO_ROS,
+        gz_topics=["/model/waffle/odometry", "/clock", "/world/default/model/waffle/joint_state"],
+        gz_typed=["/model/waffle/odometry"],
+    )
+    (found,) = findings(odom, HINTS)
+    assert found.text.endswith(
+        "Gazebo publishers of gz.msgs.Odometry there: /model/waffle/odometry"
+    )
+    assert not found.fault
+    joints = dataclasses.replace(odom, gz_topic="/joint_states", gz_typed=[])
+    assert findings(joints, HINTS)[0].text.endswith(
+        "similar topics: /world/default/model/waffle/joint_state"
+    )
+    fleet = [f"/robot{n}/odom" for n in range(1, 50)]
+    many = dataclasses.replace(odom, gz_topic="/robot50/odom", gz_topics=fleet, gz_typed=fleet)
+    assert "there: /robot1/odom, /robot2/odom, /robot3/odom and 46 more" in (
+        findings(many, HINTS)[0].text
+    )
+
+
+def test_a_side_absent_while_the_partition_is_up_a_while_is_a_fault() -> None:
+    absent = situation(Direction.GZ_TO_ROS, overdue=True)
+    (found,) = findings(absent, HINTS)
+    assert (found.key, found.fault) == ("gz-absent:publisher:overdue", True)
+    assert found.text == (
+        f"no Gazebo publisher of /odom in partition '{PART}' (1 Gazebo process heard in any "
+        "partition), though the partition's other topics have been there a while: the "
+        "simulator has none of this name"
+    )
+    gone = situation(Direction.GZ_TO_ROS, gz_peers=0, peers_lost=True)
+    assert findings(gone, HINTS)[0].text.startswith(
+        "the Gazebo Transport processes heard before are gone (a simulator that stopped, or a "
+        "network that went away); the bridge listens with ZeroMQ somewhere."
+    )
