@@ -25,6 +25,7 @@ explained, not warned about).
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import dataclasses
 import signal
@@ -310,10 +311,16 @@ def format_table(statuses: list[ChannelStatus]) -> str:
     ]
     if not statuses:
         lines.append("(no bridges)")
+    # A cause of the whole bridge ("no Gazebo process heard") is one line, not one per channel.
+    shared = collections.Counter(why for status in statuses for why in status.why.splitlines())
+    said: set[str] = set()
     for status in statuses:
-        lines += [
-            f"why {status.direction} {status.ros_name}: {why}" for why in status.why.splitlines()
-        ]
+        for why in status.why.splitlines():
+            if shared[why] == 1:
+                lines.append(f"why {status.direction} {status.ros_name}: {why}")
+            elif why not in said:
+                said.add(why)
+                lines.append(f"why {shared[why]} channels: {why}")
         if status.errors_by_reason:
             last = f"; last: {status.last_error}" if status.last_error else ""
             lines.append(

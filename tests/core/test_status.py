@@ -7,6 +7,7 @@ the test sent, once the channel has handled every message (``settled``).
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import os
 import signal
@@ -335,3 +336,15 @@ def test_the_table_lists_every_channel_and_sigusr1_prints_it(rig: Rig) -> None:
     printed = out.getvalue().splitlines()
     assert printed[0].split()[:3] == ["LEVEL", "DIRECTION", "ROS"]
     assert printed[1].split()[:7] == ["OK", "GZ->ROS", topic, topic, "active", "3", "3"]
+
+
+def test_a_cause_of_several_channels_is_one_line_of_the_table() -> None:
+    """ "No Gazebo process heard" was printed once per channel (eight ~300-character lines)."""
+    quiet = ChannelStatus(
+        "GZ->ROS", "/a", "/a", "std_msgs/msg/String", STRING, "active", 0, 0, 0, 0, 0.0, 0,
+        why="no Gazebo process",
+    )  # fmt: skip
+    statuses = [quiet, dataclasses.replace(quiet, ros_name="/b"),
+                dataclasses.replace(quiet, ros_name="/c", why="its own")]  # fmt: skip
+    whys = [line for line in format_table(statuses).splitlines() if line.startswith("why")]
+    assert whys == ["why 2 channels: no Gazebo process", "why GZ->ROS /c: its own"]
