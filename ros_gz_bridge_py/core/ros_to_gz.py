@@ -166,9 +166,11 @@ class RosToGzChannel(Channel):
         self, received: int, own_skipped: int, rate_limited: int, published: int, send_failures: int
     ) -> None:
         """What the native loop did since it last said (on its thread); a message whose send
-        failed counts among the node's ``send_failures``, as on the Python path."""
+        failed counts among the node's ``send_failures``, as on the Python path. The loop's
+        ``received`` holds the bridge's own publications it skipped, which the Python path
+        does not count as received (the table showed IN above OUT by them, unexplained)."""
         stats = self.stats
-        stats.received += received
+        stats.received += received - own_skipped
         stats.own_skipped += own_skipped
         stats.rate_limited += rate_limited
         stats.published += published

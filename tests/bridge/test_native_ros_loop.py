@@ -236,3 +236,20 @@ def test_an_embedder_closes_its_gz_node_while_ros_messages_flow(
     # Taken off before its socket went, not by the failure of a send on a closed socket:
     assert [channel.stats.last_error for channel in bridge.channels] == [""]
     bridge.close()  # after the node: closes the channels without sending
+
+
+def test_own_publications_skipped_by_the_native_loop_are_not_received(
+    bridge: Bridge, started: list[PeerProcess]
+) -> None:
+    """The native loop counted a bidirectional topic's own publications, which it skips, as
+    received: IN ran ahead of OUT by them in the status table (the Python path does not)."""
+    topic = unique_name("native_own")
+    handle = bridge.add(TopicBridgeSpec(topic, topic, "std_msgs/msg/String", STRING))
+    to_ros, to_gz = handle.channels
+    assert to_gz.native, "the ROS->Gazebo half takes the native loop"
+    publisher = start_peer("pub", topic, STRING, "50", "0", 'data: "from gazebo"', "--wait", "60")
+    started.append(publisher)
+    wait_for_line(publisher, r"^READY$")
+    wait_until(lambda: to_gz.stats.own_skipped >= 10, WAIT * 2, "own publications skipped")
+    wait_until(lambda: to_ros.stats.published >= 10, WAIT, "Gazebo's messages published")
+    assert (to_gz.stats.received, to_gz.stats.published) == (0, 0)
