@@ -165,6 +165,9 @@ class ChannelContext:
     own_publications: Callable[[str], OwnPublications] = field(
         default_factory=_own_publications_table
     )
+    #: (ROS type, Gazebo type) of the ROS->Gazebo channels whose "Passing message" line was
+    #: logged: once per pair of types, as the C++ bridge logs it.
+    passing_shown: set[tuple[str, str]] = field(default_factory=set)
 
     def resolve(self, ros_topic: str) -> str:
         return str(self.ros_node.resolve_topic_name(ros_topic))

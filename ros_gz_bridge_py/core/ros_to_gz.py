@@ -258,6 +258,10 @@ class RosToGzChannel(Channel):
 
     def _announce(self) -> None:
         self._announced = True
+        pair = (self.spec.ros_type, self.spec.gz_type)
+        if pair in self.ctx.passing_shown:
+            return
+        self.ctx.passing_shown.add(pair)
         self._logger.info(
             f"Passing message from ROS {self.spec.ros_type} to Gazebo {self.spec.gz_type} "
             "(showing msg only once per type)"

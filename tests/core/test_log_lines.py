@@ -10,13 +10,25 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
+from typing import Any
 
 import pytest
+from std_msgs.msg import String
 
 from ros_gz_bridge_py.config import Direction, ServiceBridgeSpec, TopicBridgeSpec
 from ros_gz_bridge_py.core.bridge import BridgeHandle
 from ros_gz_bridge_py.errors import ConfigError
-from tests.core.harness import Rig, gz_to_ros, options, ros_to_gz, unique
+from ros_gz_bridge_py.msgs import message_class
+from tests.core.harness import (
+    Inbox,
+    Rig,
+    RosWorld,
+    gz_to_ros,
+    options,
+    publish_until,
+    ros_to_gz,
+    unique,
+)
 
 pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
 
@@ -150,3 +162,27 @@ def test_an_entry_a_side_refuses_is_not_logged_as_created(
     with pytest.raises(ConfigError, match="invalid Gazebo Transport topic"):
         rig.add(TopicBridgeSpec(unique("ros_ok"), "/my topic", STRING, "gz.msgs.StringMsg"))
     assert logged(rig, capfd) == []
+
+
+def test_passing_a_message_to_gazebo_is_logged_once_per_pair_of_types(
+    rig: Rig, world: RosWorld, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Each channel logged it ("showing msg only once per type" twice, for two topics)."""
+    for topic in (unique("log_pass_a"), unique("log_pass_b")):
+        add(rig, topic, "gz.msgs.StringMsg", Direction.ROS_TO_GZ)
+        inbox = Inbox()
+        rig.gazebo().subscribe_typed(topic, message_class("gz.msgs.StringMsg"), inbox)
+        publisher = world.publisher(String, topic)
+
+        def publish(i: int, publisher: Any = publisher) -> None:
+            publisher.publish(String(data=str(i)))
+
+        def arrived(inbox: Inbox = inbox) -> bool:
+            return bool(inbox.messages())
+
+        publish_until(publish, arrived, "a message in Gazebo")
+    passing = [line for line in logged(rig, capfd) if line.startswith("Passing message")]
+    assert passing == [
+        f"Passing message from ROS {STRING} to Gazebo gz.msgs.StringMsg (showing msg only once "
+        "per type)"
+    ]
