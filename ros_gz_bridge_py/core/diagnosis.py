@@ -230,6 +230,10 @@ def _type_finding(situation: Situation, hints: TypeHints, endpoint: GraphEndpoin
     ros_types = hints.ros_types_for(seen)
     if hints.pairs(situation.ros_type, seen):
         fix = _retyped(hints, f"set the Gazebo type (gz_type_name) to {written}")
+    elif len(ros_types) == 1:
+        fix = _retyped(
+            hints, f"set the Gazebo type to {written} and the ROS type to {ros_types[0]}"
+        )
     elif ros_types:
         fix = _retyped(
             hints,

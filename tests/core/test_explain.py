@@ -281,8 +281,7 @@ def test_ros_to_gazebo_waits_for_gazebo_then_ros_then_flows(rig: Rig, world: Ros
     assert text.startswith(f"the Gazebo subscriber of {topic} (process ")
     assert text.endswith(
         "subscribes gz.msgs.Int32, but the bridge is configured with gz.msgs.StringMsg; "
-        "gz.msgs.Int32 pairs with std_msgs/msg/Int32: set the Gazebo type to gz.msgs.Int32 "
-        "and the ROS type to one of those"
+        "set the Gazebo type to gz.msgs.Int32 and the ROS type to std_msgs/msg/Int32"
     )
     wrong.close()
 

@@ -85,8 +85,7 @@ def test_image_bridge_sends_a_topic_of_other_types_to_parameter_bridge() -> None
     gz_side, ros_side = findings(camera, hints)  # the Gazebo side first, as flow() waits
     assert gz_side.text.endswith(
         "; image_bridge cannot take other types: bridge the topic with parameter_bridge "
-        "(gz.msgs.StringMsg pairs with std_msgs/msg/String: set the Gazebo type to "
-        "gz.msgs.StringMsg and the ROS type to one of those)"
+        "(set the Gazebo type to gz.msgs.StringMsg and the ROS type to std_msgs/msg/String)"
     )
     assert ros_side.text.endswith(
         "; image_bridge cannot take other types: bridge the topic with parameter_bridge "
