@@ -339,7 +339,8 @@ def test_the_table_lists_every_channel_and_sigusr1_prints_it(rig: Rig) -> None:
 
 
 def test_a_cause_of_several_channels_is_one_line_of_the_table() -> None:
-    """ "No Gazebo process heard" was printed once per channel (eight ~300-character lines)."""
+    """The "no Gazebo process heard" cause was printed once per channel (eight ~300-character
+    lines)."""
     quiet = ChannelStatus(
         "GZ->ROS", "/a", "/a", "std_msgs/msg/String", STRING, "active", 0, 0, 0, 0, 0.0, 0,
         why="no Gazebo process",
