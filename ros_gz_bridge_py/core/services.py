@@ -293,8 +293,8 @@ class ServiceBridge:
         providers = self._gz_node.service_info(service)
         if not providers:
             why = (
-                f"no Gazebo provider of {service} is known (gz service -l lists the services "
-                "there are)"
+                f"no Gazebo provider of {service} is known (gz service -l, ign service -l on "
+                "Fortress, lists the services there are)"
             )
             return why, False
         offered = {(p.request_type, p.response_type) for p in providers}

@@ -8,6 +8,9 @@ request values are checked where Gazebo sees them.
 
 from __future__ import annotations
 
+import os
+import signal
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -350,3 +353,29 @@ def test_a_first_call_made_the_moment_the_service_is_discoverable_is_answered(
     requests = [line for line in peer.output().splitlines() if line.startswith("REQUEST")]
     assert len(requests) == 1  # sent to Gazebo once: no retry
     assert "multi_step: 7" in requests[0]
+
+
+def test_a_call_to_a_provider_unreachable_for_two_seconds_is_served_when_it_is_back(
+    ros_side: RosSide, started: list[PeerProcess]
+) -> None:
+    """The request to a provider the bridge could not connect to yet was given up after 1 s
+    and the call failed at its timeout, 8 s later, the provider back long before (found by a
+    new user: a simulator busy for a moment)."""
+    service = unique_name("svc_frozen")
+    bridge = start_bridge(
+        f"{service}@ros_gz_interfaces/srv/ControlWorld@{WORLD_CONTROL}@{BOOLEAN}",
+        ros_args=["-p", "service_timeout:=8"],
+        creating=1,
+    )
+    started.append(bridge)
+    peer = start_replier(started, service, WORLD_CONTROL)
+    time.sleep(1.0)  # the bridge hears its ADVERTISE; no call has connected to it yet
+    os.kill(peer.pid, signal.SIGSTOP)
+    resume = threading.Timer(2.0, os.kill, (peer.pid, signal.SIGCONT))
+    resume.start()
+    try:
+        response = call(ros_side, ControlWorld, service, control_request())
+    finally:
+        resume.join()
+    assert response.success is True, bridge.output()
+    wait_for_line(peer, r"^REQUEST ")

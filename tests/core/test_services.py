@@ -142,7 +142,7 @@ def test_no_provider_gives_success_false_after_the_timeout(rig: Rig, world: RosW
     assert status.errors_by_reason == (("no reply", 1),)
     assert status.last_error == (
         f"no reply within {SERVICE_TIMEOUT:g} s: no Gazebo provider of {service} is known "
-        "(gz service -l lists the services there are)"
+        "(gz service -l, ign service -l on Fortress, lists the services there are)"
     )
 
 
@@ -153,8 +153,8 @@ def test_a_provider_of_other_types_is_named_when_nothing_answers(rig: Rig, world
     (waiting,) = StatusTracker(rig.bridge).snapshot()
     assert (waiting.level_name, waiting.flow) == ("OK", "waiting for Gazebo")
     assert waiting.message() == (
-        f"waiting for Gazebo: no Gazebo provider of {service} is known (gz service -l lists the "
-        "services there are)"
+        f"waiting for Gazebo: no Gazebo provider of {service} is known (gz service -l, ign "
+        "service -l on Fortress, lists the services there are)"
     )
     provider = Provider(GzPose, GzBoolean(data=True))
     rig.gazebo().advertise_service(service, "gz.msgs.Pose", "gz.msgs.Boolean", provider)

@@ -40,8 +40,10 @@ from ros_gz_bridge_py.transport.zmq.wire import (
 
 _LOG = logging.getLogger("ros_gz_bridge_py.transport")
 
-#: How long a ROUTER send to a peer that is not routable yet is retried (§2.9.3: gz sleeps
-#: 100 ms after connecting; we retry instead of sleeping).
+#: How long a response to a peer that is not routable yet is retried (§2.9.3: gz sleeps
+#: 100 ms after connecting; we retry instead of sleeping). A request is retried until its
+#: call's deadline: given up after this, a provider busy for a moment (a simulator loading)
+#: never got it, and the call failed at its timeout with the provider back long before.
 ROUTE_RETRY = 1.0
 
 
@@ -188,7 +190,7 @@ class ServiceRouter:
                 RoutedSend(
                     requester,
                     encode_request(srv.socket_id, request),
-                    min(call.deadline, time.monotonic() + ROUTE_RETRY),
+                    call.deadline,  # a provider busy for a moment takes it later
                     (lambda: self._finish(call, True, b"")) if one_way else None,
                 )
             )
