@@ -260,6 +260,13 @@ def _parse_topic(entry: _Entry) -> TopicBridgeSpec | TopicPattern:
     if not (topic_name or ros_topic or gz_topic):
         msg = "one of topic_name, ros_topic_name or gz_topic_name must be set"
         raise _entry_error(msg, entry.location)
+    if "/srv/" in ros_type:  # else discovery was asked for a topic of that name, silently
+        name = topic_name or ros_topic or gz_topic
+        msg = (
+            f"{ros_type} is a service type; bridge the service with service_name: {name} "
+            "(instead of the topic keys)"
+        )
+        raise _entry_error(msg, entry.at_value("ros_type_name"))
     completed_by_discovery = not (ros_type and gz_type) or has_wildcard(topic_name or gz_topic)
     if completed_by_discovery:
         gz_topic = topic_name or gz_topic or ros_topic

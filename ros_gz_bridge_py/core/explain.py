@@ -236,10 +236,12 @@ class Explainer:
         self._partition = getattr(gz_node, "partition", "").strip("/")
         #: Since when other processes have endpoints in the bridge's partition (None: not now).
         self._alive_since: float | None = None
-        #: Since when Gazebo processes are heard (None: none now), and whether they were
-        #: heard in two looks at least once (a passing `gz topic -l` is not).
+        #: Since when Gazebo processes are heard (None: none now).
         self._peers_since: float | None = None
-        self._peers_heard = False
+        #: The partition had other processes' endpoints in two looks at least once: a
+        #: simulator, which "gone" may speak of (not processes of other partitions, nor a
+        #: passing `gz topic -l`).
+        self._simulator_heard = False
         self._no_peer_said = False
         self._asked = float("-inf")
 
@@ -280,7 +282,7 @@ class Explainer:
             )
             if not quiet and self._overdue(seen, peers, now):
                 situation = dataclasses.replace(situation, overdue=True)
-            if not peers and self._peers_heard:
+            if not peers and self._simulator_heard:
                 situation = dataclasses.replace(situation, peers_lost=True)
             if (
                 situation.direction is Direction.ROS_TO_GZ
@@ -310,6 +312,7 @@ class Explainer:
         once that Gazebo is heard after "nothing can flow" was said."""
         if any(endpoint.partition.strip("/") == self._partition for endpoint in graph):
             self._alive_since = now if self._alive_since is None else self._alive_since
+            self._simulator_heard |= now - self._alive_since >= CONFIRM_AFTER
         else:
             self._alive_since = None
         if not peers:
@@ -318,7 +321,6 @@ class Explainer:
         self._peers_since = now if self._peers_since is None else self._peers_since
         if now - self._peers_since < CONFIRM_AFTER:
             return
-        self._peers_heard = True
         if self._no_peer_said:
             self._no_peer_said = False
             self._bridge_logged.clear()  # losing them again is said at once

@@ -336,6 +336,17 @@ def test_invalid_services(extra: str, message: str) -> None:
     assert _only_error(parse_yaml(text)) == message
 
 
+@pytest.mark.parametrize("gz_type", ["", "  gz_type_name: gz.msgs.WorldControl\n"])
+def test_a_service_type_in_a_topic_entry_is_told_to_use_service_name(gz_type: str) -> None:
+    """Without a Gazebo type it was left to discovery as a topic, silently (found by a new
+    user); with one, the error spoke of a missing converter."""
+    text = "- topic_name: /world/control\n  ros_type_name: ros_gz_interfaces/srv/ControlWorld\n"
+    assert _only_error(parse_yaml(text + gz_type)) == (
+        "Could not parse entry: ros_gz_interfaces/srv/ControlWorld is a service type; bridge "
+        "the service with service_name: /world/control (instead of the topic keys)"
+    )
+
+
 def test_service_needs_a_ros_type() -> None:
     message = _only_error(parse_yaml("- service_name: /remove\n"))
     assert message == "Could not parse entry: ros_type_name must be set for a service"
