@@ -238,9 +238,8 @@ class Explainer:
         self._alive_since: float | None = None
         #: Since when Gazebo processes are heard (None: none now).
         self._peers_since: float | None = None
-        #: The partition had other processes' endpoints in two looks at least once: a
-        #: simulator, which "gone" may speak of (not processes of other partitions, nor a
-        #: passing `gz topic -l`).
+        #: The partition had other processes' endpoints in two looks once: a simulator, which
+        #: "gone" may speak of (not other partitions' processes, nor a passing `gz topic -l`).
         self._simulator_heard = False
         self._no_peer_said = False
         self._asked = float("-inf")
