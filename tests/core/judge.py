@@ -15,9 +15,7 @@ from ros_gz_bridge_py.core.explain import (
 )
 from ros_gz_bridge_py.msgs import message_class
 from ros_gz_bridge_py.ros.side_node import side_node_name
-from tests.core.harness import (
-    Rig,
-)
+from tests.core.harness import Inbox, Rig, publish_until, settled
 
 STRING = "gz.msgs.StringMsg"
 GzString = message_class(STRING)
@@ -76,3 +74,14 @@ def texts(channel: Channel) -> list[str]:
 def flow_of(channel: Channel) -> Flow | None:
     """The channel's flow as the last evaluation set it."""
     return channel.flow
+
+
+def carry(channel: Channel, publisher: Any, inbox: Inbox) -> None:
+    """Publish Gazebo strings on ``publisher`` until ``inbox`` (a ROS subscriber of the
+    channel's topic) has one, and wait until the channel handled each."""
+    sent = publish_until(
+        lambda i: publisher.publish(GzString(data=str(i))),
+        lambda: bool(inbox.messages()),
+        "a message in ROS",
+    )
+    settled(channel, sent)

@@ -35,7 +35,7 @@ from tests.core.harness import (
     unique,
     wait_until,
 )
-from tests.core.judge import STRING, GzString, Judge, flow_of, spec, string_spec, texts
+from tests.core.judge import STRING, GzString, Judge, carry, flow_of, spec, string_spec, texts
 
 pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
 
@@ -106,12 +106,7 @@ def test_flowing_then_stalled(rig: Rig, world: RosWorld) -> None:
     assert (flow_of(channel), channel.findings) == (Flow.STALLED, [])  # a publisher, no message yet
 
     inbox, _ = world.subscribe(String, topic)
-    sent = publish_until(
-        lambda i: publisher.publish(GzString(data=str(i))),
-        lambda: bool(inbox.messages()),
-        "a message in ROS",
-    )
-    settled(channel, sent)
+    carry(channel, publisher, inbox)
     judge.evaluate(1.0)
     assert (flow_of(channel), channel.findings) == (Flow.FLOWING, [])
     judge.evaluate(4.0)
@@ -228,12 +223,7 @@ def test_a_topic_still_absent_while_the_simulator_is_up_is_a_warning_until_it_fl
     assert StatusTracker(rig.bridge).snapshot()[0].level == WARN
 
     publisher = simulator.advertise(topic, STRING)
-    sent = publish_until(
-        lambda i: publisher.publish(GzString(data=str(i))),
-        lambda: bool(inbox.messages()),
-        "a message in ROS",
-    )
-    settled(channel, sent)
+    carry(channel, publisher, inbox)
     judge.evaluate(1.0)
     assert judge.noted[-1] == f"{channel.describe()}: flowing"
     judge.evaluate(1.0)
@@ -251,12 +241,7 @@ def test_the_waiting_half_of_a_bidirectional_entry_that_carries_is_no_warning(
     carrying, waiting = gz_to_ros(handle), ros_to_gz(handle)
     publisher = rig.gazebo().advertise(topic, STRING)
     inbox, _ = world.subscribe(String, topic)
-    sent = publish_until(
-        lambda i: publisher.publish(GzString(data=str(i))),
-        lambda: bool(inbox.messages()),
-        "a message in ROS",
-    )
-    settled(carrying, sent)
+    carry(carrying, publisher, inbox)
     judge = Judge(rig)
     judge.evaluate()
     # Messages passed before the first look: flowing at once, not "stalled" in a first status.
