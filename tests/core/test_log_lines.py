@@ -19,16 +19,8 @@ from ros_gz_bridge_py.config import Direction, ServiceBridgeSpec, TopicBridgeSpe
 from ros_gz_bridge_py.core.bridge import BridgeHandle
 from ros_gz_bridge_py.errors import ConfigError
 from ros_gz_bridge_py.msgs import message_class
-from tests.core.harness import (
-    Inbox,
-    Rig,
-    RosWorld,
-    gz_to_ros,
-    options,
-    publish_until,
-    ros_to_gz,
-    unique,
-)
+from tests.core import harness
+from tests.core.harness import Rig, gz_to_ros, options, ros_to_gz, unique
 
 pytestmark = [pytest.mark.ros]  # rclpy participants, in this process
 
@@ -165,22 +157,22 @@ def test_an_entry_a_side_refuses_is_not_logged_as_created(
 
 
 def test_passing_a_message_to_gazebo_is_logged_once_per_pair_of_types(
-    rig: Rig, world: RosWorld, capfd: pytest.CaptureFixture[str]
+    rig: Rig, world: harness.RosWorld, capfd: pytest.CaptureFixture[str]
 ) -> None:
     """Each channel logged it ("showing msg only once per type" twice, for two topics)."""
     for topic in (unique("log_pass_a"), unique("log_pass_b")):
         add(rig, topic, "gz.msgs.StringMsg", Direction.ROS_TO_GZ)
-        inbox = Inbox()
+        inbox = harness.Inbox()
         rig.gazebo().subscribe_typed(topic, message_class("gz.msgs.StringMsg"), inbox)
         publisher = world.publisher(String, topic)
 
         def publish(i: int, publisher: Any = publisher) -> None:
             publisher.publish(String(data=str(i)))
 
-        def arrived(inbox: Inbox = inbox) -> bool:
+        def arrived(inbox: harness.Inbox = inbox) -> bool:
             return bool(inbox.messages())
 
-        publish_until(publish, arrived, "a message in Gazebo")
+        harness.publish_until(publish, arrived, "a message in Gazebo")
     passing = [line for line in logged(rig, capfd) if line.startswith("Passing message")]
     assert passing == [
         f"Passing message from ROS {STRING} to Gazebo gz.msgs.StringMsg (showing msg only once "
