@@ -56,7 +56,7 @@ from ros_gz_bridge_py.errors import (
     ConfigError,
     UnsupportedTypeError,
 )
-from ros_gz_bridge_py.msgs.names import Spelling
+from ros_gz_bridge_py.msgs.names import Spelling, same_message
 from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.ros.runtime import steady_clock
 from ros_gz_bridge_py.ros.side_node import (
@@ -144,6 +144,8 @@ class Bridge:
         steady = steady_clock()
         self._timer = ros_node.create_timer(self.options.heartbeat, self.heartbeat, clock=steady)
         self._explainer: Explainer | None = None
+        #: What was said of each service bridge's providers (``_explain_services``).
+        self._services_said: dict[int, str] = {}
         self._explain_timer: Any = None
         if self.options.explain:
             self._explainer = Explainer(
@@ -248,8 +250,31 @@ class Bridge:
             return
         try:
             self._explainer.evaluate(self.channels)
+            self._explain_services()
         except Exception as err:
             self._logger.error(f"explaining the channels failed: {err!r}")
+
+    def _explain_services(self) -> None:
+        """Say once a service's providers take other types (it was said only when a call
+        failed, its timeout later), and again if the reason changes after it went away."""
+        services = self.services
+        said = {id(s): self._services_said.get(id(s), "") for s in services}
+        for service in services:
+            why, fault = service.provider_problem()
+            if not fault:
+                said[id(service)] = ""
+            elif said[id(service)] != why:
+                said[id(service)] = why
+                self._logger.warning(f"{service.describe()}: waiting for Gazebo: {why}")
+        self._services_said = said
+
+    def _ros_service_types(self, request: str, reply: str) -> list[str]:
+        """The ROS service types whose pair converts to the Gazebo ``request``/``reply``."""
+        return [
+            pair.ros_type
+            for pair in self.registry.services
+            if same_message(pair.gz_req_type, request) and same_message(pair.gz_rep_type, reply)
+        ]
 
     def close(self) -> None:
         """Close every bridge, the heartbeat timer and the Gazebo node if the bridge made it."""
@@ -353,6 +378,7 @@ class Bridge:
                 pair,
                 self.options.service_timeout,
                 max_queued_bytes=self.options.max_queued_bytes,
+                ros_types_for=self._ros_service_types,
             )
         except ConfigError:
             raise

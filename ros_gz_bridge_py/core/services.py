@@ -23,6 +23,7 @@ from __future__ import annotations
 import collections
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -128,8 +129,12 @@ class ServiceBridge:
         timeout: float = DEFAULT_TIMEOUT,
         *,
         max_queued_bytes: int = MAX_QUEUED_BYTES,
+        ros_types_for: Callable[[str, str], list[str]] = lambda _request, _reply: [],
     ) -> None:
+        """``ros_types_for(request, reply)``: the ROS service types converting to those Gazebo
+        types (a provider of other types is told which one to bridge it with)."""
         self.spec = spec
+        self._ros_types_for = ros_types_for
         self.pair = pair
         self.timeout = timeout
         self.gz_req_type, self.gz_rep_type = resolve_gz_types(spec, pair)
@@ -304,11 +309,13 @@ class ServiceBridge:
         ):
             return "", False
         types = ", ".join(sorted(f"{request}/{reply}" for request, reply in offered))
+        theirs = sorted({t for pair in sorted(offered) for t in self._ros_types_for(*pair)})
+        named = " or ".join(theirs) if theirs else "the ROS type of theirs (bridge_types "
+        named += "" if theirs else "--print-pairs lists the service pairs)"
         why = (
             f"the Gazebo providers of {service} take {types}, not "
             f"{self.gz_req_type}/{self.gz_rep_type}, the only types {self.spec.ros_type} "
-            "converts to; bridge the service with the ROS type of theirs (bridge_types "
-            "--print-pairs lists the service pairs) or make the provider take these"
+            f"converts to; bridge the service with {named}, or make the provider take these"
         )
         return why, True
 

@@ -146,7 +146,12 @@ def test_no_provider_gives_success_false_after_the_timeout(rig: Rig, world: RosW
     )
 
 
-def test_a_provider_of_other_types_is_named_when_nothing_answers(rig: Rig, world: RosWorld) -> None:
+def test_a_provider_of_other_types_is_named_when_nothing_answers(
+    make_rig: Callable[..., Rig], world: RosWorld, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Also logged as soon as the provider is known (it was said only once a call failed, its
+    timeout later), naming the ROS type that converts to its types (found by a new user)."""
+    rig = make_rig(options(service_timeout=SERVICE_TIMEOUT, explain=True))
     service = unique("other_types")
     rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
     # before any call, the status says what it waits for (it said "ok" with no provider)
@@ -159,17 +164,24 @@ def test_a_provider_of_other_types_is_named_when_nothing_answers(rig: Rig, world
     provider = Provider(GzPose, GzBoolean(data=True))
     rig.gazebo().advertise_service(service, "gz.msgs.Pose", "gz.msgs.Boolean", provider)
     wait_until(lambda: bool(rig.gz.service_info(service)), "the provider in discovery")
+    capfd.readouterr()
+    for _ in range(2):
+        world.run(rig.bridge.explain)
+    why = (
+        f"the Gazebo providers of {service} take gz.msgs.Pose/gz.msgs.Boolean, not "
+        f"gz.msgs.WorldControl/gz.msgs.Boolean, the only types {CONTROL_WORLD} converts to; "
+        "bridge the service with ros_gz_interfaces/srv/SetEntityPose, or make the provider "
+        "take these"
+    )
+    warned = [line for line in capfd.readouterr().err.splitlines() if line.startswith("[WARN]")]
+    assert len(warned) == 1, warned  # once, not at every look
+    assert warned[0].endswith(f"{rig.bridge.services[0].describe()}: waiting for Gazebo: {why}")
     assert call(world, ControlWorld, service, control_request()).success is False
     assert provider.requests == []
     (status,) = StatusTracker(rig.bridge).snapshot()
     assert (status.level_name, status.fault) == ("WARN", True)  # a misconfiguration
     assert status.why.startswith(f"the Gazebo providers of {service} take gz.msgs.Pose/")
-    assert status.last_error == (
-        f"no reply within {SERVICE_TIMEOUT:g} s: the Gazebo providers of {service} take "
-        "gz.msgs.Pose/gz.msgs.Boolean, not gz.msgs.WorldControl/gz.msgs.Boolean, the only "
-        f"types {CONTROL_WORLD} converts to; bridge the service with the ROS type of theirs "
-        "(bridge_types --print-pairs lists the service pairs) or make the provider take these"
-    )
+    assert status.last_error == f"no reply within {SERVICE_TIMEOUT:g} s: {why}"
 
 
 def test_closing_answers_the_waiting_calls(make_rig: Callable[..., Rig], world: RosWorld) -> None:
