@@ -145,7 +145,7 @@ class Bridge:
         self._timer = ros_node.create_timer(self.options.heartbeat, self.heartbeat, clock=steady)
         self._explainer: Explainer | None = None
         #: What was said of each service bridge's providers (``_explain_services``).
-        self._services_said: dict[int, str] = {}
+        self._services_said: dict[tuple[int, str], str] = {}
         self._explain_timer: Any = None
         if self.options.explain:
             self._explainer = Explainer(
@@ -255,17 +255,34 @@ class Bridge:
             self._logger.error(f"explaining the channels failed: {err!r}")
 
     def _explain_services(self) -> None:
-        """Say once a service's providers take other types (it was said only when a call
-        failed, its timeout later), and again if the reason changes after it went away."""
+        """Say once, as soon as it is seen, what keeps a service bridge from being used: its
+        Gazebo providers take other types (it was said only when a call failed, its timeout
+        later), or a ROS node uses its name with another service type (a client of another
+        type never sees the service: its wait_for_service times out, without a word)."""
         services = self.services
-        said = {id(s): self._services_said.get(id(s), "") for s in services}
+        if not services:
+            return
+        graph = dict(self.ros_node.get_service_names_and_types())
+        said: dict[tuple[int, str], str] = {}
         for service in services:
             why, fault = service.provider_problem()
-            if not fault:
-                said[id(service)] = ""
-            elif said[id(service)] != why:
-                said[id(service)] = why
-                self._logger.warning(f"{service.describe()}: waiting for Gazebo: {why}")
+            ours = service.spec.ros_type
+            others = [t for t in graph.get(service.service_name, []) if t != ours]
+            causes = {
+                "gazebo": f"waiting for Gazebo: {why}" if fault else "",
+                "ros": f"a ROS node uses {service.service_name} with {', '.join(others)}, but "
+                f"the bridge serves {ours}: a client of another type never sees the service "
+                f"(its wait_for_service times out); have it use {ours}, or bridge the service "
+                "with its type"
+                if others
+                else "",
+            }
+            for kind, text in causes.items():
+                key = (id(service), kind)
+                if text and self._services_said.get(key) != text:
+                    self._logger.warning(f"{service.describe()}: {text}")
+                if text:
+                    said[key] = text
         self._services_said = said
 
     def _ros_service_types(self, request: str, reply: str) -> list[str]:

@@ -9,12 +9,16 @@ from __future__ import annotations
 
 import threading
 import time
+import uuid
 from collections.abc import Callable
 from typing import Any
 
 import pytest
+import rclpy
+from rclpy.context import Context
 from rclpy.qos import DurabilityPolicy, QoSProfile
-from ros_gz_interfaces.srv import ControlWorld, SetEntityPose
+from rclpy.utilities import try_shutdown
+from ros_gz_interfaces.srv import ControlWorld, DeleteEntity, SetEntityPose
 
 from ros_gz_bridge_py.config import ServiceBridgeSpec
 from ros_gz_bridge_py.core.services import HeldBytes
@@ -393,3 +397,37 @@ def test_failed_and_given_up_calls_are_counted_in_full_and_told_once_per_period(
     assert len(warnings.lines) == 2, warnings.lines
     assert "Gazebo reported failure; 1 failed so far" in warnings.lines[0]
     assert "given up after 10.0 s: its client was not discovered; 1 given up" in warnings.lines[1]
+
+
+def test_a_ros_client_of_another_service_type_is_said_once(
+    make_rig: Callable[..., Rig], world: RosWorld, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A DeleteEntity client of a ControlWorld service never sees it: its wait_for_service
+    timed out and the bridge said nothing (found by a new user)."""
+    rig = make_rig(options(service_timeout=SERVICE_TIMEOUT, explain=True))
+    service = unique("client_type")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    context = Context()
+    rclpy.init(context=context)
+    other = rclpy.create_node(f"core_client_{uuid.uuid4().hex[:8]}", context=context)
+    try:
+        other.create_client(DeleteEntity, service)
+        delete = "ros_gz_interfaces/srv/DeleteEntity"
+        wait_until(
+            lambda: delete in dict(rig.node.get_service_names_and_types()).get(service, []),
+            "the client in the graph",
+        )
+        capfd.readouterr()
+        for _ in range(2):
+            world.run(rig.bridge.explain)
+        warned = [line for line in capfd.readouterr().err.splitlines() if "[WARN]" in line]
+        assert len(warned) == 1, warned  # once, not at every look
+        assert warned[0].endswith(
+            f"{rig.bridge.services[0].describe()}: a ROS node uses {service} with {delete}, but "
+            f"the bridge serves {CONTROL_WORLD}: a client of another type never sees the "
+            f"service (its wait_for_service times out); have it use {CONTROL_WORLD}, or bridge "
+            "the service with its type"
+        )
+    finally:
+        other.destroy_node()
+        try_shutdown(context=context)
