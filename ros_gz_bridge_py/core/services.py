@@ -255,6 +255,7 @@ class ServiceBridge:
 
         with self._settling:
             self._awaited.add(future)
+        served = not self.provider_problem()[0]  # a provider of our types is known now
         try:
             self._gz_node.request_async(
                 self.spec.service, payload, self.gz_req_type, self.gz_rep_type, self.timeout,
@@ -274,7 +275,7 @@ class ServiceBridge:
         if self._closing and success is None:
             return self._fail("the bridge is shutting down", "shutting down")
         if success is None:
-            return self._fail(self._no_reply(), "no reply")
+            return self._fail(self._no_reply(served), "no reply")
         if not success:
             return self._fail("Gazebo reported failure", "Gazebo failure")
         try:
@@ -282,10 +283,16 @@ class ServiceBridge:
         except Exception as err:
             return self._fail(f"reply not converted: {err}", NOT_CONVERTED)
 
-    def _no_reply(self) -> str:
-        """Why Gazebo did not answer in time, as far as discovery knows."""
+    def _no_reply(self, served: bool) -> str:
+        """Why Gazebo did not answer in time, as far as discovery knows; ``served``: a
+        provider of the bridge's types was known when the call was made."""
         waited = f"{self.timeout:g} s"
         why, _ = self.provider_problem()
+        if served and not self._gz_node.service_info(self.spec.service):
+            why = (
+                "the Gazebo provider known when the call was made went silent (a simulator "
+                "busy or stopped: discovery forgets a process silent for 3 s)"
+            )
         return (
             f"no reply within {waited}: {why}" if why else f"no reply from Gazebo within {waited}"
         )

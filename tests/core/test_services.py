@@ -431,3 +431,38 @@ def test_a_ros_client_of_another_service_type_is_said_once(
     finally:
         other.destroy_node()
         try_shutdown(context=context)
+
+
+def test_a_provider_that_went_silent_during_the_call_is_said_so(rig: Rig, world: RosWorld) -> None:
+    """The no-reply text said no provider was known, of a provider that got the request and
+    went silent (a simulator frozen for 7 s, found by a new user)."""
+    service = unique("went_silent")
+    rig.add(ServiceBridgeSpec(service, CONTROL_WORLD))
+    entered, released = threading.Event(), threading.Event()
+
+    def stuck(_payload: bytes) -> tuple[bool, bytes]:
+        entered.set()
+        released.wait(WAIT)
+        return True, GzBoolean(data=True).SerializeToString()
+
+    offer = rig.gazebo().advertise_service(
+        service, "gz.msgs.WorldControl", "gz.msgs.Boolean", stuck
+    )
+    wait_until(lambda: bool(rig.gz.service_info(service)), "the provider in discovery")
+    client = world.run(lambda: world.node.create_client(ControlWorld, service))
+    try:
+        wait_until(client.service_is_ready, f"the service {service}")
+        future = world.run(lambda: client.call_async(control_request()))
+        wait_until(entered.is_set, "the request at the provider")
+        offer.close()  # as discovery forgets a process silent for 3 s
+        wait_until(future.done, f"a response from {service}", timeout=WAIT)
+    finally:
+        released.set()
+        world.destroy(client)
+    assert future.result().success is False
+    (status,) = StatusTracker(rig.bridge).snapshot()
+    assert status.last_error == (
+        f"no reply within {SERVICE_TIMEOUT:g} s: the Gazebo provider known when the call was "
+        "made went silent (a simulator busy or stopped: discovery forgets a process silent for "
+        "3 s)"
+    )
