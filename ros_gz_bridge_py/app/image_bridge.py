@@ -158,7 +158,10 @@ def build_bridge(
         options=dataclasses.replace(options, types_fixed_by=PROGRAM, qos_setting=QOS_SETTING),
         gz_options=params.shared.gz_node_options(stop),
     )
-    bridge.add_all(specs)
+    if bridge.add_all(specs) and not bridge.handles:
+        logger.error("No image topic could be bridged (each is refused above)")
+        bridge.close()
+        return None
     return bridge
 
 

@@ -283,7 +283,7 @@ class Channel(abc.ABC):
         hint = _HINTS.get(reason, "")
         self._logger.warning(
             f"{self.describe()}: message skipped ({reason.value}): {detail} "
-            f"({count} so far, {self.stats.errors} errors in all){hint}"
+            f"({count} so far, {_errors(self.stats.errors)} in all){hint}"
         )
 
     def describe(self) -> str:
@@ -328,3 +328,7 @@ class Channel(abc.ABC):
 
     @abc.abstractmethod
     def _output_has_subscribers(self) -> bool: ...
+
+
+def _errors(count: int) -> str:
+    return "1 error" if count == 1 else f"{count} errors"

@@ -315,7 +315,7 @@ def _no_peer_finding(situation: Situation) -> Finding:
         "the Gazebo Transport processes heard before are gone (a simulator that stopped, or a "
         "network that went away)"
         if situation.peers_lost
-        else f"no Gazebo Transport process is {still}heard at all"
+        else f"{still}no Gazebo Transport process is heard at all"
     )
     return Finding(
         "no-peer" + (":overdue" if situation.overdue else ""),
@@ -341,11 +341,12 @@ def _absent_finding(situation: Situation, role: str) -> Finding:
     if shown:
         more = f" and {len(typed) - len(shown)} more" if len(typed) > len(shown) else ""
         hint = f"; Gazebo {role}s of {situation.gz_type} there: {', '.join(shown)}{more}"
-    similar = [t for t in similar if t not in shown]
-    hint += f"; similar topics: {', '.join(similar)}" if similar else ""
     namespace = situation.ros_namespace.rstrip("/")
     inside = f"{namespace}/{situation.gz_topic.lstrip('/')}"
-    if namespace and inside in similar:
+    named = similar + shown  # the name inside the namespace may be shown for its type
+    similar = [t for t in similar if t not in shown]
+    hint += f"; similar topics: {', '.join(similar)}" if similar else ""
+    if namespace and inside in named:
         hint += (
             f"; Gazebo names do not take the bridge's namespace {namespace} unless "
             "expand_gz_topic_names is true (-p expand_gz_topic_names:=true, with the entry's "

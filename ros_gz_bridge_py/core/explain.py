@@ -367,7 +367,7 @@ class Explainer:
         return seen
 
     def _count(self, seen: _Seen, channel: Channel, now: float) -> None:
-        count = channel.stats.received
+        count = channel.stats.published  # passed on: failing every message is no flow
         if count != seen.count:
             if seen.changed is not None:
                 seen.interval = (now - seen.changed) / (count - seen.count)

@@ -377,6 +377,13 @@ def test_only_ros_arguments_is_nothing_to_bridge() -> None:
     assert "No image topics to bridge" in done.stderr
 
 
+def test_only_refused_topics_is_nothing_to_bridge() -> None:
+    """It kept running with no bridge, after one error (found by a new user)."""
+    done = _run("/camera/image/")
+    assert done.returncode == 255
+    assert "No image topic could be bridged (each is refused above)" in done.stderr
+
+
 def test_console_script_runs_the_same_main() -> None:
     script = Path(sys.prefix) / "bin" / "image_bridge"
     done = subprocess.run([str(script)], capture_output=True, text=True, timeout=60, check=False)

@@ -119,6 +119,22 @@ def test_flowing_then_stalled(rig: Rig, world: RosWorld) -> None:
     assert texts(channel)[0].startswith(f"no Gazebo publisher of {topic} in partition ")
 
 
+def test_a_channel_whose_every_message_fails_is_not_flowing(rig: Rig) -> None:
+    """Counted by what it received, a channel that published nothing (every image shorter
+    than its size) showed "flowing" (found by a new user)."""
+    topic = unique("failing")
+    channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS)))
+    publisher = rig.gazebo().advertise(topic, STRING)
+    judge = Judge(rig)
+    judge.evaluate()
+    for _ in range(3):
+        publisher.publish_raw(b"\xff\xff\xff")  # not a protobuf message
+    wait_until(lambda: channel.stats.conversion_errors == 3, "three errors")
+    judge.evaluate(1.0)
+    assert flow_of(channel) is Flow.STALLED
+    assert channel.stats.published == 0
+
+
 def test_the_topic_alive_in_another_partition_names_it(rig: Rig) -> None:
     topic = unique("partition")
     channel = gz_to_ros(rig.add(string_spec(topic, Direction.GZ_TO_ROS)))
@@ -162,7 +178,7 @@ def test_no_gazebo_at_all_is_said_once_for_the_bridge(rig: Rig) -> None:
     judge.evaluate(CONFIRM_AFTER)
     (warning,) = judge.logged
     assert warning.startswith(
-        f"Nothing can flow: no Gazebo Transport process is still heard at all; {listens}"
+        f"Nothing can flow: still no Gazebo Transport process is heard at all; {listens}"
     )
     assert StatusTracker(rig.bridge).snapshot()[0].level == WARN
     # A simulator that comes is said once it stayed; its leaving is said at once, as such.

@@ -179,7 +179,7 @@ def test_no_peer_is_no_fault_before_discovery_listened_long_enough() -> None:
     assert (settled.key, settled.fault) == ("no-peer", False)  # a simulator not up yet
     (overdue,) = findings(dataclasses.replace(early, peers_settled=True, overdue=True), HINTS)
     assert (overdue.key, overdue.fault) == ("no-peer:overdue", True)
-    assert overdue.text.startswith("no Gazebo Transport process is still heard at all; ")
+    assert overdue.text.startswith("still no Gazebo Transport process is heard at all; ")
 
 
 def test_ros_to_gazebo_waits_for_a_registered_subscriber() -> None:
@@ -369,6 +369,8 @@ def test_a_name_outside_the_bridges_namespace_is_told_how_to_put_it_inside() -> 
         "expand_gz_topic_names:=true, with the entry's Gazebo name relative), or write "
         "/robot1/odom"
     )
+    typed = dataclasses.replace(waiting, gz_typed=["/robot1/odom", "/robot2/odom"])
+    assert "expand_gz_topic_names is true" in findings(typed, HINTS)[0].text  # shown for its type
     for elsewhere in ("/", "/robot3"):  # no such topic inside the namespace: no such hint
         other = dataclasses.replace(waiting, ros_namespace=elsewhere)
         assert "namespace" not in findings(other, HINTS)[0].text
