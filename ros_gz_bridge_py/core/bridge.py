@@ -345,7 +345,8 @@ class Bridge:
                 channel.start()
         except Exception as err:
             _close_handle(handle)
-            raise ConfigError(_failed_text(spec, str(err)), spec.source or None) from err
+            why = _failed_text(spec, str(err), self.options.types_fixed_by)
+            raise ConfigError(why, spec.source or None) from err
         for channel in handle.channels:  # once they exist: a refused entry is not "Creating"
             for line in channel.creation_lines():
                 self._logger.info(line)
@@ -410,12 +411,12 @@ class Bridge:
         return BridgeHandle(spec, service=service)
 
 
-def _failed_text(spec: TopicBridgeSpec, why: str) -> str:
+def _failed_text(spec: TopicBridgeSpec, why: str, program: str = "") -> str:
     reason = RCL_SOURCE_LOCATION.sub("", why)
     return (
         f"Failed to create a bridge for topic [{spec.ros_topic}] with ROS2 type [{spec.ros_type}] "
         f"to topic [{spec.gz_topic}] with Gazebo Transport type [{spec.gz_type}]: "
-        f"{reason}{refused_name_fix(spec, reason)}"
+        f"{reason}{refused_name_fix(spec, reason, program)}"
     )
 
 

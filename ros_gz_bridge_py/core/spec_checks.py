@@ -174,16 +174,19 @@ def _optional(spec: TopicBridgeSpec, name: str, convert: Callable[[str, object],
         raise ConfigError(err.message, _where(spec)) from None
 
 
-def refused_name_fix(spec: TopicBridgeSpec, why: str) -> str:
+def refused_name_fix(spec: TopicBridgeSpec, why: str, program: str = "") -> str:
     """What to write when ``why`` says a side refuses a name of ``spec`` (rcl's words for a
-    ROS name, the transport's for a Gazebo one); '' for other failures."""
+    ROS name, the transport's for a Gazebo one); '' for other failures. ``program``: the
+    executable whose arguments name the topics (``image_bridge``), else entries do."""
     if why.startswith("failed to resolve name"):
         fix = f"; [{spec.ros_topic}] is no valid ROS name: {ROS_NAME_RULE}"
         if spec.ros_topic == spec.gz_topic and is_valid_topic(spec.gz_topic):
-            fix += (
-                ", though Gazebo takes it: set ros_topic_name to a ROS name and gz_topic_name "
-                "to this one"
+            rename = (
+                f"give it one: {program} {spec.gz_topic}:=<ROS name>"
+                if program
+                else "set ros_topic_name to a ROS name and gz_topic_name to this one"
             )
+            fix += f", though Gazebo takes it: {rename}"
         return fix
     if why.startswith("invalid Gazebo Transport topic") and spec.gz_topic.startswith("~"):
         return "; -p expand_gz_topic_names:=true expands '~' in YAML entries as in ROS names"

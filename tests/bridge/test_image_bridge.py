@@ -382,6 +382,10 @@ def test_only_refused_topics_is_nothing_to_bridge() -> None:
     done = _run("/camera/image/")
     assert done.returncode == 255
     assert "No image topic could be bridged (each is refused above)" in done.stderr
+    # The fix is this command line's, not a YAML entry's.
+    assert "though Gazebo takes it: give it one: image_bridge /camera/image/:=<ROS name>" in (
+        done.stderr
+    )
 
 
 def test_console_script_runs_the_same_main() -> None:
