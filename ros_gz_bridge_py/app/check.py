@@ -29,12 +29,8 @@ from ros_gz_bridge_py.core.diagnosis import (
     findings,
     takes_ours,
 )
-from ros_gz_bridge_py.core.explain import (
-    as_the_graph_shows,
-    gazebo_name,
-    ros_endpoints,
-    type_hints,
-)
+from ros_gz_bridge_py.core.explain import gazebo_name, type_hints
+from ros_gz_bridge_py.core.ros_endpoints import as_the_graph_shows, ros_endpoints
 from ros_gz_bridge_py.core.similar_topics import Offered, offered_by_others
 from ros_gz_bridge_py.core.spec_checks import refused_name_fix
 from ros_gz_bridge_py.errors import RCL_SOURCE_LOCATION, ConfigError, TransportError

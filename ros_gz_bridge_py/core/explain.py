@@ -10,22 +10,13 @@ carried is not warned about: an '@' entry's Gazebo topic often has no subscriber
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from rclpy.duration import Infinite
-from rclpy.qos import (
-    DurabilityPolicy,
-    LivelinessPolicy,
-    QoSCompatibility,
-    QoSProfile,
-    ReliabilityPolicy,
-    qos_check_compatible,
-)
+from rclpy.qos import QoSProfile
 
 from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.converters.registry import Registry
@@ -41,6 +32,7 @@ from ros_gz_bridge_py.core.diagnosis import (
     flow,
     wanted_role,
 )
+from ros_gz_bridge_py.core.ros_endpoints import as_the_graph_shows, ros_endpoints
 from ros_gz_bridge_py.core.ros_to_gz import RosToGzChannel
 from ros_gz_bridge_py.core.similar_topics import Offered, offered_by_others
 from ros_gz_bridge_py.transport import GzNode
@@ -68,6 +60,9 @@ BRIDGE_WIDE = frozenset({"no-peer", "no-peer:overdue"})
 #: that starts after the bridge: the bridge listened this long without hearing any Gazebo
 #: process, or the partition's other topics have been there this long (and the channel too).
 PATIENCE = 30.0
+#: Seconds after which the processes heard in the bridge's partition are a simulator, whose
+#: loss is said at once and as such (a tool such as `gz topic -e` comes and goes sooner).
+SIMULATOR_AFTER = 10.0
 
 
 def type_hints(
@@ -81,91 +76,6 @@ def type_hints(
         types_fixed_by=types_fixed_by,
         qos_setting=qos_setting,
     )
-
-
-def ros_endpoints(
-    ros_node: Any,
-    direction: Direction,
-    ros_topic: str,
-    our_qos: QoSProfile,
-    own_nodes: Iterable[tuple[str, str]],
-) -> list[RosEndpoint]:
-    """The ROS endpoints at the far end of a channel: the subscribers a Gazebo->ROS channel
-    publishes to, or the publishers a ROS->Gazebo channel reads; the bridge's own left out.
-    ``our_qos``: the channel's profile as the graph shows it (:func:`as_the_graph_shows`)."""
-    own = set(own_nodes)
-    to_ros = direction is Direction.GZ_TO_ROS
-    infos = (
-        ros_node.get_subscriptions_info_by_topic(ros_topic)
-        if to_ros
-        else ros_node.get_publishers_info_by_topic(ros_topic)
-    )
-    found = []
-    for info in infos:
-        if (info.node_name, info.node_namespace) in own:
-            continue
-        namespace = info.node_namespace.rstrip("/")
-        node = f"{namespace}/{info.node_name}"
-        publisher, subscription = (
-            (our_qos, info.qos_profile) if to_ros else (info.qos_profile, our_qos)
-        )
-        compatibility, reason = qos_check_compatible(publisher, subscription)
-        problem = ""
-        fixes: tuple[str, ...] = ()
-        if compatibility == QoSCompatibility.ERROR:
-            problem = qos_errors(reason)
-            fixes = qos_fixes(to_ros, publisher, subscription)
-        found.append(
-            RosEndpoint(node, info.topic_type, problem, describe_qos(info.qos_profile), fixes)
-        )
-    return found
-
-
-def qos_errors(reason: str) -> str:
-    """rcl's ``"ERROR: a;WARNING: b;ERROR: c;"`` as ``"a, c"``: the incompatibilities only,
-    without rcl's markup, for a sentence of ours."""
-    errors = [part.strip() for part in reason.split(";") if part.strip().startswith("ERROR:")]
-    return ", ".join(error.removeprefix("ERROR:").strip() for error in errors) or reason.strip()
-
-
-def qos_fixes(we_publish: bool, publisher: QoSProfile, subscription: QoSProfile) -> tuple[str, ...]:
-    """The ``qos_overrides`` of the bridge's endpoint (``publisher.durability:=transient_local``)
-    that match the other end's reliability and durability, the incompatibilities users meet
-    (a transient-local /map reader; a best-effort sensor publisher). Empty when those match:
-    then another policy (deadline, liveliness) is at fault, which the entry's profile sets."""
-    ours, theirs = (publisher, subscription) if we_publish else (subscription, publisher)
-    side = "publisher" if we_publish else "subscription"
-    fixes = []
-    if (publisher.reliability, subscription.reliability) == (
-        ReliabilityPolicy.BEST_EFFORT,
-        ReliabilityPolicy.RELIABLE,
-    ):
-        fixes.append(f"{side}.reliability:={theirs.reliability.name.lower()}")
-    if we_publish and (ours.durability, theirs.durability) == (
-        DurabilityPolicy.VOLATILE,
-        DurabilityPolicy.TRANSIENT_LOCAL,
-    ):  # a subscription's durability has no override (rclpy's default policies)
-        fixes.append("publisher.durability:=transient_local")
-    return tuple(fixes)
-
-
-def as_the_graph_shows(profile: QoSProfile) -> QoSProfile:
-    """``profile`` with its "default" durations and liveliness as the graph reports them for
-    a live endpoint (infinite, automatic); compared as they are, a default deadline reads as
-    "none" against an infinite one and every pair looks incompatible."""
-    shown = copy.copy(profile)
-    for name in ("deadline", "lifespan", "liveliness_lease_duration"):
-        if getattr(shown, name).nanoseconds == 0:
-            setattr(shown, name, Infinite)
-    if shown.liveliness == LivelinessPolicy.SYSTEM_DEFAULT:
-        shown.liveliness = LivelinessPolicy.AUTOMATIC
-    return shown
-
-
-def describe_qos(profile: QoSProfile) -> str:
-    """``reliable, volatile, depth 10`` (keep-all histories say so)."""
-    history = f"depth {profile.depth}" if profile.history.name == "KEEP_LAST" else "keep all"
-    return f"{profile.reliability.name.lower()}, {profile.durability.name.lower()}, {history}"
 
 
 def gazebo_name(gz_node: GzNode, topic: str) -> tuple[str, str]:
@@ -236,11 +146,11 @@ class Explainer:
         self._partition = getattr(gz_node, "partition", "").strip("/")
         #: Since when other processes have endpoints in the bridge's partition (None: not now).
         self._alive_since: float | None = None
-        #: Since when Gazebo processes are heard (None: none now).
+        #: Since when Gazebo processes are heard (None: none now), since when none is.
         self._peers_since: float | None = None
-        #: The partition had other processes' endpoints in two looks once: a simulator, which
-        #: "gone" may speak of (not other partitions' processes, nor a passing `gz topic -l`).
-        self._simulator_heard = False
+        self._quiet_since = self._started
+        #: The processes last lost were a simulator (:data:`SIMULATOR_AFTER`).
+        self._simulator_lost = False
         self._no_peer_said = False
         self._asked = float("-inf")
 
@@ -281,7 +191,7 @@ class Explainer:
             )
             if not quiet and self._overdue(seen, peers, now):
                 situation = dataclasses.replace(situation, overdue=True)
-            if not peers and self._simulator_heard:
+            if not peers and self._simulator_lost:
                 situation = dataclasses.replace(situation, peers_lost=True)
             if (
                 situation.direction is Direction.ROS_TO_GZ
@@ -307,22 +217,29 @@ class Explainer:
                 self._report(channel, seen, said, now)
 
     def _follow_peers(self, graph: Sequence[GraphEndpoint], peers: int, now: float) -> None:
-        """Note since when the bridge's partition has other processes' endpoints, and say
-        once that Gazebo is heard after "nothing can flow" was said."""
+        """Note since when the bridge's partition has other processes' endpoints and since
+        when processes are heard or none is, and say once that Gazebo is heard after
+        "nothing can flow" was said."""
+        was_alive = self._alive_since
         if any(endpoint.partition.strip("/") == self._partition for endpoint in graph):
             self._alive_since = now if self._alive_since is None else self._alive_since
-            self._simulator_heard |= now - self._alive_since >= CONFIRM_AFTER
         else:
             self._alive_since = None
         if not peers:
-            self._peers_since = None
+            if self._peers_since is not None:  # lost since the last look
+                self._simulator_lost = (
+                    was_alive is not None and now - self._peers_since >= SIMULATOR_AFTER
+                )
+                if self._simulator_lost:
+                    self._bridge_logged.clear()  # a simulator's loss is said at once
+                self._peers_since, self._quiet_since = None, now
             return
+        self._simulator_lost = False
         self._peers_since = now if self._peers_since is None else self._peers_since
         if now - self._peers_since < CONFIRM_AFTER:
             return
         if self._no_peer_said:
             self._no_peer_said = False
-            self._bridge_logged.clear()  # losing them again is said at once
             heard = "1 process" if peers == 1 else f"{peers} processes"
             self._note(f"Gazebo Transport heard now ({heard} in any partition)")
 
@@ -330,8 +247,8 @@ class Explainer:
         """Whether the channel's Gazebo side had :data:`PATIENCE` to be there."""
         if now - seen.started < PATIENCE:
             return False
-        if not peers:
-            return now - self._started >= PATIENCE
+        if not peers:  # counted from when the last were lost: a simulator restarting
+            return now - self._quiet_since >= PATIENCE
         return self._alive_since is not None and now - self._alive_since >= PATIENCE
 
     def _ros_others(self, ros_node: Any) -> frozenset[tuple[str, str]] | None:

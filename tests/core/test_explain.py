@@ -20,6 +20,7 @@ from ros_gz_bridge_py.core.explain import (
     CONFIRM_AFTER,
     EXPLAIN_PERIOD,
     PATIENCE,
+    SIMULATOR_AFTER,
     WARM_UP,
 )
 from ros_gz_bridge_py.core.status import OK, WARN, StatusTracker
@@ -181,19 +182,43 @@ def test_no_gazebo_at_all_is_said_once_for_the_bridge(rig: Rig) -> None:
         f"Nothing can flow: still no Gazebo Transport process is heard at all; {listens}"
     )
     assert StatusTracker(rig.bridge).snapshot()[0].level == WARN
-    # A simulator that comes is said once it stayed; its leaving is said at once, as such.
+    # A simulator that comes is said once it stayed; its leaving is said at once, as such,
+    # and is a fault only PATIENCE after it (a simulator restarting is the usual case).
     simulator = rig.gazebo()
     simulator.advertise(unique("clock"), STRING)  # in the bridge's partition
     judge.evaluate(EXPLAIN_PERIOD)
     judge.evaluate(EXPLAIN_PERIOD)
-    assert judge.noted[1] == "Gazebo Transport heard now (1 process in any partition)"
+    heard = "Gazebo Transport heard now (1 process in any partition)"
+    assert bridge_wide(judge.noted) == [line, heard]
+    judge.evaluate(SIMULATOR_AFTER)
     simulator.close()
     judge.evaluate(EXPLAIN_PERIOD)
     judge.evaluate(CONFIRM_AFTER)
-    assert judge.logged[1].startswith(
+    gone = (
         "Nothing can flow: the Gazebo Transport processes heard before are gone (a simulator "
         f"that stopped, or a network that went away); {listens}"
     )
+    assert bridge_wide(judge.noted)[2].startswith(gone)
+    assert len(bridge_wide(judge.logged)) == 1
+    judge.evaluate(PATIENCE)
+    judge.evaluate(CONFIRM_AFTER)
+    assert bridge_wide(judge.logged)[1].startswith(gone)
+    # A tool that comes and goes within seconds (`gz topic -e`) is no simulator: its leaving
+    # is not said again within the minute.
+    tool = rig.gazebo()
+    tool.advertise(unique("echo"), STRING)
+    judge.evaluate(EXPLAIN_PERIOD)
+    judge.evaluate(EXPLAIN_PERIOD)
+    tool.close()
+    judge.evaluate(EXPLAIN_PERIOD)
+    judge.evaluate(EXPLAIN_PERIOD)
+    assert bridge_wide(judge.noted)[3:] == [heard]
+    assert len(bridge_wide(judge.logged)) == 2
+
+
+def bridge_wide(lines: list[str]) -> list[str]:
+    """The lines said of the whole bridge, not of one channel."""
+    return [line for line in lines if not line.startswith(("GZ->ROS", "ROS->GZ"))]
 
 
 def test_an_absent_topic_suggests_similar_names_and_is_no_warning(rig: Rig) -> None:

@@ -18,13 +18,8 @@ from std_msgs.msg import Int32, String
 
 from ros_gz_bridge_py.config import Direction
 from ros_gz_bridge_py.core.channel import Channel
-from ros_gz_bridge_py.core.explain import (
-    EXPLAIN_PERIOD,
-    ROS_ENDPOINTS_REFRESH,
-    Explainer,
-    qos_errors,
-    qos_fixes,
-)
+from ros_gz_bridge_py.core.explain import EXPLAIN_PERIOD, ROS_ENDPOINTS_REFRESH, Explainer
+from ros_gz_bridge_py.core.ros_endpoints import qos_errors, qos_fixes
 from tests.core.harness import (
     Rig,
     RosWorld,
