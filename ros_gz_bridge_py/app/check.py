@@ -28,6 +28,7 @@ from ros_gz_bridge_py.core.diagnosis import (
     Situation,
     findings,
     takes_ours,
+    wanted_role,
 )
 from ros_gz_bridge_py.core.explain import gazebo_name, type_hints
 from ros_gz_bridge_py.core.ros_endpoints import as_the_graph_shows, ros_endpoints
@@ -43,7 +44,7 @@ from ros_gz_bridge_py.ros.qos import (
 )
 from ros_gz_bridge_py.ros.stop_signal import StopSignal
 from ros_gz_bridge_py.transport import GzNode, Publisher
-from ros_gz_bridge_py.transport.api import PUBLISHER, SUBSCRIBER, GraphEndpoint
+from ros_gz_bridge_py.transport.api import GraphEndpoint
 
 #: Seconds ``--check`` listens by default: discovery re-announces every second, the ROS graph
 #: settles within about two.
@@ -219,7 +220,7 @@ def _topic_reports(
             waits.append(False)
             continue
         ros_side = ros_endpoints(ros_node, direction, ros_topic, as_the_graph_shows(qos), own)
-        role = PUBLISHER if direction is Direction.GZ_TO_ROS else SUBSCRIBER
+        role = wanted_role(direction)
         situation = Situation(
             direction=direction,
             ros_topic=ros_topic,

@@ -316,6 +316,16 @@ class Registry:
         pairs.sort(key=lambda pair: not pair.default_for_gz_type)
         return [p.ros_type for p in pairs]
 
+    def ros_service_types_for(self, gz_request: str, gz_reply: str) -> list[str]:
+        """The ROS service types whose pair converts to the Gazebo request and reply types
+        (either spelling)."""
+        wanted = (canonical_type(gz_request), canonical_type(gz_reply))
+        return [
+            p.ros_type
+            for p in self.services
+            if (canonical_type(p.gz_req_type), canonical_type(p.gz_rep_type)) == wanted
+        ]
+
     def _explain_missing(self, ros_type: str, gz_type: str) -> str:
         text = f"no converter for ROS type [{ros_type}] and Gazebo type [{gz_type}]"
         if "/" in ros_type and "/msg/" not in ros_type and "/srv/" not in ros_type:

@@ -56,7 +56,7 @@ from ros_gz_bridge_py.errors import (
     ConfigError,
     UnsupportedTypeError,
 )
-from ros_gz_bridge_py.msgs.names import Spelling, same_message
+from ros_gz_bridge_py.msgs.names import Spelling
 from ros_gz_bridge_py.ros.quick_log import quick_logger
 from ros_gz_bridge_py.ros.runtime import steady_clock
 from ros_gz_bridge_py.ros.side_node import (
@@ -285,14 +285,6 @@ class Bridge:
                     said[key] = text
         self._services_said = said
 
-    def _ros_service_types(self, request: str, reply: str) -> list[str]:
-        """The ROS service types whose pair converts to the Gazebo ``request``/``reply``."""
-        return [
-            pair.ros_type
-            for pair in self.registry.services
-            if same_message(pair.gz_req_type, request) and same_message(pair.gz_rep_type, reply)
-        ]
-
     def close(self) -> None:
         """Close every bridge, the heartbeat timer and the Gazebo node if the bridge made it."""
         with self._lock:
@@ -396,7 +388,7 @@ class Bridge:
                 pair,
                 self.options.service_timeout,
                 max_queued_bytes=self.options.max_queued_bytes,
-                ros_types_for=self._ros_service_types,
+                ros_types_for=self.registry.ros_service_types_for,
             )
         except ConfigError:
             raise

@@ -162,9 +162,9 @@ def findings(situation: Situation, hints: TypeHints) -> list[Finding]:
 # --- the Gazebo side -------------------------------------------------------------------------
 
 
-def wanted_role(situation: Situation) -> str:
+def wanted_role(direction: Direction) -> str:
     """The Gazebo endpoints a channel needs: publishers to read, or subscribers to write to."""
-    return PUBLISHER if situation.direction is Direction.GZ_TO_ROS else SUBSCRIBER
+    return PUBLISHER if direction is Direction.GZ_TO_ROS else SUBSCRIBER
 
 
 def takes_ours(endpoint: GraphEndpoint, gz_type: str) -> bool:
@@ -198,7 +198,7 @@ def _where(endpoint: GraphEndpoint) -> str:
 
 
 def _gazebo_findings(situation: Situation, hints: TypeHints) -> list[Finding]:
-    role = wanted_role(situation)
+    role = wanted_role(situation.direction)
     mine = [
         e for e in situation.gz_endpoints if e.role == role and e.partition == situation.partition
     ]

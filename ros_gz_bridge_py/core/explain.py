@@ -112,6 +112,8 @@ class _Seen:
     endpoints_at: float = 0.0
     #: A cause of its own was logged since it last flowed.
     waited: bool = False
+    #: The namespace of the bridge's node (asked once, not at every pass).
+    ros_namespace: str = ""
 
 
 class Explainer:
@@ -187,12 +189,14 @@ class Explainer:
             # there (a Gazebo topic nobody subscribes to) is the usual case, never a fault.
             quiet = any(other is not channel for other in carried.get(id(channel.spec), ()))
             situation = self._situation(
-                channel, seen, now, (peers, listening), graph, ros_nodes=nodes
+                channel,
+                seen,
+                now,
+                (peers, listening),
+                graph,
+                ros_nodes=nodes,
+                overdue=not quiet and self._overdue(seen, peers, now),
             )
-            if not quiet and self._overdue(seen, peers, now):
-                situation = dataclasses.replace(situation, overdue=True)
-            if not peers and self._simulator_lost:
-                situation = dataclasses.replace(situation, peers_lost=True)
             if (
                 situation.direction is Direction.ROS_TO_GZ
                 and not situation.gz_subscriber_registered
@@ -201,7 +205,7 @@ class Explainer:
             found = findings(situation, self._hints)
             if any(f.key.startswith("gz-absent") for f in found):
                 offered = offered or offered_by_others(everything, self._partition)
-                role = wanted_role(situation)
+                role = wanted_role(situation.direction)
                 situation = dataclasses.replace(
                     situation,
                     gz_topics=offered.topics(role),
@@ -279,7 +283,8 @@ class Explainer:
         name = gazebo_name(self._gz, channel.spec.gz_topic)
         # Counted from 0: a channel that passed messages before its first evaluation (2 s
         # after the bridge started) is flowing at once, not "stalled" in its first status.
-        seen = _Seen(now, name, as_the_graph_shows(channel.qos))
+        namespace = channel.ctx.ros_node.get_namespace()
+        seen = _Seen(now, name, as_the_graph_shows(channel.qos), ros_namespace=namespace)
         self._seen[id(channel)] = seen
         return seen
 
@@ -299,10 +304,12 @@ class Explainer:
         graph: dict[str, list[GraphEndpoint]],
         *,
         ros_nodes: frozenset[tuple[str, str]] | None,
+        overdue: bool,
     ) -> Situation:
         """``gz_side``: (peer processes, where the node listens); ``graph``: the endpoints of
         other processes by topic name (``GzNode.graph``); ``ros_nodes``: the ROS graph's nodes,
-        None when it shows none but the bridge's (:meth:`_ros_others`)."""
+        None when it shows none but the bridge's (:meth:`_ros_others`); ``overdue``: its Gazebo
+        side had :data:`PATIENCE` to be there."""
         spec = channel.spec
         peers, listening = gz_side
         partition, name = seen.gz_name
@@ -327,7 +334,9 @@ class Explainer:
             discovered_by=spec.discovered_by,
             peers_settled=now - self._started >= WARM_UP,
             bidirectional=spec.direction is Direction.BIDIRECTIONAL,
-            ros_namespace=channel.ctx.ros_node.get_namespace(),
+            ros_namespace=seen.ros_namespace,
+            overdue=overdue,
+            peers_lost=not peers and self._simulator_lost,
         )
 
     def _ask_subscribers(self, now: float) -> None:

@@ -287,12 +287,13 @@ class ServiceBridge:
         """Why Gazebo did not answer in time, as far as discovery knows; ``served``: a
         provider of the bridge's types was known when the call was made."""
         waited = f"{self.timeout:g} s"
-        why, _ = self.provider_problem()
         if served and not self._gz_node.service_info(self.spec.service):
             why = (
                 "the Gazebo provider known when the call was made went silent (a simulator "
                 "busy or stopped: discovery forgets a process silent for 3 s)"
             )
+        else:
+            why, _ = self.provider_problem()
         return (
             f"no reply within {waited}: {why}" if why else f"no reply from Gazebo within {waited}"
         )
@@ -316,9 +317,10 @@ class ServiceBridge:
         ):
             return "", False
         types = ", ".join(sorted(f"{request}/{reply}" for request, reply in offered))
-        theirs = sorted({t for pair in sorted(offered) for t in self._ros_types_for(*pair)})
-        named = " or ".join(theirs) if theirs else "the ROS type of theirs (bridge_types "
-        named += "" if theirs else "--print-pairs lists the service pairs)"
+        theirs = sorted({t for pair in offered for t in self._ros_types_for(*pair)})
+        named = " or ".join(theirs) or (
+            "the ROS type of theirs (bridge_types --print-pairs lists the service pairs)"
+        )
         why = (
             f"the Gazebo providers of {service} take {types}, not "
             f"{self.gz_req_type}/{self.gz_rep_type}, the only types {self.spec.ros_type} "
